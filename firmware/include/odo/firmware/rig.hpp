@@ -1,0 +1,43 @@
+// Rig: the wiring of one configuration: the clock, the encoder source and, in simulation, the
+// simulated robot with its ground truth. The loop only ever sees the HAL interfaces.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "odo/firmware/config.hpp"
+#include "odo/firmware/loop.hpp"
+#include "odo/hal/clock.hpp"
+#include "odo/hal/encoder.hpp"
+#include "odo/hal/result.hpp"
+#include "odo/odometry/kinematics.hpp"
+
+namespace odo::fw {
+
+class Rig {
+ public:
+  ~Rig();
+  Rig(Rig&&) noexcept;
+  Rig& operator=(Rig&&) noexcept;
+
+  // create: builds the backend named in cfg.encoder.backend. virtual_time: simulated clock that
+  // runs as fast as the machine allows (simulated backends only).
+  static Result<Rig> create(const Config& cfg, const Kinematics& k, bool virtual_time);
+
+  Clock& clock() noexcept;
+  EncoderSource& encoder() noexcept;
+  // truth_observer: fills the snapshot's ground truth (simulation only; null otherwise).
+  TickObserver* truth_observer() noexcept;
+  // describe: one line saying what is wired, for the start-up report.
+  const std::string& describe() const noexcept;
+  // scenario_duration: length of the simulated motion [s], 0 when not simulated.
+  double scenario_duration() const noexcept;
+
+ private:
+  struct Impl;
+  explicit Rig(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace odo::fw

@@ -1,0 +1,49 @@
+// TableReader: typed, range-checked access to one TOML table, remembering which keys were used
+// so that unknown (mistyped) keys are reported with their line.
+#pragma once
+
+#include <cstdint>
+#include <initializer_list>
+#include <set>
+#include <string>
+#include <string_view>
+
+#include <toml++/toml.h>
+
+namespace odo::fw {
+
+class TableReader {
+ public:
+  // table may be null (section absent: every getter returns its default).
+  TableReader(const toml::table* table, std::string path, std::string_view source,
+              std::string* error);
+
+  // number: a float or integer in [lo, hi]; `unit` is printed in messages.
+  double number(std::string_view key, double def, double lo, double hi, std::string_view unit);
+  // integer: an integer in [lo, hi].
+  std::int64_t integer(std::string_view key, std::int64_t def, std::int64_t lo, std::int64_t hi);
+  bool boolean(std::string_view key, bool def);
+  std::string string(std::string_view key, std::string def);
+  // choice: a string that must be one of `allowed`.
+  std::string choice(std::string_view key, std::string def,
+                     std::initializer_list<std::string_view> allowed);
+  // sub: a nested table (may be absent).
+  TableReader sub(std::string_view key);
+  // finish: reports the first key of this table that no getter asked for.
+  void finish();
+  // ok: no error so far (the first error is kept, later ones dropped).
+  bool ok() const { return error_->empty(); }
+
+ private:
+  const toml::node* get(std::string_view key);
+  void fail(const toml::node* n, std::string_view key, const std::string& what);
+  std::string where(const toml::node* n) const;
+
+  const toml::table* table_;
+  std::string path_;
+  std::string source_;
+  std::string* error_;
+  std::set<std::string, std::less<>> used_;
+};
+
+}  // namespace odo::fw

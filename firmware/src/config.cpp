@@ -1,0 +1,89 @@
+#include "odo/firmware/config.hpp"
+
+#include <fstream>
+#include <sstream>
+
+#include "odo/firmware/toml_reader.hpp"
+
+namespace odo::fw {
+
+Config default_config() {
+  Config c;
+  c.robot.wheel_diameter = 0.15;
+  c.robot.counts_per_rev = 2048;
+  c.robot.gear_ratio = 16;
+  c.robot.wheelbase_nominal = 0.34;
+  c.robot.wheelbase = 0.34;
+  return c;
+}
+
+namespace {
+
+void read_loop(TableReader t, LoopSection& s) {
+  s.rate_hz = t.number("rate_hz", s.rate_hz, 50.0, 2000.0, "Hz");
+  s.status_period = t.number("status_period", s.status_period, 0.0, 3600.0, "s");
+  t.finish();
+}
+
+void read_robot(TableReader t, KinematicParams& p) {
+  p.wheel_diameter = t.number("wheel_diameter", p.wheel_diameter, 0.005, 5.0, "m");
+  p.counts_per_rev = t.number("counts_per_rev", p.counts_per_rev, 1.0, 1e9, "counts");
+  p.gear_ratio = t.number("gear_ratio", p.gear_ratio, 1e-3, 1e4, "");
+  p.wheelbase_nominal = t.number("wheelbase", p.wheelbase_nominal, 0.01, 20.0, "m");
+  // Until a calibration is loaded the effective wheelbase is the nominal one.
+  p.wheelbase = p.wheelbase_nominal;
+  p.c_l = t.number("c_l", p.c_l, 0.5, 1.5, "");
+  p.c_r = t.number("c_r", p.c_r, 0.5, 1.5, "");
+  t.finish();
+}
+
+void read_encoder(TableReader t, EncoderSection& s) {
+  s.backend = t.choice("backend", s.backend, {"sim", "hctl1100", "gpio", "can"});
+  t.finish();
+}
+
+void read_sim(TableReader t, SimSection& s) {
+  s.robot = t.choice("robot", s.robot, {"labmate", "nominal"});
+  s.scenario = t.choice("scenario", s.scenario, {"square-ccw", "square-cw", "squares", "idle"});
+  s.side = t.number("side", s.side, 0.1, 100.0, "m");
+  s.speed = t.number("speed", s.speed, 0.01, 5.0, "m/s");
+  s.turn_rate = t.number("turn_rate", s.turn_rate, 0.05, 10.0, "rad/s");
+  s.pause = t.number("pause", s.pause, 0.0, 60.0, "s");
+  s.counter_bits = static_cast<int>(t.integer("counter_bits", s.counter_bits, 16, 64));
+  t.finish();
+}
+
+}  // namespace
+
+Result<Config> parse_config(std::string_view text, std::string_view source) {
+  Config c = default_config();
+  c.source = std::string(source);
+  toml::table parsed;
+  try {
+    // toml++ reports syntax errors by exception; this is configure time, not the loop path.
+    parsed = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream m;
+    m << source << ":" << e.source().begin.line << ": TOML syntax error: " << e.description();
+    return make_error(Errc::kParse, m.str());
+  }
+  std::string error;
+  TableReader root(&parsed, "", source, &error);
+  read_loop(root.sub("loop"), c.loop);
+  read_robot(root.sub("robot"), c.robot);
+  read_encoder(root.sub("encoder"), c.encoder);
+  read_sim(root.sub("sim"), c.sim);
+  root.finish();
+  if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
+  return c;
+}
+
+Result<Config> load_config(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return make_error(Errc::kNotFound, path + ": cannot open config file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_config(text.str(), path);
+}
+
+}  // namespace odo::fw

@@ -1,0 +1,180 @@
+#include "odo/firmware/daemon.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <iomanip>
+#include <mutex>
+#include <numbers>
+#include <ostream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "odo/firmware/config.hpp"
+#include "odo/firmware/loop.hpp"
+#include "odo/firmware/rig.hpp"
+
+namespace odo::fw {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+
+std::string flags_text(std::uint32_t f) {
+  if (f == 0) return "ok";
+  std::string s;
+  auto add = [&](std::uint32_t bit, const char* name) {
+    if (f & bit) s += (s.empty() ? "" : "|") + std::string(name);
+  };
+  add(kEncoderStaleLeft, "stale-left");
+  add(kEncoderStaleRight, "stale-right");
+  add(kEncoderInvalidTransition, "invalid-transition");
+  add(kEncoderImplausibleJump, "implausible-jump");
+  add(kEncoderReadError, "read-error");
+  return s;
+}
+
+double position_error(const LoopSnapshot& s) {
+  return std::hypot(s.pose.x - s.truth.x, s.pose.y - s.truth.y);
+}
+
+void print_status(std::ostream& out, const LoopSnapshot& s, double rate_hz) {
+  char line[320];
+  std::snprintf(line, sizeof line, "t=%7.2f s  x=%+8.4f m  y=%+8.4f m  th=%+8.2f deg  v=%+5.2f m/s",
+                to_seconds(s.loop_time), s.pose.x, s.pose.y, wrap_angle(s.pose.theta) * kRadToDeg,
+                s.v);
+  out << line;
+  if (s.has_truth) {
+    std::snprintf(line, sizeof line, "  err=%6.2f mm", position_error(s) * 1e3);
+    out << line;
+  }
+  std::snprintf(line, sizeof line, "  rate=%6.1f Hz  lat_max=%6.3f ms  missed=%llu  enc=%s",
+                rate_hz, to_seconds(s.stats.wakeup_latency_max) * 1e3,
+                static_cast<unsigned long long>(s.stats.missed_deadlines),
+                flags_text(s.encoder_flags).c_str());
+  out << line << std::endl;
+}
+
+}  // namespace
+
+int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& out,
+               std::ostream& err) {
+  // Human-readable progress goes to stderr when stdout carries JSON.
+  std::ostream& log = o.json ? err : out;
+  Result<Config> cfg =
+      o.config_path.empty() ? Result<Config>(default_config()) : load_config(o.config_path);
+  if (!cfg) {
+    err << "odometryd: " << cfg.error().message << "\n";
+    return 2;
+  }
+  auto kin = Kinematics::create(cfg->robot);
+  if (!kin) {
+    err << "odometryd: " << cfg->source << ": robot: " << kin.error().message << "\n";
+    return 2;
+  }
+  auto rig = Rig::create(*cfg, *kin, o.virtual_time);
+  if (!rig) {
+    err << "odometryd: " << rig.error().message << "\n";
+    return 2;
+  }
+  LoopConfig lc;
+  lc.rate_hz = cfg->loop.rate_hz;
+  auto created = OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock());
+  if (!created) {
+    err << "odometryd: " << cfg->source << ": " << created.error().message << "\n";
+    return 2;
+  }
+  std::unique_ptr<OdometryLoop> loop = std::move(created).value();
+  if (TickObserver* t = rig->truth_observer()) loop->add_observer(t);
+
+  const KinematicParams& p = kin->params();
+  log << "odometryd: config " << cfg->source << "\n"
+      << "odometryd: encoders: " << rig->describe() << "\n"
+      << "odometryd: kinematics: Dn=" << p.wheel_diameter << " m, Ce=" << p.counts_per_rev
+      << ", n=" << p.gear_ratio << ", b=" << p.wheelbase << " m, c_l=" << p.c_l << ", c_r=" << p.c_r
+      << " (nominal values from the config)\n"
+      << "odometryd: loop " << cfg->loop.rate_hz << " Hz on "
+      << (o.virtual_time ? "virtual time" : "CLOCK_MONOTONIC") << std::endl;
+
+  double duration = o.duration;
+  if (duration <= 0.0 && o.virtual_time) duration = rig->scenario_duration() + 1.0;
+
+  // Status printer: its own thread, so the loop never blocks on a terminal or pipe.
+  std::mutex m;
+  std::condition_variable cv;
+  bool done = false;
+  std::thread status;
+  const bool want_status = !o.quiet && cfg->loop.status_period > 0.0 && !o.virtual_time;
+  if (want_status) {
+    status = std::thread([&] {
+      LoopSnapshot s;
+      std::uint64_t last_tick = 0;
+      auto last = std::chrono::steady_clock::now();
+      std::unique_lock lk(m);
+      const auto period = std::chrono::duration<double>(cfg->loop.status_period);
+      while (!cv.wait_for(lk, period, [&] { return done; })) {
+        if (!loop->snapshots().latest(s)) continue;
+        const auto now = std::chrono::steady_clock::now();
+        const double dt = std::chrono::duration<double>(now - last).count();
+        const double rate = dt > 0 ? static_cast<double>(s.tick - last_tick) / dt : 0.0;
+        last = now;
+        last_tick = s.tick;
+        print_status(log, s, rate);
+      }
+    });
+  }
+
+  loop->run(from_seconds(duration), stop);
+
+  if (status.joinable()) {
+    {
+      std::lock_guard lk(m);
+      done = true;
+    }
+    cv.notify_all();
+    status.join();
+  }
+
+  const LoopSnapshot& s = loop->snapshot();
+  const LoopStats& st = loop->stats();
+  const double loop_s = to_seconds(s.loop_time);
+  const double mean_rate = loop_s > 0 ? static_cast<double>(st.ticks) / loop_s : 0.0;
+  log << "odometryd: stopped after " << st.ticks << " ticks (" << loop_s << " s of loop time, "
+      << std::fixed << std::setprecision(1) << mean_rate << " Hz), missed deadlines "
+      << st.missed_deadlines << "\n"
+      << std::setprecision(4) << "odometryd: final pose x=" << s.pose.x << " m y=" << s.pose.y
+      << " m theta=" << wrap_angle(s.pose.theta) * kRadToDeg << " deg";
+  if (s.has_truth) {
+    log << "; ground truth x=" << s.truth.x << " m y=" << s.truth.y
+        << " m theta=" << wrap_angle(s.truth.theta) * kRadToDeg << " deg; position error "
+        << std::setprecision(2) << position_error(s) * 1e3 << " mm";
+  }
+  log << std::defaultfloat << std::setprecision(6) << std::endl;
+
+  if (o.json) {
+    nlohmann::json j;
+    j["x"] = s.pose.x;
+    j["y"] = s.pose.y;
+    j["theta"] = wrap_angle(s.pose.theta);
+    j["theta_cumulative"] = s.pose.theta;
+    j["distance"] = s.distance;
+    j["ticks"] = st.ticks;
+    j["loop_time"] = loop_s;
+    j["missed_deadlines"] = st.missed_deadlines;
+    j["wakeup_latency_max"] = to_seconds(st.wakeup_latency_max);
+    j["encoder_flags"] = s.encoder_flags;
+    j["invalid_transitions"] = s.encoder_counters.invalid_transitions;
+    j["implausible_jumps"] = s.encoder_counters.implausible_jumps;
+    j["stale_events"] = s.encoder_counters.stale_events;
+    j["read_errors"] = s.encoder_counters.read_errors;
+    if (s.has_truth) {
+      j["truth"] = {{"x", s.truth.x}, {"y", s.truth.y}, {"theta", wrap_angle(s.truth.theta)}};
+      j["position_error"] = position_error(s);
+    }
+    out << j.dump() << std::endl;
+  }
+  return 0;
+}
+
+}  // namespace odo::fw

@@ -1,0 +1,123 @@
+#include "odo/firmware/loop.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "odo/odometry/count_delta.hpp"
+
+namespace odo::fw {
+
+Result<std::unique_ptr<OdometryLoop>> OdometryLoop::create(const LoopConfig& cfg,
+                                                           const Kinematics& k,
+                                                           EncoderSource& encoder, Clock& clock) {
+  if (!(cfg.rate_hz >= 50.0 && cfg.rate_hz <= 2000.0)) {
+    std::ostringstream m;
+    m << "loop.rate_hz = " << cfg.rate_hz << " is outside the allowed range [50, 2000] Hz";
+    return make_error(Errc::kInvalidArgument, m.str());
+  }
+  if (auto s = check_counter_bits(encoder.counter_bits()); !s) return std::move(s).error();
+  const auto period = static_cast<TimeNs>(std::llround(1e9 / cfg.rate_hz));
+  return std::unique_ptr<OdometryLoop>(new OdometryLoop(period, k, encoder, clock));
+}
+
+OdometryLoop::OdometryLoop(TimeNs period, const Kinematics& k, EncoderSource& enc, Clock& clock)
+    : period_(period), odom_(k), enc_(&enc), clock_(&clock), bits_(enc.counter_bits()) {}
+
+bool OdometryLoop::add_observer(TickObserver* o) noexcept {
+  if (n_observers_ >= kMaxObservers) return false;
+  observers_[n_observers_++] = o;
+  return true;
+}
+
+void OdometryLoop::start() noexcept {
+  start_ = clock_->now();
+  const EncoderSample s = enc_->read(start_);
+  prev_left_ = s.left;
+  prev_right_ = s.right;
+  prev_stamp_ = s.stamp;
+  // The first deadline is one period after the reference reading, however long that took.
+  deadline_ = clock_->now() + period_;
+  snap_.encoder_flags = s.flags;
+  snap_.encoder_counters = s.counters;
+}
+
+void OdometryLoop::request_pose(const Pose2& p) noexcept {
+  // Seqlock writer: odd sequence while the three values are being replaced.
+  const std::uint32_t s = pose_req_seq_.load(std::memory_order_relaxed);
+  pose_req_seq_.store(s + 1, std::memory_order_relaxed);
+  std::atomic_thread_fence(std::memory_order_release);
+  req_x_.store(p.x, std::memory_order_relaxed);
+  req_y_.store(p.y, std::memory_order_relaxed);
+  req_theta_.store(p.theta, std::memory_order_relaxed);
+  pose_req_seq_.store(s + 2, std::memory_order_release);
+}
+
+void OdometryLoop::tick() noexcept {
+  clock_->sleep_until(deadline_);
+  const TimeNs woke = clock_->now();
+  const TimeNs latency = woke - deadline_;
+
+  // A pending set-pose command takes effect before this tick's motion is added.
+  const std::uint32_t seq = pose_req_seq_.load(std::memory_order_acquire);
+  if (seq != pose_req_seen_ && (seq & 1u) == 0) {
+    const Pose2 p{req_x_.load(std::memory_order_relaxed), req_y_.load(std::memory_order_relaxed),
+                  req_theta_.load(std::memory_order_relaxed)};
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (pose_req_seq_.load(std::memory_order_relaxed) == seq) {
+      odom_.reset(p);
+      pose_req_seen_ = seq;
+    }
+  }
+
+  const EncoderSample s = enc_->read(woke);
+  if ((s.flags & kEncoderReadError) == 0) {
+    // Counts are cumulative, so a late tick simply integrates a longer interval: nothing is lost.
+    const std::int64_t dl = wrap_delta(prev_left_, s.left, bits_);
+    const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
+    odom_.update(dl, dr, to_seconds(s.stamp - prev_stamp_));
+    prev_left_ = s.left;
+    prev_right_ = s.right;
+    prev_stamp_ = s.stamp;
+  }
+
+  ++stats_.ticks;
+  stats_.wakeup_latency_last = latency;
+  stats_.wakeup_latency_sum += latency;
+  if (latency > stats_.wakeup_latency_max) stats_.wakeup_latency_max = latency;
+
+  snap_.tick = stats_.ticks;
+  snap_.stamp = s.stamp;
+  snap_.loop_time = woke - start_;
+  snap_.pose = odom_.pose();
+  snap_.v = odom_.linear_velocity();
+  snap_.w = odom_.angular_velocity();
+  snap_.distance = odom_.distance();
+  snap_.encoder_flags = s.flags;
+  snap_.encoder_counters = s.counters;
+  for (std::size_t i = 0; i < n_observers_; ++i) observers_[i]->on_tick(snap_);
+
+  const TimeNs done = clock_->now();
+  const TimeNs compute = done - woke;
+  if (compute > stats_.compute_max) stats_.compute_max = compute;
+
+  // Next deadline; after an overrun skip the missed periods instead of bursting to catch up.
+  deadline_ += period_;
+  if (done >= deadline_) {
+    const TimeNs behind = done - deadline_;
+    const TimeNs skipped = behind / period_ + 1;
+    deadline_ += skipped * period_;
+    stats_.missed_deadlines += static_cast<std::uint64_t>(skipped);
+  }
+  snap_.stats = stats_;
+  published_.publish(snap_);
+}
+
+void OdometryLoop::run(TimeNs duration, const std::atomic<bool>& stop) noexcept {
+  start();
+  while (!stop.load(std::memory_order_relaxed)) {
+    if (duration > 0 && deadline_ - start_ > duration) break;
+    tick();
+  }
+}
+
+}  // namespace odo::fw

@@ -1,0 +1,16 @@
+// odomctl sub-commands: each file registers one command on the CLI11 app.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace odo::ctl {
+
+// Exit status of odomctl: 0 ok, 1 the operation failed, 2 bad input or bad options.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailed = 1;
+inline constexpr int kExitBadInput = 2;
+
+// add_replay: `odomctl replay` (integrate a log of raw counts).
+void add_replay(CLI::App& app, int& exit_code);
+
+}  // namespace odo::ctl

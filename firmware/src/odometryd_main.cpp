@@ -1,0 +1,47 @@
+// odometryd: the odometry firmware daemon.
+#include <csignal>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "odo/firmware/daemon.hpp"
+#include "odo/firmware/version.hpp"
+
+namespace {
+std::atomic<bool> g_stop{false};
+extern "C" void on_stop_signal(int) {
+  g_stop.store(true);
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"odometryd - wheel odometry firmware for differential-drive robots"};
+  odo::fw::DaemonOptions o;
+  app.add_option("--config", o.config_path, "TOML config file (default: built-in simulated robot)")
+      ->check(CLI::ExistingFile);
+  app.add_option("--duration", o.duration, "seconds of loop time to run, then stop (0: forever)")
+      ->check(CLI::Range(0.0, 1e9));
+  app.add_flag("--virtual-time", o.virtual_time,
+               "run the same loop on a virtual clock as fast as possible (simulation only)");
+  app.add_flag("--json", o.json, "print one JSON object with the final state at exit");
+  app.add_flag("--quiet", o.quiet, "no status lines");
+  app.set_version_flag("--version", std::string("odometryd ") + odo::fw::kVersion);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "odometryd: " << e.what() << "\n";
+    return 2;
+  }
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  return odo::fw::run_daemon(o, g_stop, std::cout, std::cerr);
+}

@@ -1,0 +1,138 @@
+#include "odo/firmware/rig.hpp"
+
+#include <sstream>
+
+#include "odo/drivers/monotonic_clock.hpp"
+#include "odo/sim/robot.hpp"
+#include "odo/sim/sim_encoder.hpp"
+#include "odo/sim/virtual_clock.hpp"
+
+namespace odo::fw {
+
+namespace {
+
+// TruthObserver: copies the simulator's exact pose into every snapshot.
+class TruthObserver final : public TickObserver {
+ public:
+  explicit TruthObserver(const sim::SimRobot& robot) : robot_(robot) {}
+  void on_tick(LoopSnapshot& snap) noexcept override {
+    snap.has_truth = true;
+    snap.truth = robot_.true_pose();
+  }
+
+ private:
+  const sim::SimRobot& robot_;
+};
+
+// EpochEncoder: the simulated encoders on a real clock, with the robot's time zero at start.
+class EpochEncoder final : public EncoderSource {
+ public:
+  EpochEncoder(sim::SimEncoderSource& inner, TimeNs epoch) : inner_(inner), epoch_(epoch) {}
+  EncoderSample read(TimeNs now) noexcept override {
+    EncoderSample s = inner_.read(now - epoch_);
+    s.stamp = now;
+    return s;
+  }
+  int counter_bits() const noexcept override { return inner_.counter_bits(); }
+
+ private:
+  sim::SimEncoderSource& inner_;
+  TimeNs epoch_;
+};
+
+sim::Scenario make_scenario(const SimSection& s, const Kinematics& k) {
+  sim::SquareOptions o;
+  o.side = s.side;
+  o.speed = s.speed;
+  o.turn_rate = s.turn_rate;
+  o.pause = s.pause;
+  sim::Scenario out;
+  auto add = [&](sim::Turn dir) {
+    o.direction = dir;
+    const sim::Scenario sq = sim::square_scenario(k, o);
+    out.insert(out.end(), sq.begin(), sq.end());
+  };
+  if (s.scenario == "square-ccw" || s.scenario == "squares") add(sim::Turn::kCounterClockwise);
+  if (s.scenario == "square-cw" || s.scenario == "squares") add(sim::Turn::kClockwise);
+  return out;
+}
+
+}  // namespace
+
+struct Rig::Impl {
+  std::unique_ptr<Clock> clock;
+  std::unique_ptr<sim::SimRobot> robot;
+  std::unique_ptr<sim::SimEncoderSource> sim_encoder;
+  std::unique_ptr<EncoderSource> encoder_wrapper;
+  EncoderSource* encoder = nullptr;
+  std::unique_ptr<TruthObserver> truth;
+  std::string description;
+  double scenario_duration = 0.0;
+};
+
+Rig::Rig(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Rig::~Rig() = default;
+Rig::Rig(Rig&&) noexcept = default;
+Rig& Rig::operator=(Rig&&) noexcept = default;
+
+Clock& Rig::clock() noexcept {
+  return *impl_->clock;
+}
+EncoderSource& Rig::encoder() noexcept {
+  return *impl_->encoder;
+}
+TickObserver* Rig::truth_observer() noexcept {
+  return impl_->truth.get();
+}
+const std::string& Rig::describe() const noexcept {
+  return impl_->description;
+}
+double Rig::scenario_duration() const noexcept {
+  return impl_->scenario_duration;
+}
+
+Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_time) {
+  auto impl = std::make_unique<Impl>();
+  if (cfg.encoder.backend != "sim") {
+    return make_error(Errc::kUnsupported, cfg.source + ": encoder.backend = \"" +
+                                              cfg.encoder.backend +
+                                              "\" is not available in this build yet");
+  }
+  const KinematicParams& p = k.params();
+  sim::RobotGeometry g;
+  g.counts_per_rev = p.counts_per_rev;
+  g.gear_ratio = p.gear_ratio;
+  if (cfg.sim.robot == "labmate") {
+    const sim::RobotGeometry lm = sim::labmate_geometry(p.wheel_diameter);
+    g.wheel_diameter_left = lm.wheel_diameter_left;
+    g.wheel_diameter_right = lm.wheel_diameter_right;
+    g.wheelbase = lm.wheelbase;
+  } else {
+    g.wheel_diameter_left = g.wheel_diameter_right = p.wheel_diameter;
+    g.wheelbase = p.wheelbase_nominal;
+  }
+  sim::Scenario scenario = make_scenario(cfg.sim, k);
+  impl->scenario_duration = sim::scenario_duration(scenario);
+  auto robot = sim::SimRobot::create(g, std::move(scenario));
+  if (!robot) return std::move(robot).error();
+  impl->robot = std::make_unique<sim::SimRobot>(std::move(robot).value());
+  impl->sim_encoder = std::make_unique<sim::SimEncoderSource>(*impl->robot, cfg.sim.counter_bits);
+  if (virtual_time) {
+    impl->clock = std::make_unique<sim::VirtualClock>();
+    impl->encoder = impl->sim_encoder.get();
+  } else {
+    impl->clock = std::make_unique<drivers::MonotonicClock>();
+    impl->encoder_wrapper = std::make_unique<EpochEncoder>(*impl->sim_encoder, impl->clock->now());
+    impl->encoder = impl->encoder_wrapper.get();
+  }
+  impl->truth = std::make_unique<TruthObserver>(*impl->robot);
+  std::ostringstream d;
+  d << "simulated robot '" << cfg.sim.robot << "' (true wheelbase " << g.wheelbase * 1e3
+    << " mm, D_R/D_L " << g.wheel_diameter_right / g.wheel_diameter_left << "), scenario '"
+    << cfg.sim.scenario << "' (" << impl->scenario_duration << " s), " << cfg.sim.counter_bits
+    << "-bit counters, " << (virtual_time ? "virtual time" : "real time (CLOCK_MONOTONIC)");
+  impl->description = d.str();
+  return Rig(std::move(impl));
+}
+
+}  // namespace odo::fw

@@ -1,0 +1,127 @@
+#include "odo/firmware/toml_reader.hpp"
+
+#include <cmath>
+#include <sstream>
+
+namespace odo::fw {
+
+TableReader::TableReader(const toml::table* table, std::string path, std::string_view source,
+                         std::string* error)
+    : table_(table), path_(std::move(path)), source_(source), error_(error) {}
+
+std::string TableReader::where(const toml::node* n) const {
+  std::ostringstream o;
+  o << source_;
+  if (n != nullptr && n->source().begin.line > 0) o << ":" << n->source().begin.line;
+  return o.str();
+}
+
+void TableReader::fail(const toml::node* n, std::string_view key, const std::string& what) {
+  if (!error_->empty()) return;
+  std::ostringstream o;
+  o << where(n != nullptr ? n : table_) << ": " << path_ << (path_.empty() ? "" : ".") << key << " "
+    << what;
+  *error_ = o.str();
+}
+
+const toml::node* TableReader::get(std::string_view key) {
+  used_.emplace(key);
+  if (table_ == nullptr) return nullptr;
+  return table_->get(key);
+}
+
+double TableReader::number(std::string_view key, double def, double lo, double hi,
+                           std::string_view unit) {
+  const toml::node* n = get(key);
+  if (n == nullptr) return def;
+  double v = 0;
+  if (auto f = n->value_exact<double>()) {
+    v = *f;
+  } else if (auto i = n->value_exact<std::int64_t>()) {
+    v = static_cast<double>(*i);
+  } else {
+    fail(n, key, "must be a number");
+    return def;
+  }
+  if (!std::isfinite(v) || v < lo || v > hi) {
+    std::ostringstream o;
+    o << "= " << v << " is outside the allowed range [" << lo << ", " << hi << "]"
+      << (unit.empty() ? "" : " ") << unit;
+    fail(n, key, o.str());
+    return def;
+  }
+  return v;
+}
+
+std::int64_t TableReader::integer(std::string_view key, std::int64_t def, std::int64_t lo,
+                                  std::int64_t hi) {
+  const toml::node* n = get(key);
+  if (n == nullptr) return def;
+  auto i = n->value_exact<std::int64_t>();
+  if (!i) {
+    fail(n, key, "must be an integer");
+    return def;
+  }
+  if (*i < lo || *i > hi) {
+    fail(n, key,
+         "= " + std::to_string(*i) + " is outside the allowed range [" + std::to_string(lo) + ", " +
+             std::to_string(hi) + "]");
+    return def;
+  }
+  return *i;
+}
+
+bool TableReader::boolean(std::string_view key, bool def) {
+  const toml::node* n = get(key);
+  if (n == nullptr) return def;
+  auto b = n->value_exact<bool>();
+  if (!b) {
+    fail(n, key, "must be true or false");
+    return def;
+  }
+  return *b;
+}
+
+std::string TableReader::string(std::string_view key, std::string def) {
+  const toml::node* n = get(key);
+  if (n == nullptr) return def;
+  auto s = n->value_exact<std::string>();
+  if (!s) {
+    fail(n, key, "must be a string");
+    return def;
+  }
+  return *s;
+}
+
+std::string TableReader::choice(std::string_view key, std::string def,
+                                std::initializer_list<std::string_view> allowed) {
+  const toml::node* n = table_ != nullptr ? table_->get(key) : nullptr;
+  std::string v = string(key, def);
+  for (std::string_view a : allowed) {
+    if (v == a) return v;
+  }
+  std::string list;
+  for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+  fail(n, key, "= \"" + v + "\" is not one of: " + list);
+  return def;
+}
+
+TableReader TableReader::sub(std::string_view key) {
+  const toml::node* n = get(key);
+  const toml::table* t = n != nullptr ? n->as_table() : nullptr;
+  if (n != nullptr && t == nullptr) fail(n, key, "must be a table");
+  return TableReader(t, path_.empty() ? std::string(key) : path_ + "." + std::string(key), source_,
+                     error_);
+}
+
+void TableReader::finish() {
+  if (table_ == nullptr) return;
+  for (const auto& [k, node] : *table_) {
+    if (used_.find(k.str()) == used_.end()) {
+      fail(&node, k.str(), "is not a known setting (misspelt?)");
+      return;
+    }
+  }
+}
+
+}  // namespace odo::fw

@@ -1,0 +1,48 @@
+// EncoderSource: where the loop gets the cumulative counts of both wheels.
+#pragma once
+
+#include <cstdint>
+
+#include "odo/hal/time.hpp"
+
+namespace odo {
+
+// Health flags of one sample; several may be set at once.
+enum EncoderFlag : std::uint32_t {
+  kEncoderOk = 0,
+  kEncoderStaleLeft = 1u << 0,          // no fresh reading of the left wheel within the timeout
+  kEncoderStaleRight = 1u << 1,         // same for the right wheel
+  kEncoderInvalidTransition = 1u << 2,  // quadrature decoder saw an illegal A/B transition
+  kEncoderImplausibleJump = 1u << 3,    // a count step beyond the wheel's physical maximum
+  kEncoderReadError = 1u << 4,          // the backend could not read the hardware this tick
+};
+
+// Cumulative event counters of a backend since start; they only grow.
+struct EncoderCounters {
+  std::uint64_t invalid_transitions = 0;
+  std::uint64_t implausible_jumps = 0;
+  std::uint64_t stale_events = 0;
+  std::uint64_t read_errors = 0;
+};
+
+// One reading of both wheels. left/right are raw counter readings exactly as the counter holds
+// them (two's complement, counter_bits wide, sign-extended to 64 bits); the loop takes wrap-aware
+// differences, so a counter may wrap freely.
+struct EncoderSample {
+  std::int64_t left = 0;
+  std::int64_t right = 0;
+  TimeNs stamp = 0;         // when the counts were latched [ns, clock of the loop]
+  std::uint32_t flags = 0;  // EncoderFlag bits for this sample
+  EncoderCounters counters;
+};
+
+class EncoderSource {
+ public:
+  virtual ~EncoderSource() = default;
+  // read: latch and return both counters; never blocks longer than one bus transaction.
+  virtual EncoderSample read(TimeNs now) noexcept = 0;
+  // counter_bits: width of the hardware counter in bits (16..64); readings wrap at 2^bits.
+  virtual int counter_bits() const noexcept = 0;
+};
+
+}  // namespace odo

@@ -1,0 +1,41 @@
+// Kinematic parameters of a differential-drive base and the count -> distance conversion.
+#pragma once
+
+#include "odo/hal/result.hpp"
+
+namespace odo {
+
+// What the firmware believes about the robot. All lengths in metres.
+struct KinematicParams {
+  double wheel_diameter = 0.0;     // nominal wheel diameter Dn [m]
+  double counts_per_rev = 0.0;     // encoder counts per motor revolution after quadrature (Ce)
+  double gear_ratio = 1.0;         // motor revolutions per wheel revolution (n)
+  double wheelbase_nominal = 0.0;  // nominal wheelbase [m], as designed
+  double wheelbase = 0.0;          // effective wheelbase b used for integration [m] (UMBmark b_new)
+  double c_l = 1.0;                // UMBmark correction factor of the left wheel (Eq. 6.33)
+  double c_r = 1.0;                // UMBmark correction factor of the right wheel (Eq. 6.34)
+};
+
+// Validated parameters plus the derived per-count distances.
+class Kinematics {
+ public:
+  // create: validates every field (finite, positive, factors within [0.5, 1.5]) and derives
+  // metres per count; the error names the field, its value and the allowed range.
+  static Result<Kinematics> create(const KinematicParams& p);
+
+  const KinematicParams& params() const noexcept { return p_; }
+  // c_m of UMBmark Eq. 2.1 with the pi of a circumference: pi * Dn / (n * Ce) [m/count].
+  double metres_per_count() const noexcept { return c_m_; }
+  double metres_per_count_left() const noexcept { return m_per_count_l_; }   // c_L * c_m [m]
+  double metres_per_count_right() const noexcept { return m_per_count_r_; }  // c_R * c_m [m]
+  double wheelbase() const noexcept { return p_.wheelbase; }                 // b [m]
+
+ private:
+  explicit Kinematics(const KinematicParams& p);
+  KinematicParams p_;
+  double c_m_ = 0.0;
+  double m_per_count_l_ = 0.0;
+  double m_per_count_r_ = 0.0;
+};
+
+}  // namespace odo

@@ -1,0 +1,77 @@
+// Planar pose integration of a differential-drive base (REP-103: x forward, y left, theta CCW).
+#pragma once
+
+#include <cstdint>
+
+#include "odo/odometry/kinematics.hpp"
+
+namespace odo {
+
+// Pose in the odometry frame. theta is cumulative (not wrapped) [rad].
+struct Pose2 {
+  double x = 0.0;      // [m]
+  double y = 0.0;      // [m]
+  double theta = 0.0;  // [rad], cumulative: two full CCW turns give 4*pi
+};
+
+// wrap_angle: maps any angle [rad] into (-pi, pi].
+double wrap_angle(double a) noexcept;
+
+// arc_step: exact pose change for wheel travels d_left, d_right [m] on a constant-curvature arc
+// of a base with wheelbase b [m]; stable for any turn, including none and on-the-spot.
+Pose2 arc_step(const Pose2& p, double d_left, double d_right, double b) noexcept;
+
+// report_step: UMBmark report Eq. 2.3-2.6 (heading updated first, then a straight chord along
+// the new heading); kept for comparison with the exact arc.
+Pose2 report_step(const Pose2& p, double d_left, double d_right, double b) noexcept;
+
+// PoseIntegrator: exact-arc integration that carries sin and cos of the heading from tick to
+// tick, so a tick with a small turn costs no trigonometric call at all.
+class PoseIntegrator {
+ public:
+  PoseIntegrator() { reset(Pose2{}); }
+  // reset: set the pose (e.g. at start or on a set-pose command).
+  void reset(const Pose2& p) noexcept;
+  // step: advance by wheel travels d_left, d_right [m] with wheelbase b [m].
+  void step(double d_left, double d_right, double b) noexcept;
+  const Pose2& pose() const noexcept { return pose_; }
+  double sin_theta() const noexcept { return s_; }
+  double cos_theta() const noexcept { return c_; }
+
+ private:
+  Pose2 pose_;
+  double s_ = 0.0;  // sin(pose_.theta)
+  double c_ = 1.0;  // cos(pose_.theta)
+  std::uint32_t steps_since_sync_ = 0;
+};
+
+// Odometry: counts -> pose and velocity with the calibrated kinematics.
+class Odometry {
+ public:
+  explicit Odometry(const Kinematics& k) : k_(k) {}
+  // update: integrate the count deltas of one tick of length dt [s] (dt <= 0: velocity kept).
+  void update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept;
+  // reset: set the pose; velocities and travelled distance are kept.
+  void reset(const Pose2& p) noexcept { integ_.reset(p); }
+  // set_kinematics: swap in new calibration (e.g. after SIGHUP); the pose is kept.
+  void set_kinematics(const Kinematics& k) noexcept { k_ = k; }
+
+  const Kinematics& kinematics() const noexcept { return k_; }
+  const Pose2& pose() const noexcept { return integ_.pose(); }
+  double linear_velocity() const noexcept { return v_; }     // [m/s] of the centre point
+  double angular_velocity() const noexcept { return w_; }    // [rad/s]
+  double distance() const noexcept { return distance_; }     // path length of the centre [m]
+  double last_d_left() const noexcept { return d_left_; }    // wheel travel of the last tick [m]
+  double last_d_right() const noexcept { return d_right_; }  // [m]
+
+ private:
+  Kinematics k_;
+  PoseIntegrator integ_;
+  double v_ = 0.0;
+  double w_ = 0.0;
+  double distance_ = 0.0;
+  double d_left_ = 0.0;
+  double d_right_ = 0.0;
+};
+
+}  // namespace odo

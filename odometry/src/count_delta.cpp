@@ -1,0 +1,27 @@
+#include "odo/odometry/count_delta.hpp"
+
+#include <string>
+
+namespace odo {
+
+Status check_counter_bits(int bits) {
+  if (bits >= 16 && bits <= 64) return Ok{};
+  return make_error(Errc::kInvalidArgument,
+                    "counter_bits = " + std::to_string(bits) + " is outside [16, 64]");
+}
+
+Result<std::int64_t> normalise_reading(std::int64_t raw, int bits) {
+  if (auto s = check_counter_bits(bits); !s) return std::move(s).error();
+  if (bits == 64) return raw;
+  const std::int64_t half = std::int64_t{1} << (bits - 1);
+  if (raw < -half || raw >= 2 * half) {
+    return make_error(Errc::kInvalidArgument,
+                      "reading " + std::to_string(raw) + " does not fit a " + std::to_string(bits) +
+                          "-bit counter (expected [" + std::to_string(-half) + ", " +
+                          std::to_string(2 * half - 1) + "])");
+  }
+  // Sign-extend: unsigned readings at or above 2^(bits-1) are negative in two's complement.
+  return wrap_delta(0, raw, bits);
+}
+
+}  // namespace odo

@@ -1,0 +1,104 @@
+#include "odo/odometry/pose.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace odo {
+namespace {
+
+// Below this half-angle the Taylor series are exact to double precision: the first dropped
+// terms are h^9/9! < 6e-18 (sin) and h^10/10! < 3e-20 (cos) for |h| <= 0.05.
+constexpr double kSeriesHalfAngle = 0.05;
+
+// Re-derive sin/cos from theta every this many steps so that the rotated pair can never drift
+// from the cumulative heading by more than a few ulp.
+constexpr std::uint32_t kResyncSteps = 1024;
+
+struct HalfAngle {
+  double s;     // sin(h)
+  double c;     // cos(h)
+  double sinc;  // sin(h)/h, 1 at h = 0
+};
+
+inline HalfAngle half_angle(double h) noexcept {
+  if (std::fabs(h) < kSeriesHalfAngle) {
+    const double h2 = h * h;
+    const double sinc = 1.0 - h2 / 6.0 * (1.0 - h2 / 20.0 * (1.0 - h2 / 42.0 * (1.0 - h2 / 72.0)));
+    const double c = 1.0 - h2 / 2.0 * (1.0 - h2 / 12.0 * (1.0 - h2 / 30.0 * (1.0 - h2 / 56.0)));
+    return {h * sinc, c, sinc};
+  }
+  const double s = std::sin(h);
+  return {s, std::cos(h), s / h};
+}
+
+}  // namespace
+
+double wrap_angle(double a) noexcept {
+  constexpr double kPi = std::numbers::pi;
+  double r = std::remainder(a, 2.0 * kPi);  // in [-pi, pi]
+  if (r <= -kPi) r += 2.0 * kPi;            // -pi maps to +pi
+  return r;
+}
+
+Pose2 arc_step(const Pose2& p, double d_left, double d_right, double b) noexcept {
+  // On an arc of chord angle dtheta the centre moves along the chord of length
+  // ds * sinc(dtheta/2), pointing at the mean heading theta + dtheta/2.
+  const double ds = 0.5 * (d_left + d_right);
+  const double dth = (d_right - d_left) / b;
+  const HalfAngle h = half_angle(0.5 * dth);
+  const double chord = ds * h.sinc;
+  const double mid = p.theta + 0.5 * dth;
+  return {p.x + chord * std::cos(mid), p.y + chord * std::sin(mid), p.theta + dth};
+}
+
+Pose2 report_step(const Pose2& p, double d_left, double d_right, double b) noexcept {
+  const double du = 0.5 * (d_right + d_left);                     // Eq. 2.3
+  const double th = p.theta + (d_right - d_left) / b;             // Eq. 2.4, 2.5
+  return {p.x + du * std::cos(th), p.y + du * std::sin(th), th};  // Eq. 2.6a/b
+}
+
+void PoseIntegrator::reset(const Pose2& p) noexcept {
+  pose_ = p;
+  s_ = std::sin(p.theta);
+  c_ = std::cos(p.theta);
+  steps_since_sync_ = 0;
+}
+
+void PoseIntegrator::step(double d_left, double d_right, double b) noexcept {
+  const double ds = 0.5 * (d_left + d_right);
+  const double dth = (d_right - d_left) / b;
+  const HalfAngle h = half_angle(0.5 * dth);
+  // cos/sin of the mean heading theta + h by the angle-sum identities.
+  const double cm = c_ * h.c - s_ * h.s;
+  const double sm = s_ * h.c + c_ * h.s;
+  const double chord = ds * h.sinc;
+  pose_.x += chord * cm;
+  pose_.y += chord * sm;
+  pose_.theta += dth;
+  if (++steps_since_sync_ >= kResyncSteps) {
+    s_ = std::sin(pose_.theta);
+    c_ = std::cos(pose_.theta);
+    steps_since_sync_ = 0;
+  } else {
+    // Rotate once more by h: theta + 2h is the new heading.
+    const double c_new = cm * h.c - sm * h.s;
+    s_ = sm * h.c + cm * h.s;
+    c_ = c_new;
+  }
+}
+
+void Odometry::update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
+  d_left_ = static_cast<double>(dn_left) * k_.metres_per_count_left();  // Eq. 6.35
+  d_right_ = static_cast<double>(dn_right) * k_.metres_per_count_right();
+  const double b = k_.wheelbase();
+  integ_.step(d_left_, d_right_, b);
+  const double ds = 0.5 * (d_left_ + d_right_);
+  distance_ += std::fabs(ds);
+  if (dt > 0.0) {
+    const double inv_dt = 1.0 / dt;
+    v_ = ds * inv_dt;
+    w_ = (d_right_ - d_left_) / b * inv_dt;
+  }
+}
+
+}  // namespace odo

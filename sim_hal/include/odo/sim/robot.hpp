@@ -1,0 +1,100 @@
+// SimRobot: a differential-drive base whose true geometry may differ from what the firmware
+// believes. It is driven by wheel angular velocities, keeps the exact ground-truth pose, and
+// produces encoder counts the way a quadrature encoder does (whole quadrature states only).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "odo/hal/result.hpp"
+#include "odo/hal/time.hpp"
+#include "odo/odometry/kinematics.hpp"
+#include "odo/odometry/pose.hpp"
+
+namespace odo::sim {
+
+// True physical geometry of the simulated base.
+struct RobotGeometry {
+  double wheel_diameter_left = 0.15;   // [m]
+  double wheel_diameter_right = 0.15;  // [m]
+  double wheelbase = 0.34;             // [m], distance between the wheel contact points
+  double counts_per_rev = 2048;        // encoder counts per motor revolution after 4x decoding
+  double gear_ratio = 16;              // motor revolutions per wheel revolution
+};
+
+// One piece of a motion profile: constant wheel angular velocities for a duration.
+struct Segment {
+  double duration = 0.0;     // [s]
+  double omega_left = 0.0;   // wheel angular velocity [rad/s], positive drives forward
+  double omega_right = 0.0;  // [rad/s]
+};
+
+using Scenario = std::vector<Segment>;
+
+// labmate_geometry: the reference robot of the UMBmark report's SET simulation: true wheelbase
+// 337 mm (nominal 340 mm) and wheel diameter ratio D_R/D_L = 0.9985 at the nominal mean diameter.
+RobotGeometry labmate_geometry(double nominal_diameter = 0.15);
+
+// nominal_params: the firmware's belief for a robot with this encoder/gear set-up.
+KinematicParams nominal_params(double wheel_diameter, double wheelbase, const RobotGeometry& g);
+
+enum class Turn { kClockwise, kCounterClockwise };
+
+// SquareOptions: the UMBmark square path.
+struct SquareOptions {
+  double side = 4.0;       // leg length [m]
+  double speed = 0.2;      // leg speed [m/s]
+  double turn_rate = 0.5;  // on-the-spot turn rate [rad/s]
+  double pause = 0.5;      // standstill after every leg and every turn [s]
+  Turn direction = Turn::kCounterClockwise;
+};
+
+// square_scenario: the wheel-velocity profile with which a robot that believes `believed`
+// drives an UMBmark square: every leg and every 90 degree turn is a whole number of encoder
+// counts sized so that the robot's own odometry (with its factors c_L, c_R and wheelbase b)
+// sees the nominal path.
+Scenario square_scenario(const Kinematics& believed, const SquareOptions& o);
+
+// scenario_duration: total duration of a scenario [s].
+double scenario_duration(const Scenario& s);
+
+class SimRobot {
+ public:
+  // Position of the encoder disc inside its quadrature state at start, in counts [0, 1).
+  static constexpr double kEncoderPhase = 0.5;
+
+  // create: validates the geometry (positive, finite) and starts at `start` with zero counts.
+  static Result<SimRobot> create(const RobotGeometry& g, Scenario scenario,
+                                 const Pose2& start = {});
+
+  // advance_to: move the robot along its scenario up to time t [ns since start]; after the last
+  // segment it stands still. Never goes backwards.
+  void advance_to(TimeNs t) noexcept;
+
+  const Pose2& true_pose() const noexcept { return pose_; }
+  // counts_left/right: cumulative encoder counts, floor of the motor angle in counts.
+  std::int64_t counts_left() const noexcept;
+  std::int64_t counts_right() const noexcept;
+  double wheel_angle_left() const noexcept { return angle_l_; }   // [rad] of the wheel
+  double wheel_angle_right() const noexcept { return angle_r_; }  // [rad]
+  TimeNs time() const noexcept { return t_; }
+  bool finished() const noexcept { return seg_ >= scenario_.size(); }
+  const RobotGeometry& geometry() const noexcept { return g_; }
+  const Scenario& scenario() const noexcept { return scenario_; }
+
+ private:
+  SimRobot(const RobotGeometry& g, Scenario s, const Pose2& start);
+  void move(double dt, const Segment& seg) noexcept;
+
+  RobotGeometry g_;
+  Scenario scenario_;
+  std::size_t seg_ = 0;
+  TimeNs seg_start_ = 0;  // start time of segment seg_ [ns]
+  TimeNs t_ = 0;
+  Pose2 pose_;
+  double angle_l_ = 0.0;
+  double angle_r_ = 0.0;
+  double counts_per_wheel_rad_ = 0.0;
+};
+
+}  // namespace odo::sim

@@ -1,0 +1,126 @@
+#include "odo/sim/robot.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+namespace odo::sim {
+
+RobotGeometry labmate_geometry(double nominal_diameter) {
+  // D_R / D_L = 0.9985 with (D_L + D_R) / 2 = Dn, so the scaling error E_s is 1.
+  constexpr double kRatio = 0.9985;
+  RobotGeometry g;
+  g.wheel_diameter_left = 2.0 * nominal_diameter / (1.0 + kRatio);
+  g.wheel_diameter_right = kRatio * g.wheel_diameter_left;
+  g.wheelbase = 0.337;
+  return g;
+}
+
+KinematicParams nominal_params(double wheel_diameter, double wheelbase, const RobotGeometry& g) {
+  KinematicParams p;
+  p.wheel_diameter = wheel_diameter;
+  p.counts_per_rev = g.counts_per_rev;
+  p.gear_ratio = g.gear_ratio;
+  p.wheelbase_nominal = wheelbase;
+  p.wheelbase = wheelbase;
+  return p;
+}
+
+Scenario square_scenario(const Kinematics& k, const SquareOptions& o) {
+  const KinematicParams& p = k.params();
+  // A real robot drives each leg and turn until its encoders reach whole-count targets, sized
+  // with what it believes (factors c_L, c_R, wheelbase b; Eq. 6.35). The commanded wheel angle is
+  // therefore a whole number of counts; the true geometry decides where the robot really goes.
+  const double counts_per_wheel_rad = p.counts_per_rev * p.gear_ratio / (2.0 * std::numbers::pi);
+  auto wheel_angle = [&](double distance, double c) {
+    return std::round(distance / (c * k.metres_per_count())) / counts_per_wheel_rad;
+  };
+  const double turn_sign = o.direction == Turn::kCounterClockwise ? 1.0 : -1.0;
+  // On-the-spot 90 degree turn: each wheel travels b/2 * pi/2 (believed) in opposite senses.
+  const double turn_arc = k.wheelbase() / 2.0 * std::numbers::pi / 2.0;
+  const double turn_time = (std::numbers::pi / 2.0) / o.turn_rate;
+  const double leg_time = o.side / o.speed;
+  const double leg_l = wheel_angle(o.side, p.c_l), leg_r = wheel_angle(o.side, p.c_r);
+  const double turn_l = wheel_angle(turn_arc, p.c_l), turn_r = wheel_angle(turn_arc, p.c_r);
+  Scenario s;
+  for (int leg = 0; leg < 4; ++leg) {
+    s.push_back({leg_time, leg_l / leg_time, leg_r / leg_time});
+    s.push_back({o.pause, 0.0, 0.0});
+    s.push_back({turn_time, -turn_sign * turn_l / turn_time, turn_sign * turn_r / turn_time});
+    s.push_back({o.pause, 0.0, 0.0});
+  }
+  return s;
+}
+
+double scenario_duration(const Scenario& s) {
+  double d = 0.0;
+  for (const Segment& seg : s) d += seg.duration;
+  return d;
+}
+
+Result<SimRobot> SimRobot::create(const RobotGeometry& g, Scenario scenario, const Pose2& start) {
+  auto bad = [](const char* f, double v) {
+    std::ostringstream m;
+    m << "sim robot " << f << " = " << v << " must be finite and > 0";
+    return make_error(Errc::kInvalidArgument, m.str());
+  };
+  if (!(g.wheel_diameter_left > 0 && std::isfinite(g.wheel_diameter_left)))
+    return bad("wheel_diameter_left", g.wheel_diameter_left);
+  if (!(g.wheel_diameter_right > 0 && std::isfinite(g.wheel_diameter_right)))
+    return bad("wheel_diameter_right", g.wheel_diameter_right);
+  if (!(g.wheelbase > 0 && std::isfinite(g.wheelbase))) return bad("wheelbase", g.wheelbase);
+  if (!(g.counts_per_rev > 0 && std::isfinite(g.counts_per_rev)))
+    return bad("counts_per_rev", g.counts_per_rev);
+  if (!(g.gear_ratio > 0 && std::isfinite(g.gear_ratio))) return bad("gear_ratio", g.gear_ratio);
+  for (const Segment& seg : scenario) {
+    if (!(seg.duration >= 0 && std::isfinite(seg.duration) && std::isfinite(seg.omega_left) &&
+          std::isfinite(seg.omega_right)))
+      return make_error(Errc::kInvalidArgument, "sim scenario segment is not finite");
+  }
+  return SimRobot(g, std::move(scenario), start);
+}
+
+SimRobot::SimRobot(const RobotGeometry& g, Scenario s, const Pose2& start)
+    : g_(g), scenario_(std::move(s)), pose_(start) {
+  counts_per_wheel_rad_ = g.counts_per_rev * g.gear_ratio / (2.0 * std::numbers::pi);
+}
+
+void SimRobot::move(double dt, const Segment& seg) noexcept {
+  const double da_l = seg.omega_left * dt;
+  const double da_r = seg.omega_right * dt;
+  angle_l_ += da_l;
+  angle_r_ += da_r;
+  // Constant wheel speeds give a constant-curvature arc: the exact arc step is the truth.
+  pose_ = arc_step(pose_, da_l * g_.wheel_diameter_left / 2.0, da_r * g_.wheel_diameter_right / 2.0,
+                   g_.wheelbase);
+}
+
+void SimRobot::advance_to(TimeNs t) noexcept {
+  while (t_ < t) {
+    if (seg_ >= scenario_.size()) {
+      t_ = t;  // standing still after the last segment
+      return;
+    }
+    const Segment& seg = scenario_[seg_];
+    const TimeNs seg_end = seg_start_ + from_seconds(seg.duration);
+    const TimeNs until = t < seg_end ? t : seg_end;
+    move(to_seconds(until - t_), seg);
+    t_ = until;
+    if (t_ >= seg_end) {
+      ++seg_;
+      seg_start_ = seg_end;
+    }
+  }
+}
+
+std::int64_t SimRobot::counts_left() const noexcept {
+  // The count changes only when the shaft crosses a quadrature state boundary; the encoder starts
+  // half a state away from one (kEncoderPhase), as a real disc rests somewhere inside a state.
+  return static_cast<std::int64_t>(std::floor(angle_l_ * counts_per_wheel_rad_ + kEncoderPhase));
+}
+
+std::int64_t SimRobot::counts_right() const noexcept {
+  return static_cast<std::int64_t>(std::floor(angle_r_ * counts_per_wheel_rad_ + kEncoderPhase));
+}
+
+}  // namespace odo::sim

@@ -1,0 +1,99 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sim_fixture.hpp"
+
+namespace odo::test {
+namespace {
+
+sim::Scenario wiggle() {
+  // Arbitrary wheel-velocity profile: forward, arc, reverse arc, spin.
+  // About 1.5e5 counts forward in all, so 16-bit counters wrap twice over.
+  return {{3.0, 4.0, 4.0}, {2.0, 2.0, 5.0}, {2.5, -3.0, -1.0}, {1.5, -4.0, 4.0}, {5.0, 5.0, 5.0}};
+}
+
+TEST(Loop, SixteenBitCountersWrapWithoutLoss) {
+  // Start the 16-bit counters 50 counts below the wrap; the profile drives ~10^5 counts, so
+  // they wrap many times. The pose must equal that of 64-bit counters exactly.
+  const auto k = *Kinematics::create(nominal_labmate());
+  sim::RobotGeometry g;
+  SimRun narrow(g, k, wiggle(), 16, 32767 - 50);
+  SimRun wide(g, k, wiggle(), 64);
+  narrow.drive();
+  wide.drive();
+  EXPECT_EQ(narrow.loop->odometry().pose().x, wide.loop->odometry().pose().x);
+  EXPECT_EQ(narrow.loop->odometry().pose().y, wide.loop->odometry().pose().y);
+  EXPECT_EQ(narrow.loop->odometry().pose().theta, wide.loop->odometry().pose().theta);
+  EXPECT_GT(std::fabs(wide.robot.counts_left()), 65536);
+}
+
+TEST(Loop, OverrunsSkipPeriodsAndLoseNoCount) {
+  // Every read takes 25 ms of a 10 ms period: each tick misses two deadlines, the loop skips
+  // them, and the cumulative counts still integrate to the same pose as an on-time loop.
+  const auto k = *Kinematics::create(nominal_labmate());
+  sim::RobotGeometry g;
+  SimRun slow(g, k, wiggle());
+  SimRun fast(g, k, wiggle());
+  slow.encoder.set_read_delay(&slow.clock, 25'000'000);
+  slow.drive();
+  fast.drive();
+  const auto& st = slow.loop->stats();
+  EXPECT_GT(st.missed_deadlines, 0u);
+  EXPECT_EQ(fast.loop->stats().missed_deadlines, 0u);
+  // Ticks happen every 30 ms: 25 ms read, then the next free 10 ms boundary.
+  EXPECT_EQ(st.missed_deadlines, 2 * st.ticks);
+  // No count is lost: the heading is a sum of count deltas, independent of how the ticks cut
+  // the drive, so both loops agree to rounding, and both agree with the truth to one count.
+  const Pose2& a = slow.loop->odometry().pose();
+  const Pose2& b = fast.loop->odometry().pose();
+  EXPECT_NEAR(a.theta, b.theta, 1e-12);
+  EXPECT_NEAR(a.theta, slow.robot.true_pose().theta, k.metres_per_count() / g.wheelbase);
+  // Position depends on the partition only where a tick straddles a change of wheel speeds
+  // (the arc of such a tick is not the true two-piece path): 5 straddled changes, each at most
+  // v * dt * dtheta ~ 0.15 m/s * 0.03 s * 0.03 rad ~ 0.1 mm.
+  EXPECT_NEAR(a.x, slow.robot.true_pose().x, 5e-4);
+  EXPECT_NEAR(a.y, slow.robot.true_pose().y, 5e-4);
+  EXPECT_NEAR(b.x, fast.robot.true_pose().x, 5e-4);
+  EXPECT_NEAR(b.y, fast.robot.true_pose().y, 5e-4);
+}
+
+TEST(Loop, SetPoseTakesEffectAtNextTick) {
+  const auto k = *Kinematics::create(nominal_labmate());
+  sim::RobotGeometry g;
+  SimRun run(g, k, {{1.0, 0.0, 0.0}});
+  run.loop->start();
+  run.loop->tick();
+  run.loop->request_pose({1.5, -2.0, 0.25});
+  EXPECT_DOUBLE_EQ(run.loop->odometry().pose().x, 0.0);  // not before the next tick
+  run.loop->tick();
+  EXPECT_DOUBLE_EQ(run.loop->odometry().pose().x, 1.5);
+  EXPECT_DOUBLE_EQ(run.loop->odometry().pose().y, -2.0);
+  EXPECT_DOUBLE_EQ(run.loop->odometry().pose().theta, 0.25);
+}
+
+TEST(Loop, RejectsRateOutsideRange) {
+  const auto k = *Kinematics::create(nominal_labmate());
+  sim::RobotGeometry g;
+  auto robot = *sim::SimRobot::create(g, {});
+  sim::SimEncoderSource enc(robot);
+  sim::VirtualClock clock;
+  auto l = fw::OdometryLoop::create(fw::LoopConfig{10.0}, k, enc, clock);
+  ASSERT_FALSE(l.ok());
+  EXPECT_NE(l.error().message.find("[50, 2000] Hz"), std::string::npos);
+}
+
+TEST(Loop, PublishesSnapshotsWithStats) {
+  const auto k = *Kinematics::create(nominal_labmate());
+  sim::RobotGeometry g;
+  SimRun run(g, k, {{1.0, 2.0, 2.0}});
+  run.drive(0.0);
+  fw::LoopSnapshot s;
+  ASSERT_TRUE(run.loop->snapshots().latest(s));
+  EXPECT_EQ(s.tick, run.loop->stats().ticks);
+  EXPECT_EQ(s.tick, 100u);  // 1 s at 100 Hz
+  EXPECT_DOUBLE_EQ(s.pose.x, run.loop->odometry().pose().x);
+}
+
+}  // namespace
+}  // namespace odo::test
