@@ -1,0 +1,32 @@
+// Helpers for tests that need a kernel facility (vcan, gpio-sim, mtdram). They run inside the
+// VM harness (tools/vm-run.sh, which sets ODO_IN_VM=1); anywhere else they skip with the reason.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+
+namespace odo::test {
+
+// in_vm: true inside the project's VM harness.
+inline bool in_vm() {
+  const char* v = std::getenv("ODO_IN_VM");
+  return v != nullptr && std::string(v) == "1";
+}
+
+// run: a shell command in the guest; returns its exit status.
+inline int run(const std::string& cmd) {
+  const int rc = std::system(cmd.c_str());
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
+}
+
+}  // namespace odo::test
+
+// ODO_REQUIRE_VM: first statement of every kernel-tier test.
+#define ODO_REQUIRE_VM()                                                                  \
+  do {                                                                                    \
+    if (!::odo::test::in_vm())                                                            \
+      GTEST_SKIP() << "needs the VM harness (tools/vm-run.sh): this kernel has no vcan, " \
+                      "gpio-sim or mtdram; tools/test.sh runs the kernel tier in the VM"; \
+  } while (0)
