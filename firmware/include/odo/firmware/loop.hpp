@@ -41,6 +41,10 @@ struct LoopSnapshot {
   LoopStats stats;
   bool has_truth = false;  // a simulated or external absolute reference was available
   Pose2 truth;             // ground truth pose at the sample time (simulation only)
+  // Pose covariance of (x, y, theta), row-major [m^2, m rad, rad^2]; valid when has_cov.
+  std::array<double, 9> cov{};
+  bool has_cov = false;
+  std::uint8_t calibration_state = 0;  // 0 uncalibrated (nominal values), 1 calibrated, 2 corrupt
 };
 
 // TickObserver: called on the loop thread after every tick; must not block or allocate.
