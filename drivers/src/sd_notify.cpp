@@ -33,7 +33,7 @@ SdNotifier SdNotifier::to_socket(std::string_view address, TimeNs watchdog_inter
   if (address.empty() || address.size() >= sizeof(sockaddr_un::sun_path)) return n;
   n.address_ = std::string(address);
   if (n.address_[0] == '@') n.address_[0] = '\0';  // Linux abstract namespace
-  n.fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  n.fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
   n.watchdog_ = watchdog_interval;
   return n;
 }
@@ -52,6 +52,8 @@ SdNotifier SdNotifier::from_environment() {
 }
 
 bool SdNotifier::notify(std::string_view message) const noexcept {
+  // Non-blocking socket: a receiver that stopped reading (full queue) costs a lost message,
+  // never a blocked notifier thread.
   if (fd_ < 0) return false;
   sockaddr_un sa{};
   sa.sun_family = AF_UNIX;
