@@ -8,7 +8,8 @@ set -euo pipefail
 
 build_pkgs=(g++ cmake make pkg-config python3 libeigen3-dev libgpiod-dev libtomlplusplus-dev
   libcli11-dev nlohmann-json3-dev)
-test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind)
+test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind
+  rt-tests stress-ng systemd)  # cyclictest + load for tools/jitter.sh; systemd-analyze verify
 
 want=("${build_pkgs[@]}")
 for arg in "$@"; do

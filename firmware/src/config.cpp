@@ -53,6 +53,15 @@ void read_sim(TableReader t, SimSection& s) {
   t.finish();
 }
 
+void read_realtime(TableReader t, RealtimeSection& s) {
+  s.priority = static_cast<int>(t.integer("priority", s.priority, 0, 99));
+  s.lock_memory = t.boolean("lock_memory", s.lock_memory);
+  s.cpu = static_cast<int>(t.integer("cpu", s.cpu, -1, 1023));
+  s.prefault_stack = static_cast<int>(t.integer("prefault_stack", s.prefault_stack, 0, 4194304));
+  s.required = t.boolean("required", s.required);
+  t.finish();
+}
+
 }  // namespace
 
 Result<Config> parse_config(std::string_view text, std::string_view source) {
@@ -73,6 +82,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_robot(root.sub("robot"), c.robot);
   read_encoder(root.sub("encoder"), c.encoder);
   read_sim(root.sub("sim"), c.sim);
+  read_realtime(root.sub("realtime"), c.realtime);
   root.finish();
   if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
   return c;

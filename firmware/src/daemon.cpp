@@ -14,7 +14,10 @@
 
 #include "odo/firmware/config.hpp"
 #include "odo/firmware/loop.hpp"
+#include "odo/firmware/realtime_setup.hpp"
 #include "odo/firmware/rig.hpp"
+#include "odo/firmware/timing_report.hpp"
+#include "odo/firmware/watchdog.hpp"
 
 namespace odo::fw {
 namespace {
@@ -49,8 +52,9 @@ void print_status(std::ostream& out, const LoopSnapshot& s, double rate_hz) {
     std::snprintf(line, sizeof line, "  err=%6.2f mm", position_error(s) * 1e3);
     out << line;
   }
-  std::snprintf(line, sizeof line, "  rate=%6.1f Hz  lat_max=%6.3f ms  missed=%llu  enc=%s",
-                rate_hz, to_seconds(s.stats.wakeup_latency_max) * 1e3,
+  char timing[96];
+  std::snprintf(line, sizeof line, "  rate=%6.1f Hz  %s  missed=%llu  enc=%s", rate_hz,
+                format_timing_status(timing, sizeof timing, s.stats),
                 static_cast<unsigned long long>(s.stats.missed_deadlines),
                 flags_text(s.encoder_flags).c_str());
   out << line << std::endl;
@@ -125,7 +129,33 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
     });
   }
 
+  auto stop_status = [&] {
+    if (!status.joinable()) return;
+    {
+      std::lock_guard lk(m);
+      done = true;
+    }
+    cv.notify_all();
+    status.join();
+  };
+
+  // systemd: READY=1 after the first tick, WATCHDOG=1 only while the tick counter advances.
+  auto watchdog = LoopWatchdog::from_environment([&l = *loop] { return l.heartbeat(); });
+  if (watchdog->enabled()) {
+    log << "odometryd: systemd notify: on, watchdog "
+        << (watchdog->interval() > 0 ? std::to_string(to_seconds(watchdog->interval())) + " s"
+                                     : std::string("off"))
+        << std::endl;
+  }
+  // The loop runs on this thread: real-time set-up after the status thread started, so that
+  // thread keeps normal scheduling.
+  if (!setup_realtime(cfg->realtime, o.virtual_time, log, err)) {
+    stop_status();
+    return 1;
+  }
+  watchdog->start();
   loop->run(from_seconds(duration), stop);
+  watchdog->stop();
 
   if (status.joinable()) {
     {
@@ -151,6 +181,7 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
         << std::setprecision(2) << position_error(s) * 1e3 << " mm";
   }
   log << std::defaultfloat << std::setprecision(6) << std::endl;
+  if (o.stats) print_timing_stats(log, st, loop->period());
 
   if (o.json) {
     nlohmann::json j;
@@ -163,6 +194,14 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
     j["loop_time"] = loop_s;
     j["missed_deadlines"] = st.missed_deadlines;
     j["wakeup_latency_max"] = to_seconds(st.wakeup_latency_max);
+    for (const auto& [name, t] : {std::pair{"wakeup_latency", &st.wakeup_latency},
+                                  std::pair{"compute_time", &st.compute_time}}) {
+      j["timing"][name] = {{"min", to_seconds(t->min)},
+                           {"mean", to_seconds(t->mean)},
+                           {"p99", to_seconds(t->p99)},
+                           {"p999", to_seconds(t->p999)},
+                           {"max", to_seconds(t->max)}};
+    }
     j["encoder_flags"] = s.encoder_flags;
     j["invalid_transitions"] = s.encoder_counters.invalid_transitions;
     j["implausible_jumps"] = s.encoder_counters.implausible_jumps;

@@ -100,6 +100,13 @@ void OdometryLoop::tick() noexcept {
   const TimeNs done = clock_->now();
   const TimeNs compute = done - woke;
   if (compute > stats_.compute_max) stats_.compute_max = compute;
+  wakeup_hist_.record(latency);
+  compute_hist_.record(compute);
+  if ((stats_.ticks & (kSummaryTicks - 1)) == 0) {
+    stats_.wakeup_latency = wakeup_hist_.summary();
+    stats_.compute_time = compute_hist_.summary();
+  }
+  heartbeat_.store(stats_.ticks, std::memory_order_relaxed);
 
   // Next deadline; after an overrun skip the missed periods instead of bursting to catch up.
   deadline_ += period_;
@@ -119,6 +126,9 @@ void OdometryLoop::run(TimeNs duration, const std::atomic<bool>& stop) noexcept 
     if (duration > 0 && deadline_ - start_ > duration) break;
     tick();
   }
+  stats_.wakeup_latency = wakeup_hist_.summary();
+  stats_.compute_time = compute_hist_.summary();
+  snap_.stats = stats_;
 }
 
 }  // namespace odo::fw

@@ -25,6 +25,9 @@ int main(int argc, char** argv) {
                "run the same loop on a virtual clock as fast as possible (simulation only)");
   app.add_flag("--json", o.json, "print one JSON object with the final state at exit");
   app.add_flag("--quiet", o.quiet, "no status lines");
+  app.add_flag("--stats", o.stats,
+               "print wake-up latency and compute time statistics (min, mean, p99, p99.9, max) "
+               "and missed deadlines at exit");
   app.set_version_flag("--version", std::string("odometryd ") + odo::fw::kVersion);
   try {
     app.parse(argc, argv);

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <vector>
 
 #include "sim_fixture.hpp"
 
@@ -28,24 +30,74 @@ TEST(Loop, SixteenBitCountersWrapWithoutLoss) {
   EXPECT_GT(std::fabs(wide.robot.counts_left()), 65536);
 }
 
+// Records what each tick integrated: the sample time and the count deltas (wheel travel divided
+// by metres per count, which is an integer count up to rounding).
+struct TickRecorder final : fw::TickObserver {
+  explicit TickRecorder(const fw::OdometryLoop*& l) : loop(l) { stamps.reserve(4096); }
+  void on_tick(fw::LoopSnapshot& s) noexcept override {
+    const Odometry& o = loop->odometry();
+    stamps.push_back(s.stamp);
+    counts_left += std::llround(o.last_d_left() / o.kinematics().metres_per_count_left());
+    counts_right += std::llround(o.last_d_right() / o.kinematics().metres_per_count_right());
+  }
+  const fw::OdometryLoop*& loop;
+  std::vector<TimeNs> stamps;
+  std::int64_t counts_left = 0;
+  std::int64_t counts_right = 0;
+};
+
 TEST(Loop, OverrunsSkipPeriodsAndLoseNoCount) {
   // Every read takes 25 ms of a 10 ms period: each tick misses two deadlines, the loop skips
-  // them, and the cumulative counts still integrate to the same pose as an on-time loop.
+  // them, and the cumulative counts still integrate to the same pose as an on-time loop. The
+  // slow loop also has 16-bit counters starting near the wrap, so overruns and wraps mix
+  // (~1.5e5 counts forward, 0.03 s * 4 m/s / 1.44e-5 m = 8300 counts per tick < 2^15).
   const auto k = *Kinematics::create(nominal_labmate());
   sim::RobotGeometry g;
-  SimRun slow(g, k, wiggle());
+  SimRun slow(g, k, wiggle(), 16, 32767 - 50);
   SimRun fast(g, k, wiggle());
   slow.encoder.set_read_delay(&slow.clock, 25'000'000);
+  const fw::OdometryLoop* slow_loop = slow.loop.get();
+  TickRecorder rec(slow_loop);
+  slow.loop->add_observer(&rec);
   slow.drive();
   fast.drive();
   const auto& st = slow.loop->stats();
   EXPECT_GT(st.missed_deadlines, 0u);
   EXPECT_EQ(fast.loop->stats().missed_deadlines, 0u);
-  // Ticks happen every 30 ms: 25 ms read, then the next free 10 ms boundary.
+  // Ticks happen every 30 ms: 25 ms read, then the next free 10 ms boundary; no bursts.
   EXPECT_EQ(st.missed_deadlines, 2 * st.ticks);
-  // No count is lost: the heading is a sum of count deltas, independent of how the ticks cut
-  // the drive, so both loops agree to rounding, and both agree with the truth to one count.
+  ASSERT_EQ(rec.stamps.size(), st.ticks);
+  for (std::size_t i = 1; i < rec.stamps.size(); ++i)
+    ASSERT_EQ(rec.stamps[i] - rec.stamps[i - 1], 30'000'000) << "tick " << i;
+
+  // No count is lost: the deltas the loop integrated sum exactly to the robot's counts.
+  EXPECT_EQ(rec.counts_left, slow.robot.counts_left());
+  EXPECT_EQ(rec.counts_right, slow.robot.counts_right());
+  EXPECT_GT(std::abs(slow.robot.counts_left()), 65536);  // the 16-bit counters wrapped
+
+  // The pose stays exact: it is bit for bit the pose of integrating the true counts over the
+  // long (30 ms) intervals, computed here independently of the loop from a second robot
+  // sampled at the same instants with 64-bit counts.
+  auto ref_robot = *sim::SimRobot::create(g, wiggle());
+  Odometry ref(k);
+  std::int64_t pl = 0, pr = 0;
+  TimeNs pt = 0;  // the reference reading of start() is at time 0 with zero counts
+  for (const TimeNs t : rec.stamps) {
+    ref_robot.advance_to(t);
+    ref.update(ref_robot.counts_left() - pl, ref_robot.counts_right() - pr, to_seconds(t - pt));
+    pl = ref_robot.counts_left();
+    pr = ref_robot.counts_right();
+    pt = t;
+  }
   const Pose2& a = slow.loop->odometry().pose();
+  EXPECT_EQ(a.x, ref.pose().x);
+  EXPECT_EQ(a.y, ref.pose().y);
+  EXPECT_EQ(a.theta, ref.pose().theta);
+  EXPECT_EQ(slow.loop->odometry().linear_velocity(), ref.linear_velocity());
+  EXPECT_EQ(slow.loop->odometry().distance(), ref.distance());
+
+  // Against the on-time loop: the heading is a sum of count deltas, independent of how the
+  // ticks cut the drive, so both agree to rounding, and both agree with the truth to one count.
   const Pose2& b = fast.loop->odometry().pose();
   EXPECT_NEAR(a.theta, b.theta, 1e-12);
   EXPECT_NEAR(a.theta, slow.robot.true_pose().theta, k.metres_per_count() / g.wheelbase);

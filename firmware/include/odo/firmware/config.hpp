@@ -30,12 +30,22 @@ struct EncoderSection {
   std::string backend = "sim";  // sim | hctl1100 | gpio | can
 };
 
+// [realtime]: how the loop thread is made real-time at start (each part reported at start).
+struct RealtimeSection {
+  int priority = 80;            // SCHED_FIFO priority 1..99 of the loop thread; 0 = SCHED_OTHER
+  bool lock_memory = true;      // mlockall(MCL_CURRENT | MCL_FUTURE)
+  int cpu = -1;                 // pin the loop thread to this CPU; -1 = no pinning
+  int prefault_stack = 262144;  // bytes of loop stack touched before the first tick, 0..4 MiB
+  bool required = false;        // true: refuse to start when a requested part cannot be applied
+};
+
 struct Config {
   std::string source = "<built-in>";  // file the config came from
   LoopSection loop;
   KinematicParams robot;  // nominal robot; c_l, c_r, wheelbase may be replaced by calibration
   EncoderSection encoder;
   SimSection sim;
+  RealtimeSection realtime;
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.

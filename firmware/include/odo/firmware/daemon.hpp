@@ -14,6 +14,7 @@ struct DaemonOptions {
   bool virtual_time = false;
   bool json = false;   // one JSON object on stdout at exit
   bool quiet = false;  // no status lines
+  bool stats = false;  // timing statistics table at exit
 };
 
 // run_daemon: runs the firmware until stop, duration or signal; returns the process exit code.

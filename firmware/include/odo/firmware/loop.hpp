@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "odo/firmware/latency_histogram.hpp"
 #include "odo/firmware/triple_buffer.hpp"
 #include "odo/hal/clock.hpp"
 #include "odo/hal/encoder.hpp"
@@ -25,6 +26,10 @@ struct LoopStats {
   TimeNs wakeup_latency_max = 0;       // [ns]
   TimeNs wakeup_latency_sum = 0;       // [ns], for the mean
   TimeNs compute_max = 0;              // tick body duration, worst [ns]
+  // Histogram summaries (min, mean, p99, p99.9, max [ns]) of the wake-up latency and of the
+  // compute time; refreshed every kSummaryTicks ticks and when run() returns.
+  TimingSummary wakeup_latency;
+  TimingSummary compute_time;
 };
 
 // What one tick produced; observers and the status thread see this.
@@ -61,6 +66,7 @@ struct LoopConfig {
 class OdometryLoop {
  public:
   static constexpr std::size_t kMaxObservers = 4;
+  static constexpr std::uint64_t kSummaryTicks = 256;  // power of two
 
   // create: validates the rate and the encoder's counter width (heap-allocated once, at
   // configure time: the loop holds atomics and is neither copied nor moved).
@@ -84,6 +90,11 @@ class OdometryLoop {
 
   const Odometry& odometry() const noexcept { return odom_; }
   const LoopStats& stats() const noexcept { return stats_; }
+  // Full histograms (loop thread, or after run() returned).
+  const LatencyHistogram& wakeup_histogram() const noexcept { return wakeup_hist_; }
+  const LatencyHistogram& compute_histogram() const noexcept { return compute_hist_; }
+  // heartbeat: ticks so far, readable from any thread (the watchdog proves the loop is alive).
+  std::uint64_t heartbeat() const noexcept { return heartbeat_.load(std::memory_order_relaxed); }
   const LoopSnapshot& snapshot() const noexcept { return snap_; }
   TimeNs period() const noexcept { return period_; }
   // snapshots: the newest snapshot for another thread (status printer, supervisor).
@@ -106,6 +117,9 @@ class OdometryLoop {
   std::int64_t prev_right_ = 0;
   TimeNs prev_stamp_ = 0;
   LoopStats stats_;
+  LatencyHistogram wakeup_hist_;
+  LatencyHistogram compute_hist_;
+  std::atomic<std::uint64_t> heartbeat_{0};
   LoopSnapshot snap_;
   TripleBuffer<LoopSnapshot> published_;
 

@@ -1,0 +1,19 @@
+// Text forms of the loop's timing statistics: the `odometryd --stats` table and the fragment of
+// the status line.
+#pragma once
+
+#include <cstddef>
+#include <iosfwd>
+
+#include "odo/firmware/loop.hpp"
+
+namespace odo::fw {
+
+// print_timing_stats: the table of wake-up latency and compute time (min, mean, p99, p99.9,
+// max in microseconds) and the missed deadlines, for a loop of period `period` [ns].
+void print_timing_stats(std::ostream& out, const LoopStats& st, TimeNs period);
+
+// format_timing_status: "lat p99/max=12/80 us cmp p99=4 us" into buf (no allocation); returns buf.
+const char* format_timing_status(char* buf, std::size_t size, const LoopStats& st) noexcept;
+
+}  // namespace odo::fw

@@ -1,0 +1,42 @@
+#include "odo/firmware/timing_report.hpp"
+
+#include <cstdio>
+#include <ostream>
+
+namespace odo::fw {
+namespace {
+
+double us(TimeNs ns) {
+  return static_cast<double>(ns) * 1e-3;
+}
+
+void row(std::ostream& out, const char* name, const TimingSummary& s) {
+  char line[160];
+  std::snprintf(line, sizeof line, "  %-16s %10.1f %10.1f %10.1f %10.1f %10.1f\n", name, us(s.min),
+                us(s.mean), us(s.p99), us(s.p999), us(s.max));
+  out << line;
+}
+
+}  // namespace
+
+void print_timing_stats(std::ostream& out, const LoopStats& st, TimeNs period) {
+  char head[200];
+  std::snprintf(head, sizeof head,
+                "odometryd: timing over %llu ticks (period %.3f ms), missed deadlines %llu\n"
+                "  %-16s %10s %10s %10s %10s %10s  [us]\n",
+                static_cast<unsigned long long>(st.ticks), us(period) * 1e-3,
+                static_cast<unsigned long long>(st.missed_deadlines), "", "min", "mean", "p99",
+                "p99.9", "max");
+  out << head;
+  row(out, "wake-up latency", st.wakeup_latency);
+  row(out, "compute time", st.compute_time);
+  out.flush();
+}
+
+const char* format_timing_status(char* buf, std::size_t size, const LoopStats& st) noexcept {
+  std::snprintf(buf, size, "lat p99/max=%.0f/%.0f us  cmp p99=%.1f us", us(st.wakeup_latency.p99),
+                us(st.wakeup_latency_max), us(st.compute_time.p99));
+  return buf;
+}
+
+}  // namespace odo::fw

@@ -1,0 +1,40 @@
+// tick_driver: runs N loop ticks for instruction counting with callgrind
+// (tools/callgrind_tick.sh). Usage: tick_driver sim|counting N
+//   sim       the simulated robot on a long arc (as BM_LoopTick)
+//   counting  a counter-register encoder (as BM_LoopTickFirmwareOnly)
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+
+#include "counting_encoder.hpp"
+#include "odo/firmware/loop.hpp"
+#include "odo/sim/robot.hpp"
+#include "odo/sim/sim_encoder.hpp"
+#include "odo/sim/virtual_clock.hpp"
+
+int main(int argc, char** argv) {
+  if (argc != 3 || (std::strcmp(argv[1], "sim") != 0 && std::strcmp(argv[1], "counting") != 0)) {
+    std::fprintf(stderr, "usage: tick_driver sim|counting N\n");
+    return 2;
+  }
+  const long n = std::atol(argv[2]);
+  if (n <= 0) {
+    std::fprintf(stderr, "tick_driver: N = '%s' must be a positive integer\n", argv[2]);
+    return 2;
+  }
+  const auto k = *odo::Kinematics::create({0.15, 2048, 16, 0.34, 0.34, 1.0, 1.0});
+  auto robot = *odo::sim::SimRobot::create(odo::sim::RobotGeometry{}, {{1e7, 3.0, 3.3}});
+  odo::sim::SimEncoderSource sim_enc(robot, 32);
+  odo::bench::CountingEncoder count_enc(52, 57);
+  odo::EncoderSource& enc = argv[1][0] == 's' ? static_cast<odo::EncoderSource&>(sim_enc)
+                                              : static_cast<odo::EncoderSource&>(count_enc);
+  odo::sim::VirtualClock clock;
+  auto loop = odo::fw::OdometryLoop::create(odo::fw::LoopConfig{1000.0}, k, enc, clock).value();
+  loop->start();
+  for (long i = 0; i < n; ++i) loop->tick();
+  const odo::Pose2& p = loop->odometry().pose();
+  std::printf("ticks=%llu x=%.6f y=%.6f theta=%.6f\n",
+              static_cast<unsigned long long>(loop->stats().ticks), p.x, p.y, p.theta);
+  return 0;
+}

@@ -1,0 +1,41 @@
+#include <gtest/gtest.h>
+
+#include "odo/firmware/config.hpp"
+
+namespace odo::fw {
+namespace {
+
+TEST(RealtimeConfig, DefaultsAndValues) {
+  const Config d = default_config();
+  EXPECT_EQ(d.realtime.priority, 80);
+  EXPECT_TRUE(d.realtime.lock_memory);
+  EXPECT_EQ(d.realtime.cpu, -1);
+  EXPECT_FALSE(d.realtime.required);
+  auto c = parse_config(
+      "[realtime]\npriority = 0\nlock_memory = false\ncpu = 1\nprefault_stack = 0\n"
+      "required = true\n",
+      "rt.toml");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  EXPECT_EQ(c->realtime.priority, 0);
+  EXPECT_FALSE(c->realtime.lock_memory);
+  EXPECT_EQ(c->realtime.cpu, 1);
+  EXPECT_EQ(c->realtime.prefault_stack, 0);
+  EXPECT_TRUE(c->realtime.required);
+}
+
+TEST(RealtimeConfig, OutOfRangeAndUnknownKeysNameFileLineAndField) {
+  auto c = parse_config("[loop]\nrate_hz = 100\n[realtime]\npriority = 120\n", "rt.toml");
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.error().message.find("rt.toml:4"), std::string::npos) << c.error().message;
+  EXPECT_NE(c.error().message.find("priority"), std::string::npos) << c.error().message;
+  EXPECT_NE(c.error().message.find("99"), std::string::npos) << c.error().message;
+  auto u = parse_config("[realtime]\nprio = 10\n", "rt.toml");
+  ASSERT_FALSE(u.ok());
+  EXPECT_NE(u.error().message.find("prio"), std::string::npos) << u.error().message;
+  auto b = parse_config("[realtime]\nrequired = \"yes\"\n", "rt.toml");
+  ASSERT_FALSE(b.ok());
+  EXPECT_NE(b.error().message.find("required"), std::string::npos) << b.error().message;
+}
+
+}  // namespace
+}  // namespace odo::fw
