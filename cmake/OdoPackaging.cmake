@@ -81,3 +81,14 @@ set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
   ${ODO_DEB_CONTROL}/postrm)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
 include(CPack)
+
+# ctest -L package: build this tree's package and check it (tests/package/check_deb.sh). For the
+# machine's own architecture it also installs, runs, verifies the unit, removes and purges (root
+# only; tools/test.sh runs it on the throw-away CI machine). Not part of the unit|sim|cli tiers.
+if(ODO_BUILD_TESTS AND ODO_DEB_ARCH)
+  add_test(NAME package_deb
+    COMMAND bash ${ODO_PKG_SOURCE}/tests/package/check_deb.sh ${CMAKE_BINARY_DIR} ${ODO_PKG_SOURCE}
+            ${ODO_DEB_ARCH} $<$<NOT:$<BOOL:${CMAKE_CROSSCOMPILING}>>:--install>)
+  set_tests_properties(package_deb PROPERTIES LABELS package SKIP_RETURN_CODE 77 RUN_SERIAL ON
+    TIMEOUT 300)
+endif()
