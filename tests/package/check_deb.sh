@@ -112,6 +112,11 @@ if [ "$install" = --install ]; then
       '/usr/bin/odometryd --config /etc/odometryd/odometryd.toml --virtual-time --duration 5 --json --quiet >"$tmp/run.json" && python3 -c "import json,sys; j=json.load(open(sys.argv[1])); assert j[\"ticks\"] >= 499, j" "$tmp/run.json"'
     check "/var/lib/odometryd exists after install" '[ -d /var/lib/odometryd ]'
     unit=/lib/systemd/system/odometryd.service
+    user=$(sed -n 's/^[[:space:]]*User=[[:space:]]*//p' "$unit" 2>/dev/null | tail -n 1)
+    if [ -n "$user" ] && [ "$user" != root ]; then
+      check "the unit's User=$user exists and owns /var/lib/odometryd" \
+        'getent passwd "$user" >/dev/null && [ "$(stat -c %U /var/lib/odometryd)" = "$user" ]'
+    fi
     if [ -f "$unit" ]; then
       if command -v systemd-analyze >/dev/null; then
         check "systemd-analyze verify $unit" \
