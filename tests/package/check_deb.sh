@@ -128,13 +128,14 @@ if [ "$install" = --install ]; then
     else
       echo "SKIPPED: systemd-analyze verify: the package has no unit yet (firmware/systemd/odometryd.service is not in the source tree)"
     fi
+    # A store that holds a record survives remove and purge (postrm); an empty directory does not.
+    [ -e /var/lib/odometryd/calibration.bin ] && keep_store=1 || keep_store=0
+    [ $keep_store = 1 ] || echo "test record" >/var/lib/odometryd/calibration.bin
     echo "--- dpkg -r diffodom"
     check "dpkg -r" 'dpkg -r diffodom >"$tmp/dpkg.log" 2>&1 || { cat "$tmp/dpkg.log"; false; }'
     check "binaries gone after remove" '[ ! -e /usr/bin/odometryd ] && [ ! -e /usr/bin/odomctl ]'
     check "conffile kept after remove" '[ -f /etc/odometryd/odometryd.toml ]'
-    # A store that holds a record survives a purge (postrm); an empty directory does not.
-    [ -e /var/lib/odometryd/calibration.bin ] && keep_store=1 || keep_store=0
-    [ $keep_store = 1 ] || echo "test record" >/var/lib/odometryd/calibration.bin
+    check "calibration store kept after remove" '[ -f /var/lib/odometryd/calibration.bin ]'
     echo "--- dpkg -P diffodom"
     check "dpkg -P" 'dpkg -P diffodom >"$tmp/dpkg.log" 2>&1 || { cat "$tmp/dpkg.log"; false; }'
     check "config gone after purge" '[ ! -e /etc/odometryd/odometryd.toml ]'
