@@ -50,7 +50,8 @@ if [[ ${ODO_PACKAGES:-1} == 1 ]]; then
     echo "=== package of $c ==="
     t0=$(date +%s)
     # ctest exits 0 for a skipped test; the summary then says why from the test output.
-    if ctest --test-dir "build/$c" -L package --output-on-failure -V >"build/$c/package.log" 2>&1
+    if ODO_PACKAGE_INSTALL=1 ctest --test-dir "build/$c" -L package --output-on-failure -V \
+        >"build/$c/package.log" 2>&1
     then r=ok; else r=FAILED; status=1; fi
     # Every check is in build/$c/package.log; show failures, skips, sizes and the count.
     grep -E '^[0-9]+: (FAIL|SKIPPED|size|package|check_deb)' "build/$c/package.log" | cut -d' ' -f2- || true
