@@ -12,8 +12,10 @@ build_pkgs=(g++ cmake make pkg-config python3 libeigen3-dev libgpiod-dev libtoml
   libcli11-dev nlohmann-json3-dev)
 test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind)
 # Cross builds (toolchains/, presets cross-aarch64 and cross-armhf) and the package checks
-# (tests/package/check_deb.sh: dpkg-shlibdeps, file, systemd-analyze; fresh_install.sh: debootstrap).
-cross_pkgs=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user dpkg-dev file systemd debootstrap)
+# (tests/package/: check_deb.sh uses dpkg-shlibdeps, file, systemd-analyze; fresh_install.sh
+# uses debootstrap).
+cross_pkgs=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user dpkg-dev file systemd
+  debootstrap)
 cross_archs=(arm64 armhf)
 # Target libraries linked into the binaries or tests (Multi-Arch: same; one per architecture).
 # Eigen, CLI11 and nlohmann-json are Architecture: all headers: the native package serves all.
