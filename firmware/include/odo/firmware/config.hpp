@@ -30,12 +30,19 @@ struct EncoderSection {
   std::string backend = "sim";  // sim | hctl1100 | gpio | can
 };
 
+// Where the calibration record lives ([calibration]); see calibration_io.hpp.
+struct CalibrationSection {
+  std::string store = "/var/lib/odometryd/calibration.bin";  // "" = no store: nominal values
+  std::string backend = "auto";                              // auto | file | nvmem | mtd
+};
+
 struct Config {
   std::string source = "<built-in>";  // file the config came from
   LoopSection loop;
   KinematicParams robot;  // nominal robot; c_l, c_r, wheelbase may be replaced by calibration
   EncoderSection encoder;
   SimSection sim;
+  CalibrationSection calibration;
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.
