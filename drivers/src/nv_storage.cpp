@@ -201,8 +201,9 @@ Result<std::unique_ptr<MtdStorage>> MtdStorage::open(const std::string& path) {
   }
   NvGeometry g;
   g.size = info.size;
-  // MTD_NO_ERASE devices (RAM, NVRAM) are byte-writable.
-  g.erase_block = (info.flags & MTD_NO_ERASE) ? 0 : info.erasesize;
+  // Flash discipline (erase, then program) wherever the device offers erase blocks, even on
+  // MTD_NO_ERASE devices such as mtdram, which implement MEMERASE as well.
+  g.erase_block = info.erasesize;
   g.write_unit = info.writesize > 0 ? info.writesize : 1;
   return std::unique_ptr<MtdStorage>(new MtdStorage(path, fd, g));
 }
