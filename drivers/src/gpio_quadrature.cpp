@@ -58,6 +58,7 @@ struct GpioQuadratureEncoder::Impl {
   std::array<std::uint64_t, 2> edges{};
   std::array<std::uint64_t, 2> index_pulses{};
   std::array<std::int64_t, 2> index_count{};
+  std::array<TimeNs, 2> last_ts{};  // timestamp of the last applied A/B edge per wheel
   std::array<WheelAtomics, 2> pub;
   std::atomic<bool> stop{false};
   std::atomic<bool> held{false};
@@ -122,7 +123,14 @@ void GpioQuadratureEncoder::Impl::process(std::size_t n) noexcept {
       if (o.rising) levels |= bit;
       o.done = true;
     }
-    trackers[r.wheel].apply(mask, levels);
+    if (e.ts < last_ts[r.wheel]) {
+      // Arrived after a younger edge of the other line was already applied (the kernel's IRQ
+      // thread ran later than the reorder window): report it instead of miscounting.
+      trackers[r.wheel].adopt(mask, levels);
+    } else {
+      trackers[r.wheel].apply(mask, levels);
+      last_ts[r.wheel] = e.ts;
+    }
     edges[r.wheel] += (mask == 3u) ? 2 : 1;
   }
 }
@@ -188,10 +196,15 @@ void GpioQuadratureEncoder::Impl::run() noexcept {
       }
       continue;
     }
-    // Each line's events arrive in order; merge the lines by timestamp (stable: equal stamps
-    // keep their read order).
-    std::stable_sort(pending.begin(), pending.end(),
-                     [](const Event& x, const Event& y) { return x.ts < y.ts; });
+    // Each line's events arrive in order, so the buffer is nearly sorted: an insertion sort
+    // merges the lines by timestamp in place (stable: equal stamps keep their read order) and,
+    // unlike std::stable_sort, allocates nothing.
+    for (std::size_t k = 1; k < pending.size(); ++k) {
+      const Event e = pending[k];
+      std::size_t m = k;
+      for (; m > 0 && pending[m - 1].ts > e.ts; --m) pending[m] = pending[m - 1];
+      pending[m] = e;
+    }
     // Process what is older than the reorder window; all of it when the buffer is nearly full.
     const TimeNs cutoff = t_read - cfg.reorder_window;
     std::size_t n = 0;

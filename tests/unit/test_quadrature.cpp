@@ -102,5 +102,15 @@ TEST(QuadTracker, ResyncCountsADifferenceOnly) {
   EXPECT_EQ(t.state(), 1);
 }
 
+TEST(QuadTracker, LateEdgeIsAdoptedAsInvalid) {
+  QuadTracker t;
+  t.reset(0);
+  EXPECT_EQ(t.apply(kB, kB), QuadStep::kBackward);  // 00 -> 01
+  t.adopt(kA, kA);                                  // a late A edge: 01 -> 11 without motion
+  EXPECT_EQ(t.count(), -1);
+  EXPECT_EQ(t.invalid(), 1u);
+  EXPECT_EQ(t.state(), 3);
+}
+
 }  // namespace
 }  // namespace odo

@@ -43,6 +43,14 @@ class QuadTracker {
     return true;
   }
 
+  // adopt: an edge that arrived out of time order (older than one already applied): its
+  // direction cannot be known any more; counted as invalid, its level taken without motion.
+  void adopt(std::uint8_t mask, std::uint8_t levels) noexcept {
+    mask &= 3u;
+    ++invalid_;
+    state_ = static_cast<QuadState>((state_ & ~mask) | (levels & mask));
+  }
+
   std::int64_t count() const noexcept { return count_; }
   std::uint64_t invalid() const noexcept { return invalid_; }
   QuadState state() const noexcept { return state_; }

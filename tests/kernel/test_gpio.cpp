@@ -1,0 +1,287 @@
+// Kernel tier: the libgpiod backends on real kernel GPIO chips (gpio-sim in the VM harness).
+// Edges are driven through the simulator's sysfs `pull` attributes.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <functional>
+#include <mutex>
+#include <thread>
+
+#include "gpio_sim.hpp"
+#include "kernel_env.hpp"
+#include "odo/drivers/gpio_quadrature.hpp"
+#include "odo/drivers/gpiod_parallel_bus.hpp"
+#include "odo/drivers/hctl1100_encoder.hpp"
+#include "odo/hal/quadrature.hpp"
+#include "odo/sim/hctl1100_model.hpp"
+
+namespace odo::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+// wait_for: polls `done` every 5 ms until it holds or `limit` passes; returns its last value.
+bool wait_for(const std::function<bool()>& done, std::chrono::milliseconds limit) {
+  const auto end = std::chrono::steady_clock::now() + limit;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(5ms);
+  }
+  return true;
+}
+
+// FlowControl: the kernel queues 16 events per line and drops the rest when the reader has no
+// CPU (one emulated vCPU shared with the writer); keeping fewer than 8 edges in flight makes a
+// test about exact decoding. How fast the decoder can go is what bench_gpio_edges measures.
+struct FlowControl {
+  std::function<std::uint64_t()> processed;  // edges the decoder has taken
+  std::uint64_t written = 0;
+  void before_edge() {
+    while (written - processed() >= 8) std::this_thread::sleep_for(200us);
+    ++written;
+  }
+};
+
+// QuadWriter: moves a simulated encoder on lines a/b one quadrature state at a time.
+struct QuadWriter {
+  GpioSim& sim;
+  int a, b;
+  FlowControl* flow = nullptr;
+  std::int64_t pos = 0;
+  // step: one count forward (+1) or backward (-1): exactly one line changes.
+  void step(int dir) {
+    if (flow != nullptr) flow->before_edge();
+    const QuadState from = quad_state_at(pos);
+    pos += dir;
+    const QuadState to = quad_state_at(pos);
+    const QuadState changed = from ^ to;
+    if (changed & 2u) ASSERT_TRUE(sim.pull(a, (to & 2u) != 0));
+    if (changed & 1u) ASSERT_TRUE(sim.pull(b, (to & 1u) != 0));
+  }
+};
+
+drivers::GpioQuadratureConfig quad_config(const GpioSim& sim) {
+  drivers::GpioQuadratureConfig c;
+  c.chip = sim.chip();
+  c.left = {0, 1, 4, false};
+  c.right = {2, 3, -1, false};
+  c.consumer = "odo-test";
+  return c;
+}
+
+TEST(GpioQuadratureKernel, ThousandsOfEdgesBothDirectionsCountExactly) {
+  ODO_REQUIRE_VM();
+  GpioSim sim("odo_quad_exact", 5);
+  auto enc = drivers::GpioQuadratureEncoder::open(quad_config(sim));
+  ASSERT_TRUE(enc.ok()) << enc.error().message;
+  auto& e = **enc;
+  FlowControl flow{[&] { return e.wheel(0).edges + e.wheel(1).edges; }};
+  QuadWriter left{sim, 0, 1, &flow};
+  QuadWriter right{sim, 2, 3, &flow};
+  // Left: 3000 forward, 1200 back; right: 2000 back, 500 forward; interleaved edge by edge.
+  for (int i = 0; i < 3000; ++i) {
+    left.step(+1);
+    if (i < 2000) right.step(-1);
+  }
+  for (int i = 0; i < 1200; ++i) {
+    left.step(-1);
+    if (i < 500) right.step(+1);
+  }
+  const std::uint64_t edges = 3000 + 1200 + 2000 + 500;
+  ASSERT_TRUE(wait_for([&] { return e.wheel(0).edges + e.wheel(1).edges >= edges; }, 20s))
+      << "edges seen " << e.wheel(0).edges + e.wheel(1).edges << " of " << edges;
+  std::this_thread::sleep_for(100ms);  // nothing more may arrive
+  const EncoderSample s = e.read(0);
+  EXPECT_EQ(s.left, 1800);
+  EXPECT_EQ(s.right, -1500);
+  EXPECT_EQ(s.counters.invalid_transitions, 0u);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(e.wheel(0).edges + e.wheel(1).edges, edges);
+}
+
+TEST(GpioQuadratureKernel, IndexLineLatchesTheCount) {
+  ODO_REQUIRE_VM();
+  GpioSim sim("odo_quad_index", 5);
+  auto enc = drivers::GpioQuadratureEncoder::open(quad_config(sim));
+  ASSERT_TRUE(enc.ok()) << enc.error().message;
+  auto& e = **enc;
+  FlowControl flow{[&] { return e.wheel(0).edges; }};
+  QuadWriter left{sim, 0, 1, &flow};
+  for (int i = 0; i < 37; ++i) left.step(+1);
+  ASSERT_TRUE(wait_for([&] { return e.wheel(0).count == 37; }, 5s));
+  ASSERT_TRUE(sim.pull(4, true));  // index pulse
+  ASSERT_TRUE(sim.pull(4, false));
+  for (int i = 0; i < 5; ++i) left.step(+1);
+  ASSERT_TRUE(wait_for([&] { return e.wheel(0).count == 42; }, 5s));
+  EXPECT_EQ(e.wheel(0).index_pulses, 1u);
+  EXPECT_EQ(e.wheel(0).index_count, 37);
+}
+
+// Edges lost in the kernel (its per-line event queue holds 16 events) are detected and counted
+// as invalid transitions, never turned into motion; counting goes on correctly afterwards.
+TEST(GpioQuadratureKernel, LostEventsAreDetectedAndNotCounted) {
+  ODO_REQUIRE_VM();
+  GpioSim sim("odo_quad_lost", 5);
+  auto enc = drivers::GpioQuadratureEncoder::open(quad_config(sim));
+  ASSERT_TRUE(enc.ok()) << enc.error().message;
+  auto& e = **enc;
+  // Control: two legal steps while the reader is held fit in the queue and count normally.
+  e.hold(true);
+  std::this_thread::sleep_for(20ms);
+  QuadWriter left{sim, 0, 1};
+  left.step(+1);
+  left.step(+1);
+  e.hold(false);
+  ASSERT_TRUE(wait_for([&] { return e.wheel(0).count == 2; }, 5s));
+  EXPECT_EQ(e.wheel(0).invalid, 0u);
+
+  // Injection: A toggles 41 times while the reader is held: 25 of the edges are dropped by the
+  // kernel; the 16 delivered ones alternate and cancel, and A ends on the opposite level.
+  e.hold(true);
+  std::this_thread::sleep_for(20ms);
+  const bool a0 = (quad_state_at(left.pos) & 2u) != 0;
+  for (int i = 1; i <= 41; ++i) ASSERT_TRUE(sim.pull(0, (i % 2 == 1) ? !a0 : a0));
+  e.hold(false);
+  ASSERT_TRUE(wait_for([&] { return e.wheel(0).invalid >= 1; }, 5s))
+      << "lost edges were not detected; count " << e.wheel(0).count;
+  const EncoderSample s = e.read(0);
+  EXPECT_TRUE(s.flags & kEncoderInvalidTransition);
+  EXPECT_GE(s.counters.invalid_transitions, 1u);
+  // No motion was invented: the count stayed within one step of where it was.
+  EXPECT_LE(std::llabs(e.wheel(0).count - 2), 1);
+
+  // From the adopted state, 100 legal steps count exactly 100.
+  const std::int64_t base = e.wheel(0).count;
+  const std::uint64_t inv = e.wheel(0).invalid;
+  // The writer's idea of the position: A was flipped an odd number of times.
+  left.pos = 0;
+  QuadState now = quad_state((!a0), (quad_state_at(2) & 1u) != 0);
+  while (quad_state_at(left.pos) != now) ++left.pos;
+  FlowControl flow{[&] { return e.wheel(0).edges; }, e.wheel(0).edges};
+  left.flow = &flow;
+  for (int i = 0; i < 100; ++i) left.step(+1);
+  ASSERT_TRUE(wait_for([&] { return e.wheel(0).count == base + 100; }, 5s))
+      << "count " << e.wheel(0).count << " expected " << base + 100;
+  EXPECT_EQ(e.wheel(0).invalid, inv);
+}
+
+TEST(GpioQuadratureKernel, BadLinesAreClearErrors) {
+  ODO_REQUIRE_VM();
+  GpioSim sim("odo_quad_bad", 5);
+  auto c = quad_config(sim);
+  c.right.b = 40;  // the chip has 5 lines
+  auto enc = drivers::GpioQuadratureEncoder::open(c);
+  ASSERT_FALSE(enc.ok());
+  EXPECT_NE(enc.error().message.find("line 40 (right b)"), std::string::npos)
+      << enc.error().message;
+  c.chip = "/dev/gpiochip-none";
+  auto enc2 = drivers::GpioQuadratureEncoder::open(c);
+  ASSERT_FALSE(enc2.ok());
+  EXPECT_NE(enc2.error().message.find("gpiochip-none"), std::string::npos);
+}
+
+// The HCTL-1100 driver over the libgpiod bus on gpio-sim lines. A responder thread plays the
+// chip: it watches the control lines' sysfs values, decodes the address the bus drives on
+// AD0..7, asks the register model and answers through the pull attributes once AD are inputs.
+class ChipResponder {
+ public:
+  // Lines: AD0..7 = 0..7, ALE 8, OE 9 (/OE), RW 10, CS0 11 (/CS), CS1 12 (/CS).
+  ChipResponder(GpioSim& sim, sim::Hctl1100Model& u0, sim::Hctl1100Model& u1)
+      : sim_(sim), units_{&u0, &u1}, thread_([this] { run(); }) {}
+  ~ChipResponder() {
+    stop_ = true;
+    thread_.join();
+  }
+  std::vector<int> addresses() {
+    std::lock_guard lk(m_);
+    return addresses_;
+  }
+  std::mutex& model_mutex() { return m_; }
+
+ private:
+  void run() {
+    while (!stop_) {
+      int unit = -1;
+      if (sim_.value(11) == 0) unit = 0;
+      if (sim_.value(12) == 0) unit = unit < 0 ? 1 : 2;
+      if (unit < 0 || unit > 1 || sim_.value(8) != 0 || sim_.value(9) != 1) {
+        std::this_thread::sleep_for(500us);
+        continue;
+      }
+      // Address phase: CS asserted, ALE has fallen, OE not yet asserted; AD are outputs.
+      int addr = 0;
+      for (int i = 0; i < 8; ++i) addr |= (sim_.value(i) == 1 ? 1 : 0) << i;
+      while (!stop_ && sim_.value(9) != 0) std::this_thread::sleep_for(500us);  // wait for /OE
+      std::uint8_t data = 0;
+      {
+        std::lock_guard lk(m_);
+        addresses_.push_back(addr);
+        data = units_[unit]->read_register(static_cast<std::uint8_t>(addr));
+      }
+      for (int i = 0; i < 8; ++i) sim_.pull(i, ((data >> i) & 1) != 0);
+      // Wait for the end of the cycle (/CS released).
+      while (!stop_ && sim_.value(11 + unit) == 0) std::this_thread::sleep_for(500us);
+    }
+  }
+  GpioSim& sim_;
+  sim::Hctl1100Model* units_[2];
+  std::mutex m_;
+  std::vector<int> addresses_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+drivers::GpiodBusConfig bus_config(const GpioSim& sim) {
+  drivers::GpiodBusConfig c;
+  c.chip = sim.chip();
+  c.ad = {0, 1, 2, 3, 4, 5, 6, 7};
+  c.ale = 8;
+  c.oe = 9;
+  c.rw = 10;
+  c.cs = {11, 12};
+  // A software chip answering through sysfs under an emulated CPU needs milliseconds.
+  c.settle = 25'000'000;
+  c.consumer = "odo-test";
+  return c;
+}
+
+TEST(HctlOverGpiodBusKernel, DriverReadsTheModelThroughGpioLines) {
+  ODO_REQUIRE_VM();
+  GpioSim sim("odo_hctl_bus", 13);
+  sim::Hctl1100Model left(sim::Hctl1100Model::Latch::kLsbLatch);
+  sim::Hctl1100Model right(sim::Hctl1100Model::Latch::kLsbLatch);
+  left.preset(123456);    // 0x01E240
+  right.preset(-654321);  // 0xF6040F
+  auto bus = drivers::GpiodParallelBus::open(bus_config(sim));
+  ASSERT_TRUE(bus.ok()) << bus.error().message;
+  ChipResponder chip(sim, left, right);
+  drivers::Hctl1100Config hc;
+  hc.max_counts_per_s = 10000;
+  auto enc = drivers::Hctl1100Encoder::create(**bus, hc);
+  ASSERT_TRUE(enc.ok()) << enc.error().message;
+  const EncoderSample a = enc->read(0);
+  EXPECT_EQ(a.flags, 0u);
+  EXPECT_EQ(a.left, 123456);
+  EXPECT_EQ(a.right, -654321);
+  // Every cycle drove a position register address, LSB first: 14h, 13h, 12h.
+  const std::vector<int> seen = chip.addresses();
+  ASSERT_EQ(seen.size(), 12u);  // 2 wheels x 2 agreeing readings x 3 bytes
+  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], 0x14 - int(i % 3)) << i;
+  // The wheel moves 300 counts forward across the LSB roll-over (0x40 + 300 = 0x16C).
+  {
+    std::lock_guard lk(chip.model_mutex());
+    left.follow(300);
+  }
+  const EncoderSample b = enc->read(1'000'000'000);
+  EXPECT_EQ(b.flags, 0u);
+  EXPECT_EQ(b.left, 123756);
+  EXPECT_EQ(b.right, -654321);
+  // Idle state after the cycles: /CS and /OE released (high), ALE low.
+  EXPECT_EQ(sim.value(11), 1);
+  EXPECT_EQ(sim.value(12), 1);
+  EXPECT_EQ(sim.value(9), 1);
+  EXPECT_EQ(sim.value(8), 0);
+}
+
+}  // namespace
+}  // namespace odo::test
