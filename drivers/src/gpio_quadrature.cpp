@@ -40,6 +40,7 @@ TimeNs monotonic_now() noexcept {
 // The published state of one wheel: written by the event thread, read by the loop.
 struct WheelAtomics {
   std::atomic<std::int64_t> count{0};
+  std::atomic<std::uint64_t> received{0};
   std::atomic<std::uint64_t> edges{0};
   std::atomic<std::uint64_t> invalid{0};
   std::atomic<std::uint64_t> index_pulses{0};
@@ -181,6 +182,8 @@ void GpioQuadratureEncoder::Impl::run() noexcept {
         }
         for (int e = 0; e < got && pending.size() < pending.capacity(); ++e) {
           const gpiod_line_event& ev = buf[static_cast<std::size_t>(e)];
+          if (roles[idx].role != Role::kIndex)
+            pub[roles[idx].wheel].received.fetch_add(1, std::memory_order_relaxed);
           pending.push_back(Event{static_cast<TimeNs>(ev.ts.tv_sec) * kNsPerSecond + ev.ts.tv_nsec,
                                   static_cast<std::uint8_t>(idx),
                                   ev.event_type == GPIOD_LINE_EVENT_RISING_EDGE, false});
@@ -303,6 +306,7 @@ GpioWheelStats GpioQuadratureEncoder::wheel(int i) const noexcept {
   const WheelAtomics& a = impl_->pub[i == 0 ? 0 : 1];
   GpioWheelStats s;
   s.count = a.count.load(std::memory_order_acquire);
+  s.received = a.received.load(std::memory_order_relaxed);
   s.edges = a.edges.load(std::memory_order_relaxed);
   s.invalid = a.invalid.load(std::memory_order_relaxed);
   s.index_pulses = a.index_pulses.load(std::memory_order_relaxed);

@@ -42,7 +42,8 @@ struct GpioQuadratureConfig {
 // Diagnostics of one wheel, read from the atomics.
 struct GpioWheelStats {
   std::int64_t count = 0;
-  std::uint64_t edges = 0;
+  std::uint64_t received = 0;  // A/B events read from the kernel (before merging)
+  std::uint64_t edges = 0;     // A/B edges decoded
   std::uint64_t invalid = 0;
   std::uint64_t index_pulses = 0;
   std::int64_t index_count = 0;  // count at the last index rising edge
