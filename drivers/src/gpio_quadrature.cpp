@@ -60,6 +60,11 @@ struct GpioQuadratureEncoder::Impl {
   std::array<std::uint64_t, 2> index_pulses{};
   std::array<std::int64_t, 2> index_count{};
   std::array<TimeNs, 2> last_ts{};  // timestamp of the last applied A/B edge per wheel
+  TimeNs seen_ts[2][2] = {};
+  std::uint64_t events_read = 0;  // all events read from the kernel
+  bool suspect = false;           // idle check saw a difference once
+  std::array<QuadState, 2> suspect_levels{};
+  std::uint64_t suspect_events = 0;  // newest received timestamp per wheel and line (A, B)
   std::array<WheelAtomics, 2> pub;
   std::atomic<bool> stop{false};
   std::atomic<bool> held{false};
@@ -137,17 +142,25 @@ void GpioQuadratureEncoder::Impl::process(std::size_t n) noexcept {
 }
 
 void GpioQuadratureEncoder::Impl::idle_check() noexcept {
-  // Two readings 2 ms apart with no event in between and the same difference from the tracked
-  // state: the edges that led there were lost, not merely still in flight.
-  std::array<QuadState, 2> a{};
-  std::array<QuadState, 2> b{};
-  if (!read_levels(a)) return;
-  sleep_ns(2'000'000);
-  if (!read_levels(b) || a != b) return;
-  timespec zero{0, 0};
-  gpiod_line_bulk evb;
-  if (gpiod_line_event_wait_bulk(&bulk, &zero, &evb) != 0) return;  // events arrived: not idle
-  for (int w = 0; w < 2; ++w) trackers[w].resync(a[w]);
+  // A difference between the lines and the decoded state counts as lost edges only when it was
+  // seen at two idle checks in a row (idle_check apart) with not one event read in between:
+  // an edge whose event is merely late (the kernel's IRQ thread not yet run) is not a loss.
+  std::array<QuadState, 2> now{};
+  if (!read_levels(now)) return;
+  bool differs = false;
+  for (int w = 0; w < 2; ++w) differs = differs || now[w] != trackers[w].state();
+  if (!differs) {
+    suspect = false;
+    return;
+  }
+  if (suspect && suspect_levels == now && suspect_events == events_read) {
+    for (int w = 0; w < 2; ++w) trackers[w].resync(now[w]);
+    suspect = false;
+    return;
+  }
+  suspect = true;
+  suspect_levels = now;
+  suspect_events = events_read;
 }
 
 void GpioQuadratureEncoder::Impl::run() noexcept {
@@ -182,10 +195,13 @@ void GpioQuadratureEncoder::Impl::run() noexcept {
         }
         for (int e = 0; e < got && pending.size() < pending.capacity(); ++e) {
           const gpiod_line_event& ev = buf[static_cast<std::size_t>(e)];
-          if (roles[idx].role != Role::kIndex)
+          const TimeNs ts = static_cast<TimeNs>(ev.ts.tv_sec) * kNsPerSecond + ev.ts.tv_nsec;
+          ++events_read;
+          if (roles[idx].role != Role::kIndex) {
             pub[roles[idx].wheel].received.fetch_add(1, std::memory_order_relaxed);
-          pending.push_back(Event{static_cast<TimeNs>(ev.ts.tv_sec) * kNsPerSecond + ev.ts.tv_nsec,
-                                  static_cast<std::uint8_t>(idx),
+            seen_ts[roles[idx].wheel][roles[idx].role == Role::kA ? 0 : 1] = ts;
+          }
+          pending.push_back(Event{ts, static_cast<std::uint8_t>(idx),
                                   ev.event_type == GPIOD_LINE_EVENT_RISING_EDGE, false});
         }
       }
@@ -208,13 +224,21 @@ void GpioQuadratureEncoder::Impl::run() noexcept {
       for (; m > 0 && pending[m - 1].ts > e.ts; --m) pending[m] = pending[m - 1];
       pending[m] = e;
     }
-    // Process what is older than the reorder window; all of it when the buffer is nearly full.
+    // An A/B edge is ready when the wheel's other line has delivered a younger edge (each
+    // line's queue is in order, so nothing older of that line can still come) or when it is
+    // older than the reorder window (the other line may simply not have moved). While the
+    // wheel turns, A and B alternate, so the order is exact whatever the kernel's latency.
+    // Everything is ready when the buffer is nearly full.
     const TimeNs cutoff = t_read - cfg.reorder_window;
+    const bool flush = pending.size() * 4 >= pending.capacity() * 3;
     std::size_t n = 0;
-    if (pending.size() * 4 >= pending.capacity() * 3) {
-      n = pending.size();
-    } else {
-      while (n < pending.size() && pending[n].ts <= cutoff) ++n;
+    while (n < pending.size()) {
+      const Event& e = pending[n];
+      const LineRole role = roles[e.line];
+      const bool other_newer =
+          role.role != Role::kIndex && seen_ts[role.wheel][role.role == Role::kA ? 1 : 0] > e.ts;
+      if (!(flush || other_newer || e.ts <= cutoff)) break;
+      ++n;
     }
     if (n == 0) continue;
     process(n);

@@ -16,6 +16,9 @@ struct GpiodParallelBus::Impl {
   std::vector<gpiod_line*> cs;
 
   void settle() const noexcept { sleep_ns(cfg.settle); }
+  void phase(int unit, BusPhaseHook::Phase p) const noexcept {
+    if (cfg.hook != nullptr) cfg.hook->on_phase(unit, p);
+  }
   // Closing the chip (ChipHandle) releases every requested line.
 };
 
@@ -82,14 +85,17 @@ BusRead GpiodParallelBus::read_register(int unit, std::uint8_t reg) noexcept {
   // The chip latches the address on the falling edge of ALE.
   ok = ok && gpiod_line_set_value(m.ale, 0) == 0;
   m.settle();
+  if (ok) m.phase(unit, BusPhaseHook::Phase::kAddressLatched);
   ok = ok && gpiod_line_set_direction_input_bulk(&m.ad) == 0;
   ok = ok && gpiod_line_set_value(m.oe, 1) == 0;
   m.settle();
+  if (ok) m.phase(unit, BusPhaseHook::Phase::kOutputEnabled);
   int data[8] = {};
   ok = ok && gpiod_line_get_value_bulk(&m.ad, data) == 0;
   // Release the bus even after a failure, so the chip never drives AD against us.
   const bool released = gpiod_line_set_value(m.oe, 0) == 0 && gpiod_line_set_value(cs, 0) == 0;
   m.settle();
+  m.phase(unit, BusPhaseHook::Phase::kReleased);
   if (!ok || !released) return {};
   std::uint8_t v = 0;
   for (int i = 0; i < 8; ++i) v = static_cast<std::uint8_t>(v | ((data[i] != 0 ? 1 : 0) << i));

@@ -200,55 +200,55 @@ TEST(GpioQuadratureKernel, BadLinesAreClearErrors) {
   EXPECT_NE(enc2.error().message.find("gpiochip-none"), std::string::npos);
 }
 
-// The HCTL-1100 driver over the libgpiod bus on gpio-sim lines. A responder thread plays the
-// chip: it watches the control lines' sysfs values, decodes the address the bus drives on
-// AD0..7, asks the register model and answers through the pull attributes once AD are inputs.
-class ChipResponder {
+// The HCTL-1100 driver over the libgpiod bus on gpio-sim lines. ChipResponder plays the chip:
+// told by the bus after each phase (BusPhaseHook, instead of a wall-clock race against an
+// emulated CPU), it looks only at the lines through sysfs: which /CS is low, the address on
+// AD0..7 while ALE has fallen, and answers from the register model through the pull attributes
+// once AD are inputs and /OE is low.
+class ChipResponder final : public drivers::BusPhaseHook {
  public:
   // Lines: AD0..7 = 0..7, ALE 8, OE 9 (/OE), RW 10, CS0 11 (/CS), CS1 12 (/CS).
   ChipResponder(GpioSim& sim, sim::Hctl1100Model& u0, sim::Hctl1100Model& u1)
-      : sim_(sim), units_{&u0, &u1}, thread_([this] { run(); }) {}
-  ~ChipResponder() {
-    stop_ = true;
-    thread_.join();
-  }
-  std::vector<int> addresses() {
-    std::lock_guard lk(m_);
-    return addresses_;
-  }
-  std::mutex& model_mutex() { return m_; }
-
- private:
-  void run() {
-    while (!stop_) {
-      int unit = -1;
-      if (sim_.value(11) == 0) unit = 0;
-      if (sim_.value(12) == 0) unit = unit < 0 ? 1 : 2;
-      if (unit < 0 || unit > 1 || sim_.value(8) != 0 || sim_.value(9) != 1) {
-        std::this_thread::sleep_for(500us);
-        continue;
+      : sim_(sim), units_{&u0, &u1} {}
+  void on_phase(int, Phase phase) noexcept override {
+    switch (phase) {
+      case Phase::kAddressLatched: {
+        // /CS of exactly one chip low, ALE low, /OE high, R/W high (read); AD drive the address.
+        selected_ = -1;
+        if (sim_.value(11) == 0 && sim_.value(12) == 1) selected_ = 0;
+        if (sim_.value(12) == 0 && sim_.value(11) == 1) selected_ = 1;
+        if (sim_.value(8) != 0 || sim_.value(9) != 1 || sim_.value(10) != 1) selected_ = -1;
+        addr_ = 0;
+        for (int i = 0; i < 8; ++i) addr_ |= (sim_.value(i) == 1 ? 1 : 0) << i;
+        addresses_.push_back(selected_ < 0 ? -1 : addr_);
+        break;
       }
-      // Address phase: CS asserted, ALE has fallen, OE not yet asserted; AD are outputs.
-      int addr = 0;
-      for (int i = 0; i < 8; ++i) addr |= (sim_.value(i) == 1 ? 1 : 0) << i;
-      while (!stop_ && sim_.value(9) != 0) std::this_thread::sleep_for(500us);  // wait for /OE
-      std::uint8_t data = 0;
-      {
-        std::lock_guard lk(m_);
-        addresses_.push_back(addr);
-        data = units_[unit]->read_register(static_cast<std::uint8_t>(addr));
+      case Phase::kOutputEnabled: {
+        if (selected_ < 0 || sim_.value(9) != 0) {
+          protocol_errors_++;
+          break;
+        }
+        const std::uint8_t data =
+            units_[selected_]->read_register(static_cast<std::uint8_t>(addr_));
+        for (int i = 0; i < 8; ++i) sim_.pull(i, ((data >> i) & 1) != 0);
+        break;
       }
-      for (int i = 0; i < 8; ++i) sim_.pull(i, ((data >> i) & 1) != 0);
-      // Wait for the end of the cycle (/CS released).
-      while (!stop_ && sim_.value(11 + unit) == 0) std::this_thread::sleep_for(500us);
+      case Phase::kReleased:
+        if (sim_.value(11) != 1 || sim_.value(12) != 1 || sim_.value(9) != 1) protocol_errors_++;
+        selected_ = -1;
+        break;
     }
   }
+  const std::vector<int>& addresses() const { return addresses_; }
+  int protocol_errors() const { return protocol_errors_; }
+
+ private:
   GpioSim& sim_;
   sim::Hctl1100Model* units_[2];
-  std::mutex m_;
+  int selected_ = -1;
+  int addr_ = 0;
+  int protocol_errors_ = 0;
   std::vector<int> addresses_;
-  std::atomic<bool> stop_{false};
-  std::thread thread_;
 };
 
 drivers::GpiodBusConfig bus_config(const GpioSim& sim) {
@@ -259,8 +259,7 @@ drivers::GpiodBusConfig bus_config(const GpioSim& sim) {
   c.oe = 9;
   c.rw = 10;
   c.cs = {11, 12};
-  // A software chip answering through sysfs under an emulated CPU needs milliseconds.
-  c.settle = 60'000'000;
+  c.settle = 0;  // the responder is told each phase through the hook
   c.consumer = "odo-test";
   return c;
 }
@@ -272,9 +271,11 @@ TEST(HctlOverGpiodBusKernel, DriverReadsTheModelThroughGpioLines) {
   sim::Hctl1100Model right(sim::Hctl1100Model::Latch::kLsbLatch);
   left.preset(123456);    // 0x01E240
   right.preset(-654321);  // 0xF6040F
-  auto bus = drivers::GpiodParallelBus::open(bus_config(sim));
-  ASSERT_TRUE(bus.ok()) << bus.error().message;
   ChipResponder chip(sim, left, right);
+  drivers::GpiodBusConfig bc = bus_config(sim);
+  bc.hook = &chip;
+  auto bus = drivers::GpiodParallelBus::open(bc);
+  ASSERT_TRUE(bus.ok()) << bus.error().message;
   drivers::Hctl1100Config hc;
   hc.max_counts_per_s = 10000;
   auto enc = drivers::Hctl1100Encoder::create(**bus, hc);
@@ -285,13 +286,11 @@ TEST(HctlOverGpiodBusKernel, DriverReadsTheModelThroughGpioLines) {
   EXPECT_EQ(a.right, -654321);
   // Every cycle drove a position register address, LSB first: 14h, 13h, 12h.
   const std::vector<int> seen = chip.addresses();
+  EXPECT_EQ(chip.protocol_errors(), 0);
   ASSERT_EQ(seen.size(), 12u);  // 2 wheels x 2 agreeing readings x 3 bytes
   for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], 0x14 - int(i % 3)) << i;
   // The wheel moves 300 counts forward across the LSB roll-over (0x40 + 300 = 0x16C).
-  {
-    std::lock_guard lk(chip.model_mutex());
-    left.follow(300);
-  }
+  left.follow(300);
   const EncoderSample b = enc->read(1'000'000'000);
   EXPECT_EQ(b.flags, 0u);
   EXPECT_EQ(b.left, 123756);

@@ -29,9 +29,10 @@ struct GpioQuadratureConfig {
   GpioWheelLines right;
   bool active_low = false;  // the encoder outputs are inverted
   int batch = 64;           // events read per line and system call, 1..1024
-  // Events newer than (now - reorder_window) wait for the next round, so that an edge of the
-  // other line that is still on its way is merged in timestamp order [ns]. An edge that still
-  // arrives out of order is counted as an invalid transition, never as motion.
+  // An A/B edge is applied once the other line of its wheel has delivered a younger edge
+  // (exact order while the wheel turns, whatever the kernel's latency), or once it is older
+  // than reorder_window (the other line may not have moved) [ns]. An edge that still arrives
+  // out of order is counted as an invalid transition, never as motion.
   TimeNs reorder_window = 5'000'000;
   // With no events for this long the thread compares the tracked levels with the lines and
   // counts a difference as lost edges [ns].

@@ -20,6 +20,15 @@
 
 namespace odo::drivers {
 
+// BusPhaseHook: told after each phase of a read cycle (after the settle wait). Diagnostics, and
+// the gpio-sim test, where a software chip must answer through sysfs before the bus samples.
+class BusPhaseHook {
+ public:
+  enum class Phase { kAddressLatched, kOutputEnabled, kReleased };
+  virtual ~BusPhaseHook() = default;
+  virtual void on_phase(int unit, Phase phase) noexcept = 0;
+};
+
 struct GpiodBusConfig {
   std::string chip;                // /dev/gpiochipN, gpiochipN, a chip label or a number
   std::array<unsigned, 8> ad{};    // line offsets of AD0..AD7
@@ -30,6 +39,7 @@ struct GpiodBusConfig {
   bool control_active_low = true;  // CS and OE are active-low pins (/CS, /OE)
   TimeNs settle = 0;               // [ns] wait after each strobe
   std::string consumer = "odometryd";
+  BusPhaseHook* hook = nullptr;  // not owned; null: none
 };
 
 class GpiodParallelBus final : public ParallelBus {
