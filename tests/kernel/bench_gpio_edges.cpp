@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const int n = argc > 1 ? std::atoi(argv[1]) : 4000;
-  const double reorder_ms = argc > 2 ? std::atof(argv[2]) : 5.0;  // decoder's reorder window
+  const double reorder_ms = argc > 2 ? std::atof(argv[2]) : 20.0;  // decoder's reorder window
   const double rates[] = {500, 1000, 2000, 5000, 10000, 20000, 0};
   odo::test::GpioSim sim("odo_bench", 4);
   std::printf("decoder reorder window %.1f ms\n", reorder_ms);

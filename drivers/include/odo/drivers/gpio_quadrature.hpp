@@ -33,7 +33,7 @@ struct GpioQuadratureConfig {
   // (exact order while the wheel turns, whatever the kernel's latency), or once it is older
   // than reorder_window (the other line may not have moved) [ns]. An edge that still arrives
   // out of order is counted as an invalid transition, never as motion.
-  TimeNs reorder_window = 5'000'000;
+  TimeNs reorder_window = 20'000'000;
   // With no events for this long the thread compares the tracked levels with the lines and
   // counts a difference as lost edges [ns].
   TimeNs idle_check = 50'000'000;

@@ -62,7 +62,7 @@ struct GpioSection {
   bool reverse_left = false;
   bool reverse_right = false;
   int batch = 64;                // events per read, 1..1024
-  double reorder_window = 5e-3;  // [s] 0..0.1
+  double reorder_window = 0.02;  // [s] 0..0.1
   double idle_check = 0.05;      // [s] 0.01..10
 };
 
