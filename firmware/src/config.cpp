@@ -68,6 +68,47 @@ void read_calibration(TableReader t, CalibrationSection& s) {
   t.finish();
 }
 
+void read_hctl1100(TableReader t, Hctl1100Section& s) {
+  s.bus = t.choice("bus", s.bus, {"gpio", "sim"});
+  s.chip = t.string("chip", s.chip);
+  for (int i = 0; i < 8; ++i) {
+    const std::string key = "ad" + std::to_string(i);
+    s.ad[i] = static_cast<int>(t.integer(key, s.ad[i], 0, 1023));
+  }
+  s.ale = static_cast<int>(t.integer("ale", s.ale, 0, 1023));
+  s.oe = static_cast<int>(t.integer("oe", s.oe, 0, 1023));
+  s.rw = static_cast<int>(t.integer("rw", s.rw, 0, 1023));
+  s.cs_left = static_cast<int>(t.integer("cs_left", s.cs_left, 0, 1023));
+  s.cs_right = static_cast<int>(t.integer("cs_right", s.cs_right, 0, 1023));
+  s.control_active_low = t.boolean("control_active_low", s.control_active_low);
+  s.settle = t.number("settle", s.settle, 0.0, 0.1, "s");
+  s.max_speed = t.number("max_speed", s.max_speed, 0.01, 100.0, "m/s");
+  s.agree_window = static_cast<int>(t.integer("agree_window", s.agree_window, 0, 64));
+  s.max_attempts = static_cast<int>(t.integer("max_attempts", s.max_attempts, 2, 16));
+  s.reverse_left = t.boolean("reverse_left", s.reverse_left);
+  s.reverse_right = t.boolean("reverse_right", s.reverse_right);
+  s.latch = t.choice("latch", s.latch, {"none", "lsb"});
+  s.bus_cycle = t.number("bus_cycle", s.bus_cycle, 0.0, 1e-3, "s");
+  t.finish();
+}
+
+void read_gpio(TableReader t, GpioSection& s) {
+  s.chip = t.string("chip", s.chip);
+  s.left_a = static_cast<int>(t.integer("left_a", s.left_a, 0, 1023));
+  s.left_b = static_cast<int>(t.integer("left_b", s.left_b, 0, 1023));
+  s.left_index = static_cast<int>(t.integer("left_index", s.left_index, -1, 1023));
+  s.right_a = static_cast<int>(t.integer("right_a", s.right_a, 0, 1023));
+  s.right_b = static_cast<int>(t.integer("right_b", s.right_b, 0, 1023));
+  s.right_index = static_cast<int>(t.integer("right_index", s.right_index, -1, 1023));
+  s.active_low = t.boolean("active_low", s.active_low);
+  s.reverse_left = t.boolean("reverse_left", s.reverse_left);
+  s.reverse_right = t.boolean("reverse_right", s.reverse_right);
+  s.batch = static_cast<int>(t.integer("batch", s.batch, 1, 1024));
+  s.reorder_window = t.number("reorder_window", s.reorder_window, 0.0, 0.1, "s");
+  s.idle_check = t.number("idle_check", s.idle_check, 0.01, 10.0, "s");
+  t.finish();
+}
+
 }  // namespace
 
 Result<Config> parse_config(std::string_view text, std::string_view source) {
@@ -90,6 +131,8 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_sim(root.sub("sim"), c.sim);
   read_realtime(root.sub("realtime"), c.realtime);
   read_calibration(root.sub("calibration"), c.calibration);
+  read_hctl1100(root.sub("hctl1100"), c.hctl1100);
+  read_gpio(root.sub("gpio"), c.gpio);
   root.finish();
   if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
   return c;

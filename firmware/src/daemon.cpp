@@ -59,7 +59,19 @@ void print_status(std::ostream& out, const LoopSnapshot& s, double rate_hz) {
                 format_timing_status(timing, sizeof timing, s.stats),
                 static_cast<unsigned long long>(s.stats.missed_deadlines),
                 flags_text(s.encoder_flags).c_str());
-  out << line << std::endl;
+  out << line;
+  // Cumulative encoder fault counters, once there is something to count (a fault between two
+  // status lines would otherwise be invisible in the per-sample flags).
+  const EncoderCounters& c = s.encoder_counters;
+  if (c.invalid_transitions + c.implausible_jumps + c.stale_events + c.read_errors > 0) {
+    std::snprintf(line, sizeof line, " (invalid=%llu jumps=%llu stale=%llu read_errors=%llu)",
+                  static_cast<unsigned long long>(c.invalid_transitions),
+                  static_cast<unsigned long long>(c.implausible_jumps),
+                  static_cast<unsigned long long>(c.stale_events),
+                  static_cast<unsigned long long>(c.read_errors));
+    out << line;
+  }
+  out << std::endl;
 }
 
 }  // namespace

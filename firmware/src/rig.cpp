@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "encoder_backends.hpp"
 #include "odo/drivers/monotonic_clock.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_encoder.hpp"
@@ -66,6 +67,7 @@ struct Rig::Impl {
   std::unique_ptr<EncoderSource> encoder_wrapper;
   EncoderSource* encoder = nullptr;
   std::unique_ptr<TruthObserver> truth;
+  std::unique_ptr<EncoderBackend> backend;  // hctl1100 / gpio (encoder_backends.hpp)
   std::string description;
   double scenario_duration = 0.0;
 };
@@ -93,7 +95,23 @@ double Rig::scenario_duration() const noexcept {
 
 Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_time) {
   auto impl = std::make_unique<Impl>();
-  if (cfg.encoder.backend != "sim") {
+  const std::string& be = cfg.encoder.backend;
+  const bool hctl_sim = be == "hctl1100" && cfg.hctl1100.bus == "sim";
+  if (be == "gpio" || (be == "hctl1100" && !hctl_sim)) {
+    if (virtual_time)
+      return make_error(Errc::kInvalidArgument,
+                        "--virtual-time needs a simulated encoder "
+                        "backend (encoder.backend = \"" +
+                            be + "\")");
+    auto b = be == "gpio" ? make_gpio_backend(cfg) : make_hctl_gpio_backend(cfg, k);
+    if (!b) return std::move(b).error();
+    impl->backend = std::move(b).value();
+    impl->clock = std::make_unique<drivers::MonotonicClock>();
+    impl->encoder = &impl->backend->encoder();
+    impl->description = impl->backend->describe() + ", real time (CLOCK_MONOTONIC)";
+    return Rig(std::move(impl));
+  }
+  if (be != "sim" && !hctl_sim) {
     return make_error(Errc::kUnsupported, cfg.source + ": encoder.backend = \"" +
                                               cfg.encoder.backend +
                                               "\" is not available in this build yet");
@@ -125,12 +143,20 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     impl->encoder_wrapper = std::make_unique<EpochEncoder>(*impl->sim_encoder, impl->clock->now());
     impl->encoder = impl->encoder_wrapper.get();
   }
+  if (hctl_sim) {
+    const TimeNs epoch = virtual_time ? 0 : impl->clock->now();
+    auto b = make_hctl_sim_backend(cfg, k, *impl->robot, *impl->clock, epoch);
+    if (!b) return std::move(b).error();
+    impl->backend = std::move(b).value();
+    impl->encoder = &impl->backend->encoder();
+  }
   impl->truth = std::make_unique<TruthObserver>(*impl->robot);
   std::ostringstream d;
   d << "simulated robot '" << cfg.sim.robot << "' (true wheelbase " << g.wheelbase * 1e3
     << " mm, D_R/D_L " << g.wheel_diameter_right / g.wheel_diameter_left << "), scenario '"
     << cfg.sim.scenario << "' (" << impl->scenario_duration << " s), " << cfg.sim.counter_bits
-    << "-bit counters, " << (virtual_time ? "virtual time" : "real time (CLOCK_MONOTONIC)");
+    << "-bit counters, " << (hctl_sim ? impl->backend->describe() + ", " : std::string())
+    << (virtual_time ? "virtual time" : "real time (CLOCK_MONOTONIC)");
   impl->description = d.str();
   return Rig(std::move(impl));
 }

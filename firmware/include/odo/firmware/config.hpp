@@ -26,6 +26,46 @@ struct SimSection {
   int counter_bits = 32;                // simulated counter width, 16..64
 };
 
+// [hctl1100]: two HCTL-1100 counter chips on one 8-bit multiplexed bus (AD0..AD7, ALE, /OE,
+// R/W, one /CS per chip). bus = "gpio": the lines on a GPIO chip via libgpiod; bus = "sim": the
+// register model following the simulated robot (same driver, same bus interface).
+struct Hctl1100Section {
+  std::string bus = "gpio";  // gpio | sim
+  std::string chip = "gpiochip0";
+  int ad[8] = {0, 1, 2, 3, 4, 5, 6, 7};  // line offsets of AD0..AD7
+  int ale = 8;
+  int oe = 9;
+  int rw = 10;
+  int cs_left = 11;
+  int cs_right = 12;
+  bool control_active_low = true;  // /CS and /OE are active-low pins
+  double settle = 0.0;             // [s] extra wait after each bus strobe, 0..0.1
+  double max_speed = 3.0;          // [m/s] physical maximum wheel surface speed (jump check)
+  int agree_window = 16;           // [counts] 0..64
+  int max_attempts = 4;            // 2..16
+  bool reverse_left = false;
+  bool reverse_right = false;
+  std::string latch = "none";  // bus = "sim" only: none | lsb (byte-latch model)
+  double bus_cycle = 1e-6;     // bus = "sim" only: [s] duration of one simulated bus cycle
+};
+
+// [gpio]: A/B (and optional index) lines of both wheels, decoded in software.
+struct GpioSection {
+  std::string chip = "gpiochip0";
+  int left_a = 0;
+  int left_b = 1;
+  int left_index = -1;  // -1 = none
+  int right_a = 2;
+  int right_b = 3;
+  int right_index = -1;
+  bool active_low = false;
+  bool reverse_left = false;
+  bool reverse_right = false;
+  int batch = 64;                // events per read, 1..1024
+  double reorder_window = 0.02;  // [s] 0..0.1
+  double idle_check = 0.05;      // [s] 0.01..10
+};
+
 struct EncoderSection {
   std::string backend = "sim";  // sim | hctl1100 | gpio | can
 };
@@ -53,6 +93,8 @@ struct Config {
   SimSection sim;
   RealtimeSection realtime;
   CalibrationSection calibration;
+  Hctl1100Section hctl1100;
+  GpioSection gpio;
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.

@@ -1,0 +1,77 @@
+// GpioQuadratureEncoder: A/B quadrature lines of both wheels on GPIO, decoded in software from
+// libgpiod 1.6 both-edge events. A dedicated thread waits for events, reads them in batches
+// (gpiod_line_event_read_multiple), merges A and B of each wheel by kernel timestamp and feeds
+// a QuadTracker; counts and fault counters reach the loop through atomics (no locks). An
+// optional index line per wheel latches the count at its rising edge. libgpiod types stay in
+// the .cpp.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "odo/hal/encoder.hpp"
+#include "odo/hal/result.hpp"
+#include "odo/hal/time.hpp"
+
+namespace odo::drivers {
+
+struct GpioWheelLines {
+  unsigned a = 0;        // line offset of channel A
+  unsigned b = 0;        // channel B
+  int index = -1;        // index (Z) line offset, -1 = none
+  bool reverse = false;  // negate the count (mirrored motor mounting)
+};
+
+struct GpioQuadratureConfig {
+  std::string chip;  // /dev/gpiochipN, gpiochipN, a chip label or a number
+  GpioWheelLines left;
+  GpioWheelLines right;
+  bool active_low = false;  // the encoder outputs are inverted
+  int batch = 64;           // events read per line and system call, 1..1024
+  // An A/B edge is applied once the other line of its wheel has delivered a younger edge
+  // (exact order while the wheel turns, whatever the kernel's latency), or once it is older
+  // than reorder_window (the other line may not have moved) [ns]. An edge that still arrives
+  // out of order is counted as an invalid transition, never as motion.
+  TimeNs reorder_window = 20'000'000;
+  // With no events for this long the thread compares the tracked levels with the lines and
+  // counts a difference as lost edges [ns].
+  TimeNs idle_check = 50'000'000;
+  std::string consumer = "odometryd";
+};
+
+// Diagnostics of one wheel, read from the atomics.
+struct GpioWheelStats {
+  std::int64_t count = 0;
+  std::uint64_t received = 0;  // A/B events read from the kernel (before merging)
+  std::uint64_t edges = 0;     // A/B edges decoded
+  std::uint64_t invalid = 0;
+  std::uint64_t index_pulses = 0;
+  std::int64_t index_count = 0;  // count at the last index rising edge
+};
+
+class GpioQuadratureEncoder final : public EncoderSource {
+ public:
+  // open: requests the lines and starts the event thread. Errors name chip, line and role.
+  static Result<std::unique_ptr<GpioQuadratureEncoder>> open(const GpioQuadratureConfig& cfg);
+  ~GpioQuadratureEncoder() override;  // stops and joins the thread
+
+  // read: the current cumulative counts (64-bit, never wrap in practice); flags
+  // kEncoderInvalidTransition when invalid transitions were counted since the last read,
+  // kEncoderReadError when the event thread failed.
+  EncoderSample read(TimeNs now) noexcept override;
+  int counter_bits() const noexcept override { return 64; }
+
+  GpioWheelStats wheel(int i) const noexcept;  // 0 left, 1 right
+  // hold: diagnostics/tests: while held the thread reads no events (the kernel queue fills and
+  // overflows as it would under an overloaded CPU).
+  void hold(bool on) noexcept;
+
+ private:
+  struct Impl;
+  explicit GpioQuadratureEncoder(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+  std::uint64_t last_invalid_ = 0;
+};
+
+}  // namespace odo::drivers

@@ -1,0 +1,345 @@
+#include "odo/drivers/gpio_quadrature.hpp"
+
+#include <gpiod.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <ctime>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "gpiod_util.hpp"
+#include "odo/drivers/quad_tracker.hpp"
+
+namespace odo::drivers {
+namespace {
+
+enum class Role : std::uint8_t { kA, kB, kIndex };
+
+struct LineRole {
+  int wheel = 0;
+  Role role = Role::kA;
+};
+
+struct Event {
+  TimeNs ts = 0;
+  std::uint8_t line = 0;  // index into the request bulk
+  bool rising = false;
+  bool done = false;  // consumed as part of an earlier same-timestamp group
+};
+
+TimeNs monotonic_now() noexcept {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return static_cast<TimeNs>(t.tv_sec) * kNsPerSecond + t.tv_nsec;
+}
+
+// The published state of one wheel: written by the event thread, read by the loop.
+struct WheelAtomics {
+  std::atomic<std::int64_t> count{0};
+  std::atomic<std::uint64_t> received{0};
+  std::atomic<std::uint64_t> edges{0};
+  std::atomic<std::uint64_t> invalid{0};
+  std::atomic<std::uint64_t> index_pulses{0};
+  std::atomic<std::int64_t> index_count{0};
+};
+
+}  // namespace
+
+struct GpioQuadratureEncoder::Impl {
+  GpioQuadratureConfig cfg;
+  ChipHandle chip;
+  gpiod_line_bulk bulk{};
+  std::array<LineRole, 6> roles{};
+  unsigned n_lines = 0;
+  std::array<QuadTracker, 2> trackers{};
+  std::array<std::uint64_t, 2> edges{};
+  std::array<std::uint64_t, 2> index_pulses{};
+  std::array<std::int64_t, 2> index_count{};
+  std::array<TimeNs, 2> last_ts{};  // timestamp of the last applied A/B edge per wheel
+  TimeNs seen_ts[2][2] = {};
+  std::uint64_t events_read = 0;  // all events read from the kernel
+  bool suspect = false;           // idle check saw a difference once
+  std::array<QuadState, 2> suspect_levels{};
+  std::uint64_t suspect_events = 0;  // newest received timestamp per wheel and line (A, B)
+  std::array<WheelAtomics, 2> pub;
+  std::atomic<bool> stop{false};
+  std::atomic<bool> held{false};
+  std::atomic<bool> failed{false};
+  std::vector<Event> pending;         // sorted by timestamp after each round
+  std::vector<gpiod_line_event> buf;  // one batch
+  std::thread thread;
+
+  std::int64_t signed_count(int w) const noexcept {
+    const bool rev = w == 0 ? cfg.left.reverse : cfg.right.reverse;
+    return rev ? -trackers[w].count() : trackers[w].count();
+  }
+  void publish() noexcept {
+    for (int w = 0; w < 2; ++w) {
+      pub[w].edges.store(edges[w], std::memory_order_relaxed);
+      pub[w].invalid.store(trackers[w].invalid(), std::memory_order_relaxed);
+      pub[w].index_pulses.store(index_pulses[w], std::memory_order_relaxed);
+      pub[w].index_count.store(index_count[w], std::memory_order_relaxed);
+      pub[w].count.store(signed_count(w), std::memory_order_release);
+    }
+  }
+  bool read_levels(std::array<QuadState, 2>& out) noexcept {
+    int v[6] = {};
+    if (gpiod_line_get_value_bulk(&bulk, v) != 0) return false;
+    out = {0, 0};
+    for (unsigned i = 0; i < n_lines; ++i) {
+      const LineRole r = roles[i];
+      if (r.role == Role::kIndex || v[i] == 0) continue;
+      out[r.wheel] |= r.role == Role::kA ? QuadTracker::kLineA : QuadTracker::kLineB;
+    }
+    return true;
+  }
+  void process(std::size_t n) noexcept;
+  void idle_check() noexcept;
+  void run() noexcept;
+};
+
+void GpioQuadratureEncoder::Impl::process(std::size_t n) noexcept {
+  for (std::size_t i = 0; i < n; ++i) {
+    Event& e = pending[i];
+    if (e.done) continue;
+    const LineRole r = roles[e.line];
+    e.done = true;
+    if (r.role == Role::kIndex) {
+      if (e.rising) {
+        ++index_pulses[r.wheel];
+        index_count[r.wheel] = signed_count(r.wheel);
+      }
+      continue;
+    }
+    // This wheel's A/B events with the same timestamp changed at the same instant: one
+    // transition (both lines changing is the illegal one).
+    std::uint8_t mask = r.role == Role::kA ? QuadTracker::kLineA : QuadTracker::kLineB;
+    std::uint8_t levels = e.rising ? mask : 0;
+    for (std::size_t j = i + 1; j < n && pending[j].ts == e.ts; ++j) {
+      Event& o = pending[j];
+      const LineRole ro = roles[o.line];
+      if (o.done || ro.wheel != r.wheel || ro.role == Role::kIndex) continue;
+      const std::uint8_t bit = ro.role == Role::kA ? QuadTracker::kLineA : QuadTracker::kLineB;
+      if (mask & bit) continue;  // the same line again: its own transition, later
+      mask |= bit;
+      if (o.rising) levels |= bit;
+      o.done = true;
+    }
+    if (e.ts < last_ts[r.wheel]) {
+      // Arrived after a younger edge of the other line was already applied (the kernel's IRQ
+      // thread ran later than the reorder window): report it instead of miscounting.
+      trackers[r.wheel].adopt(mask, levels);
+    } else {
+      trackers[r.wheel].apply(mask, levels);
+      last_ts[r.wheel] = e.ts;
+    }
+    edges[r.wheel] += (mask == 3u) ? 2 : 1;
+  }
+}
+
+void GpioQuadratureEncoder::Impl::idle_check() noexcept {
+  // A difference between the lines and the decoded state counts as lost edges only when it was
+  // seen at two idle checks in a row (idle_check apart) with not one event read in between:
+  // an edge whose event is merely late (the kernel's IRQ thread not yet run) is not a loss.
+  std::array<QuadState, 2> now{};
+  if (!read_levels(now)) return;
+  bool differs = false;
+  for (int w = 0; w < 2; ++w) differs = differs || now[w] != trackers[w].state();
+  if (!differs) {
+    suspect = false;
+    return;
+  }
+  if (suspect && suspect_levels == now && suspect_events == events_read) {
+    for (int w = 0; w < 2; ++w) trackers[w].resync(now[w]);
+    suspect = false;
+    return;
+  }
+  suspect = true;
+  suspect_levels = now;
+  suspect_events = events_read;
+}
+
+void GpioQuadratureEncoder::Impl::run() noexcept {
+  TimeNs last_activity = monotonic_now();
+  while (!stop.load(std::memory_order_relaxed)) {
+    if (held.load(std::memory_order_relaxed)) {
+      sleep_ns(1'000'000);
+      last_activity = monotonic_now();
+      continue;
+    }
+    // Short timeout while events wait for their reorder window; otherwise idle-check period.
+    const TimeNs wait =
+        pending.empty() ? std::min<TimeNs>(cfg.idle_check, 100'000'000) : cfg.reorder_window;
+    timespec to{static_cast<time_t>(wait / kNsPerSecond), static_cast<long>(wait % kNsPerSecond)};
+    gpiod_line_bulk evb;
+    const int r = gpiod_line_event_wait_bulk(&bulk, &to, &evb);
+    if (r < 0) {
+      failed.store(true, std::memory_order_release);
+      return;
+    }
+    const TimeNs t_read = monotonic_now();
+    if (r > 0) {
+      for (unsigned k = 0; k < gpiod_line_bulk_num_lines(&evb); ++k) {
+        gpiod_line* l = gpiod_line_bulk_get_line(&evb, k);
+        unsigned idx = 0;
+        while (idx < n_lines && gpiod_line_bulk_get_line(&bulk, idx) != l) ++idx;
+        const int got =
+            gpiod_line_event_read_multiple(l, buf.data(), static_cast<unsigned>(buf.size()));
+        if (got < 0) {
+          failed.store(true, std::memory_order_release);
+          return;
+        }
+        for (int e = 0; e < got && pending.size() < pending.capacity(); ++e) {
+          const gpiod_line_event& ev = buf[static_cast<std::size_t>(e)];
+          const TimeNs ts = static_cast<TimeNs>(ev.ts.tv_sec) * kNsPerSecond + ev.ts.tv_nsec;
+          ++events_read;
+          if (roles[idx].role != Role::kIndex) {
+            pub[roles[idx].wheel].received.fetch_add(1, std::memory_order_relaxed);
+            seen_ts[roles[idx].wheel][roles[idx].role == Role::kA ? 0 : 1] = ts;
+          }
+          pending.push_back(Event{ts, static_cast<std::uint8_t>(idx),
+                                  ev.event_type == GPIOD_LINE_EVENT_RISING_EDGE, false});
+        }
+      }
+      last_activity = t_read;
+    }
+    if (pending.empty()) {
+      if (r == 0 && t_read - last_activity >= cfg.idle_check) {
+        idle_check();
+        publish();
+        last_activity = monotonic_now();
+      }
+      continue;
+    }
+    // Each line's events arrive in order, so the buffer is nearly sorted: an insertion sort
+    // merges the lines by timestamp in place (stable: equal stamps keep their read order) and,
+    // unlike std::stable_sort, allocates nothing.
+    for (std::size_t k = 1; k < pending.size(); ++k) {
+      const Event e = pending[k];
+      std::size_t m = k;
+      for (; m > 0 && pending[m - 1].ts > e.ts; --m) pending[m] = pending[m - 1];
+      pending[m] = e;
+    }
+    // An A/B edge is ready when the wheel's other line has delivered a younger edge (each
+    // line's queue is in order, so nothing older of that line can still come) or when it is
+    // older than the reorder window (the other line may simply not have moved). While the
+    // wheel turns, A and B alternate, so the order is exact whatever the kernel's latency.
+    // Everything is ready when the buffer is nearly full.
+    const TimeNs cutoff = t_read - cfg.reorder_window;
+    const bool flush = pending.size() * 4 >= pending.capacity() * 3;
+    std::size_t n = 0;
+    while (n < pending.size()) {
+      const Event& e = pending[n];
+      const LineRole role = roles[e.line];
+      const bool other_newer =
+          role.role != Role::kIndex && seen_ts[role.wheel][role.role == Role::kA ? 1 : 0] > e.ts;
+      if (!(flush || other_newer || e.ts <= cutoff)) break;
+      ++n;
+    }
+    if (n == 0) continue;
+    process(n);
+    pending.erase(pending.begin(), pending.begin() + static_cast<std::ptrdiff_t>(n));
+    publish();
+  }
+}
+
+GpioQuadratureEncoder::GpioQuadratureEncoder(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+GpioQuadratureEncoder::~GpioQuadratureEncoder() {
+  impl_->stop.store(true);
+  if (impl_->thread.joinable()) impl_->thread.join();
+}
+
+Result<std::unique_ptr<GpioQuadratureEncoder>> GpioQuadratureEncoder::open(
+    const GpioQuadratureConfig& cfg) {
+  if (cfg.batch < 1 || cfg.batch > 1024)
+    return make_error(Errc::kInvalidArgument, "gpio: batch must be in [1, 1024] events");
+  if (cfg.reorder_window < 0 || cfg.reorder_window > 100'000'000)
+    return make_error(Errc::kInvalidArgument, "gpio: reorder_window must be in [0, 0.1] s");
+  if (cfg.idle_check < 10'000'000 || cfg.idle_check > 10 * kNsPerSecond)
+    return make_error(Errc::kInvalidArgument, "gpio: idle_check must be in [0.01, 10] s");
+  auto impl = std::make_unique<Impl>();
+  impl->cfg = cfg;
+  auto chip = open_chip(cfg.chip);
+  if (!chip) return std::move(chip).error();
+  impl->chip = std::move(chip).value();
+  gpiod_line_bulk_init(&impl->bulk);
+  struct Want {
+    int offset;
+    LineRole role;
+    const char* name;
+  };
+  const Want wants[6] = {{static_cast<int>(cfg.left.a), {0, Role::kA}, "left a"},
+                         {static_cast<int>(cfg.left.b), {0, Role::kB}, "left b"},
+                         {cfg.left.index, {0, Role::kIndex}, "left index"},
+                         {static_cast<int>(cfg.right.a), {1, Role::kA}, "right a"},
+                         {static_cast<int>(cfg.right.b), {1, Role::kB}, "right b"},
+                         {cfg.right.index, {1, Role::kIndex}, "right index"}};
+  std::vector<int> used;
+  for (const Want& w : wants) {
+    if (w.offset < 0) continue;
+    if (std::find(used.begin(), used.end(), w.offset) != used.end())
+      return make_error(Errc::kInvalidArgument, "gpio: line " + std::to_string(w.offset) + " (" +
+                                                    w.name + ") is used twice");
+    used.push_back(w.offset);
+    gpiod_line* l = get_line(impl->chip.get(), static_cast<unsigned>(w.offset));
+    if (l == nullptr) {
+      errno = 0;
+      return line_error(cfg.chip, static_cast<unsigned>(w.offset), w.name);
+    }
+    gpiod_line_bulk_add(&impl->bulk, l);
+    impl->roles[impl->n_lines++] = w.role;
+  }
+  const int flags = cfg.active_low ? GPIOD_LINE_REQUEST_FLAG_ACTIVE_LOW : 0;
+  if (gpiod_line_request_bulk_both_edges_events_flags(&impl->bulk, cfg.consumer.c_str(), flags) !=
+      0)
+    return line_error(cfg.chip, cfg.left.a, "encoder lines");
+  std::array<QuadState, 2> levels{};
+  if (!impl->read_levels(levels))
+    return make_error(Errc::kIo, "GPIO chip '" + cfg.chip + "': cannot read the encoder lines");
+  for (int w = 0; w < 2; ++w) impl->trackers[w].reset(levels[w]);
+  impl->buf.resize(static_cast<std::size_t>(cfg.batch));
+  impl->pending.reserve(8192);
+  Impl* raw = impl.get();
+  impl->thread = std::thread([raw] { raw->run(); });
+  return std::unique_ptr<GpioQuadratureEncoder>(new GpioQuadratureEncoder(std::move(impl)));
+}
+
+EncoderSample GpioQuadratureEncoder::read(TimeNs now) noexcept {
+  EncoderSample s;
+  s.stamp = now;
+  s.left = impl_->pub[0].count.load(std::memory_order_acquire);
+  s.right = impl_->pub[1].count.load(std::memory_order_acquire);
+  const std::uint64_t inv = impl_->pub[0].invalid.load(std::memory_order_relaxed) +
+                            impl_->pub[1].invalid.load(std::memory_order_relaxed);
+  if (inv != last_invalid_) s.flags |= kEncoderInvalidTransition;
+  last_invalid_ = inv;
+  s.counters.invalid_transitions = inv;
+  if (impl_->failed.load(std::memory_order_acquire)) {
+    s.flags |= kEncoderReadError;
+    s.counters.read_errors = 1;
+  }
+  return s;
+}
+
+GpioWheelStats GpioQuadratureEncoder::wheel(int i) const noexcept {
+  const WheelAtomics& a = impl_->pub[i == 0 ? 0 : 1];
+  GpioWheelStats s;
+  s.count = a.count.load(std::memory_order_acquire);
+  s.received = a.received.load(std::memory_order_relaxed);
+  s.edges = a.edges.load(std::memory_order_relaxed);
+  s.invalid = a.invalid.load(std::memory_order_relaxed);
+  s.index_pulses = a.index_pulses.load(std::memory_order_relaxed);
+  s.index_count = a.index_count.load(std::memory_order_relaxed);
+  return s;
+}
+
+void GpioQuadratureEncoder::hold(bool on) noexcept {
+  impl_->held.store(on, std::memory_order_relaxed);
+}
+
+}  // namespace odo::drivers

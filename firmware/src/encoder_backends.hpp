@@ -1,0 +1,46 @@
+// Wiring of the hardware encoder backends of issue 5: the HCTL-1100 pair (over the libgpiod bus
+// or over the register model that follows the simulated robot) and GPIO quadrature. Rig owns
+// the returned object; the loop sees only its EncoderSource.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "odo/firmware/config.hpp"
+#include "odo/hal/clock.hpp"
+#include "odo/hal/encoder.hpp"
+#include "odo/hal/result.hpp"
+#include "odo/odometry/kinematics.hpp"
+
+namespace odo::sim {
+class SimRobot;
+}
+
+namespace odo::fw {
+
+class EncoderBackend {
+ public:
+  virtual ~EncoderBackend() = default;
+  virtual EncoderSource& encoder() noexcept = 0;
+  // describe: one line for the start-up report.
+  virtual const std::string& describe() const noexcept = 0;
+};
+
+// max_counts_per_s: the jump limit of [hctl1100].max_speed [m/s] in counts/s of this robot.
+double max_counts_per_s(const Hctl1100Section& s, const KinematicParams& p);
+
+// make_gpio_backend: [gpio] lines via libgpiod; errors name the config file and the line.
+Result<std::unique_ptr<EncoderBackend>> make_gpio_backend(const Config& cfg);
+
+// make_hctl_gpio_backend: [hctl1100] with bus = "gpio".
+Result<std::unique_ptr<EncoderBackend>> make_hctl_gpio_backend(const Config& cfg,
+                                                               const Kinematics& k);
+
+// make_hctl_sim_backend: [hctl1100] with bus = "sim": two register models that follow `robot`
+// at the time of `clock` minus `epoch`, on a simulated bus, read by the real driver.
+Result<std::unique_ptr<EncoderBackend>> make_hctl_sim_backend(const Config& cfg,
+                                                              const Kinematics& k,
+                                                              sim::SimRobot& robot, Clock& clock,
+                                                              TimeNs epoch);
+
+}  // namespace odo::fw
