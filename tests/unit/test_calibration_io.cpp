@@ -7,6 +7,7 @@
 #include "odo/calibration/store.hpp"
 #include "odo/firmware/calibration_io.hpp"
 #include "odo/firmware/calibration_reload.hpp"
+#include "odo/firmware/config.hpp"
 
 namespace odo::fw {
 namespace {
@@ -162,6 +163,34 @@ TEST(CalibrationHandover, AppliedOnTheLoopThreadBetweenTicks) {
   EXPECT_FALSE(h.offer(*k, 1, stop));  // previous offer not yet taken, and stopping
   h.on_tick(snap);
   EXPECT_EQ(snap.calibration_state, 2);
+}
+
+}  // namespace
+}  // namespace odo::fw
+
+namespace odo::fw {
+namespace {
+
+TEST(CalibrationConfig, SectionKeysAndErrors) {
+  auto c = parse_config("[calibration]\nstore = \"/dev/mtd3\"\nbackend = \"mtd\"\n", "t.toml");
+  ASSERT_TRUE(c) << c.error().message;
+  EXPECT_EQ(c->calibration.store, "/dev/mtd3");
+  EXPECT_EQ(c->calibration.backend, "mtd");
+  EXPECT_EQ(default_config().calibration.store, kDefaultCalibrationStore);
+  auto bad = parse_config("[calibration]\nbackend = \"eeprom\"\n", "t.toml");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("backend"), std::string::npos);
+  EXPECT_FALSE(parse_config("[calibration]\nstroe = \"x\"\n", "t.toml"));
+}
+
+TEST(CalibrationConfig, NoStoreConfiguredMeansNominal) {
+  KinematicParams p;
+  p.wheel_diameter = 0.15;
+  p.counts_per_rev = 2048;
+  p.wheelbase_nominal = p.wheelbase = 0.34;
+  AppliedCalibration a = read_and_apply(p, "", "auto");
+  EXPECT_EQ(a.state, 0);
+  EXPECT_NE(a.report.find("no store configured"), std::string::npos);
 }
 
 }  // namespace
