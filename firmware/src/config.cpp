@@ -53,6 +53,12 @@ void read_sim(TableReader t, SimSection& s) {
   t.finish();
 }
 
+void read_error_model(TableReader t, ErrorModelParams& k) {
+  k.k_left = t.number("k_left", k.k_left, 0.0, kErrorModelKMax, "m^(1/2)");
+  k.k_right = t.number("k_right", k.k_right, 0.0, kErrorModelKMax, "m^(1/2)");
+  t.finish();
+}
+
 }  // namespace
 
 Result<Config> parse_config(std::string_view text, std::string_view source) {
@@ -73,6 +79,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_robot(root.sub("robot"), c.robot);
   read_encoder(root.sub("encoder"), c.encoder);
   read_sim(root.sub("sim"), c.sim);
+  read_error_model(root.sub("error_model"), c.error_model);
   root.finish();
   if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
   return c;

@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "odo/hal/result.hpp"
+#include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
 
 namespace odo::fw {
@@ -36,6 +37,7 @@ struct Config {
   KinematicParams robot;  // nominal robot; c_l, c_r, wheelbase may be replaced by calibration
   EncoderSection encoder;
   SimSection sim;
+  ErrorModelParams error_model;  // [error_model]: Chong-Kleeman k_L, k_R [m^(1/2)]
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.
