@@ -12,5 +12,7 @@ inline constexpr int kExitBadInput = 2;
 
 // add_replay: `odomctl replay` (integrate a log of raw counts).
 void add_replay(CLI::App& app, int& exit_code);
+// add_errormodel: `odomctl errormodel validate|fit` (Chong-Kleeman error model).
+void add_errormodel(CLI::App& app, int& exit_code);
 
 }  // namespace odo::ctl
