@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "../unit/loglog_slope.hpp"
 #include "odo/firmware/error_model_tools.hpp"
 #include "odo/sim/wheel_noise.hpp"
 #include "sim_fixture.hpp"
@@ -100,19 +101,6 @@ class ErrorAt final : public fw::TickObserver {
   std::vector<std::uint64_t> ticks_;
   std::size_t next_ = 0;
 };
-
-double loglog_slope(const std::vector<double>& d, const std::vector<double>& v) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double n = static_cast<double>(d.size());
-  for (std::size_t i = 0; i < d.size(); ++i) {
-    const double x = std::log(d[i]), y = std::log(v[i]);
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    sxy += x * y;
-  }
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
 
 TEST(ErrorMonteCarlo, StraightLineLateralCubicAlongTrackLinear) {
   // 0.5 m/s at 100 Hz: 5 mm per tick, so distance d is reached at tick 200 d (+1 for the first

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <vector>
 
+#include "loglog_slope.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/pose.hpp"
 
@@ -304,20 +305,6 @@ TEST(ErrorModel, FiniteAndPositiveSemidefiniteEverywhere) {
   for (double v : p) EXPECT_EQ(v, 0.0);
 }
 
-// slope: least-squares slope of log(v) against log(d).
-double loglog_slope(const std::vector<double>& d, const std::vector<double>& v) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  const double n = static_cast<double>(d.size());
-  for (std::size_t i = 0; i < d.size(); ++i) {
-    const double x = std::log(d[i]), y = std::log(v[i]);
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    sxy += x * y;
-  }
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
-
 TEST(ErrorModel, StraightLineLateralCubicAlongTrackLinear) {
   // Integrated tick by tick (1 mm ticks) as the loop does: lateral variance ~ D^3, along-track
   // ~ D (Sec. 4.1). Fitted log-log slopes over 0.5 .. 16 m must be within 2% of 3 and 1.
@@ -334,8 +321,8 @@ TEST(ErrorModel, StraightLineLateralCubicAlongTrackLinear) {
     along.push_back(p[XX]);
     lateral.push_back(p[YY]);
   }
-  EXPECT_NEAR(loglog_slope(dist, lateral), 3.0, 0.02 * 3.0);
-  EXPECT_NEAR(loglog_slope(dist, along), 1.0, 0.02 * 1.0);
+  EXPECT_NEAR(test::loglog_slope(dist, lateral), 3.0, 0.02 * 3.0);
+  EXPECT_NEAR(test::loglog_slope(dist, along), 1.0, 0.02 * 1.0);
 }
 
 TEST(ErrorModel, ParameterRanges) {
