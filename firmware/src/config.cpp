@@ -109,6 +109,12 @@ void read_gpio(TableReader t, GpioSection& s) {
   t.finish();
 }
 
+void read_error_model(TableReader t, ErrorModelParams& k) {
+  k.k_left = t.number("k_left", k.k_left, 0.0, kErrorModelKMax, "m^(1/2)");
+  k.k_right = t.number("k_right", k.k_right, 0.0, kErrorModelKMax, "m^(1/2)");
+  t.finish();
+}
+
 }  // namespace
 
 Result<Config> parse_config(std::string_view text, std::string_view source) {
@@ -133,6 +139,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_calibration(root.sub("calibration"), c.calibration);
   read_hctl1100(root.sub("hctl1100"), c.hctl1100);
   read_gpio(root.sub("gpio"), c.gpio);
+  read_error_model(root.sub("error_model"), c.error_model);
   root.finish();
   if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
   return c;

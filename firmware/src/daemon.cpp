@@ -104,6 +104,7 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
   }
   LoopConfig lc;
   lc.rate_hz = cfg->loop.rate_hz;
+  lc.error_model = cfg->error_model;
   auto created = OdometryLoop::create(lc, *calibrated, rig->encoder(), rig->clock());
   if (!created) {
     err << "odometryd: " << cfg->source << ": " << created.error().message << "\n";

@@ -16,12 +16,21 @@ Result<std::unique_ptr<OdometryLoop>> OdometryLoop::create(const LoopConfig& cfg
     return make_error(Errc::kInvalidArgument, m.str());
   }
   if (auto s = check_counter_bits(encoder.counter_bits()); !s) return std::move(s).error();
+  if (auto s = check_error_model(cfg.error_model); !s) {
+    return make_error(Errc::kInvalidArgument, "error_model." + s.error().message);
+  }
   const auto period = static_cast<TimeNs>(std::llround(1e9 / cfg.rate_hz));
-  return std::unique_ptr<OdometryLoop>(new OdometryLoop(period, k, encoder, clock));
+  return std::unique_ptr<OdometryLoop>(new OdometryLoop(period, cfg, k, encoder, clock));
 }
 
-OdometryLoop::OdometryLoop(TimeNs period, const Kinematics& k, EncoderSource& enc, Clock& clock)
-    : period_(period), odom_(k), enc_(&enc), clock_(&clock), bits_(enc.counter_bits()) {}
+OdometryLoop::OdometryLoop(TimeNs period, const LoopConfig& cfg, const Kinematics& k,
+                           EncoderSource& enc, Clock& clock)
+    : period_(period),
+      odom_(k),
+      cov_(cfg.error_model),
+      enc_(&enc),
+      clock_(&clock),
+      bits_(enc.counter_bits()) {}
 
 bool OdometryLoop::add_observer(TickObserver* o) noexcept {
   if (n_observers_ >= kMaxObservers) return false;
@@ -66,6 +75,7 @@ void OdometryLoop::tick() noexcept {
     std::atomic_thread_fence(std::memory_order_acquire);
     if (pose_req_seq_.load(std::memory_order_relaxed) == seq) {
       odom_.reset(p);
+      cov_.reset();
       pose_req_seen_ = seq;
     }
   }
@@ -75,7 +85,9 @@ void OdometryLoop::tick() noexcept {
     // Counts are cumulative, so a late tick simply integrates a longer interval: nothing is lost.
     const std::int64_t dl = wrap_delta(prev_left_, s.left, bits_);
     const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
+    const double theta0 = odom_.pose().theta;
     odom_.update(dl, dr, to_seconds(s.stamp - prev_stamp_));
+    cov_.step(theta0, odom_.last_d_left(), odom_.last_d_right(), odom_.kinematics().wheelbase());
     prev_left_ = s.left;
     prev_right_ = s.right;
     prev_stamp_ = s.stamp;
@@ -93,6 +105,8 @@ void OdometryLoop::tick() noexcept {
   snap_.v = odom_.linear_velocity();
   snap_.w = odom_.angular_velocity();
   snap_.distance = odom_.distance();
+  snap_.cov = cov_.cov();
+  snap_.has_cov = true;
   snap_.encoder_flags = s.flags;
   snap_.encoder_counters = s.counters;
   for (std::size_t i = 0; i < n_observers_; ++i) observers_[i]->on_tick(snap_);

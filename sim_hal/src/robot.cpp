@@ -90,9 +90,11 @@ void SimRobot::move(double dt, const Segment& seg) noexcept {
   const double da_r = seg.omega_right * dt;
   angle_l_ += da_l;
   angle_r_ += da_r;
+  double d_l = da_l * g_.wheel_diameter_left / 2.0;
+  double d_r = da_r * g_.wheel_diameter_right / 2.0;
+  if (perturbation_ != nullptr) perturbation_->perturb(d_l, d_r);
   // Constant wheel speeds give a constant-curvature arc: the exact arc step is the truth.
-  pose_ = arc_step(pose_, da_l * g_.wheel_diameter_left / 2.0, da_r * g_.wheel_diameter_right / 2.0,
-                   g_.wheelbase);
+  pose_ = arc_step(pose_, d_l, d_r, g_.wheelbase);
 }
 
 void SimRobot::advance_to(TimeNs t) noexcept {

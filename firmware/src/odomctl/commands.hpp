@@ -14,5 +14,7 @@ inline constexpr int kExitBadInput = 2;
 void add_replay(CLI::App& app, int& exit_code);
 // add_calib: `odomctl calib show|set|import|export|reset` (the calibration store).
 void add_calib(CLI::App& app, int& exit_code);
+// add_errormodel: `odomctl errormodel validate|fit` (Chong-Kleeman error model).
+void add_errormodel(CLI::App& app, int& exit_code);
 
 }  // namespace odo::ctl

@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "odo/hal/result.hpp"
+#include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
 
 namespace odo::fw {
@@ -95,6 +96,7 @@ struct Config {
   CalibrationSection calibration;
   Hctl1100Section hctl1100;
   GpioSection gpio;
+  ErrorModelParams error_model;  // [error_model]: Chong-Kleeman k_L, k_R [m^(1/2)]
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.

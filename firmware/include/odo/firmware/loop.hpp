@@ -13,6 +13,7 @@
 #include "odo/hal/clock.hpp"
 #include "odo/hal/encoder.hpp"
 #include "odo/hal/result.hpp"
+#include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
 #include "odo/odometry/pose.hpp"
 
@@ -60,12 +61,13 @@ class TickObserver {
 };
 
 struct LoopConfig {
-  double rate_hz = 100.0;  // [Hz], 50..2000
+  double rate_hz = 100.0;        // [Hz], 50..2000
+  ErrorModelParams error_model;  // Chong-Kleeman k_L, k_R for the pose covariance
 };
 
 class OdometryLoop {
  public:
-  static constexpr std::size_t kMaxObservers = 4;
+  static constexpr std::size_t kMaxObservers = 8;
   static constexpr std::uint64_t kSummaryTicks = 256;  // power of two
 
   // create: validates the rate and the encoder's counter width (heap-allocated once, at
@@ -83,7 +85,8 @@ class OdometryLoop {
   // limit). Calls start() first.
   void run(TimeNs duration, const std::atomic<bool>& stop) noexcept;
 
-  // request_pose: thread-safe; the pose is replaced at the start of the next tick.
+  // request_pose: thread-safe; the pose is replaced at the start of the next tick and its
+  // covariance reset to zero (a set pose is taken as exact).
   void request_pose(const Pose2& p) noexcept;
   // set_kinematics: swap calibration between ticks (same thread as tick()).
   void set_kinematics(const Kinematics& k) noexcept { odom_.set_kinematics(k); }
@@ -101,10 +104,12 @@ class OdometryLoop {
   TripleBuffer<LoopSnapshot>& snapshots() noexcept { return published_; }
 
  private:
-  OdometryLoop(TimeNs period, const Kinematics& k, EncoderSource& enc, Clock& clock);
+  OdometryLoop(TimeNs period, const LoopConfig& cfg, const Kinematics& k, EncoderSource& enc,
+               Clock& clock);
 
   TimeNs period_;
   Odometry odom_;
+  PoseCovariance cov_;
   EncoderSource* enc_;
   Clock* clock_;
   int bits_;

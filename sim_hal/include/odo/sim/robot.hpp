@@ -40,6 +40,15 @@ KinematicParams nominal_params(double wheel_diameter, double wheelbase, const Ro
 
 enum class Turn { kClockwise, kCounterClockwise };
 
+// TravelPerturbation: changes what the wheels really travel over the ground during one simulation
+// step (slip, non-systematic noise); the encoders still count the wheel rotation.
+class TravelPerturbation {
+ public:
+  virtual ~TravelPerturbation() = default;
+  // perturb: d_left, d_right [m] are the ground travels of this step; change them in place.
+  virtual void perturb(double& d_left, double& d_right) noexcept = 0;
+};
+
 // SquareOptions: the UMBmark square path.
 struct SquareOptions {
   double side = 4.0;       // leg length [m]
@@ -81,6 +90,8 @@ class SimRobot {
   bool finished() const noexcept { return seg_ >= scenario_.size(); }
   const RobotGeometry& geometry() const noexcept { return g_; }
   const Scenario& scenario() const noexcept { return scenario_; }
+  // set_travel_perturbation: applied to every step's ground travel (not owned; null = none).
+  void set_travel_perturbation(TravelPerturbation* p) noexcept { perturbation_ = p; }
 
  private:
   SimRobot(const RobotGeometry& g, Scenario s, const Pose2& start);
@@ -95,6 +106,7 @@ class SimRobot {
   double angle_l_ = 0.0;
   double angle_r_ = 0.0;
   double counts_per_wheel_rad_ = 0.0;
+  TravelPerturbation* perturbation_ = nullptr;
 };
 
 }  // namespace odo::sim

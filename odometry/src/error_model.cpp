@@ -1,0 +1,231 @@
+#include "odo/odometry/error_model.hpp"
+
+#include <Eigen/Core>
+#include <cmath>
+#include <sstream>
+
+// Derivation (Chong & Kleeman Sec. 4; our own notation, checked against brute-force per-step
+// Jacobian propagation in tests/unit/test_error_model.cpp).
+//
+// Take one arc in the frame of its start pose: heading theta(u) = phi u, centre travel D u for
+// the arc parameter u in [0, 1], with D = (d_L + d_R) / 2 and phi = (d_R - d_L) / b. Cut it into
+// k pieces of du (Eq. 15). A piece's wheel noise dL, dR (variances k_L^2 |d_L| du, k_R^2 |d_R| du,
+// Eq. 4) moves the pose by G = [c/2, c/2; s/2, s/2; -1/b, 1/b] (c, s = cos, sin of phi u); the
+// state Jacobians of all later pieces multiply to [1 0 -Y; 0 1 X; 0 0 1], where (X, Y) is the
+// displacement still to come, X = D X^(u) = D int_u^1 cos(phi t) dt, Y = D Y^(u) = D int_u^1 sin.
+// So the left wheel's noise reaches the end of the arc through a_L = p + q and the right one's
+// through a_R = p - q, with p = (c/2, s/2, 0) and q = (Y/b, -X/b, -1/b). For k -> infinity the sum
+// of Eq. 16 becomes an integral:
+//   Cov(U) = int_0^1 (w_L a_L a_L^T + w_R a_R a_R^T) du
+//          = W+ int (p p^T + q q^T) du + W- int (p q^T + q p^T) du,
+//   w_L = k_L^2 |d_L|, w_R = k_R^2 |d_R|, W+ = w_L + w_R, W- = w_L - w_R.
+// With a = D / b, entry by entry:
+//   xx = W+ (I_cc/4 + a^2 J_yy) + W- a J_cy          yy = W+ (I_ss/4 + a^2 J_xx) - W- a J_sx
+//   xy = W+ (I_cs/4 - a^2 J_xy) + W- a (J_sy - J_cx)/2
+//   tt = W+ / b^2     xt = -(W+ a J_y + W- I_c/2) / b     yt = (W+ a J_x - W- I_s/2) / b
+// where I_f = int_0^1 f du and J_f = int_0^1 f du with X^, Y^ in place of X, Y. This is the
+// quantity of Eq. 17; we derive it ourselves because the seed text of Eq. 17/18 lost factors in
+// conversion (its Cov_33 = c3/B^2 is not even dimensionless), and we write it with D and phi
+// instead of r = D/phi and (L - R) denominators, so the straight-line (phi -> 0) and on-the-spot
+// (D -> 0) limits need no division by zero:
+//   straight line: xx = W+/4, yy = W+ D^2/(3 b^2), xy = -W- D/(4b), xt = -W-/(2b),
+//                  yt = W+ D/(2 b^2), tt = W+/b^2 (along-track ~ D, lateral ~ D^3);
+//   on the spot:   xx = W+ I_cc/4, yy = W+ I_ss/4, xy = W+ I_cs/4, xt = -W- I_c/(2b),
+//                  yt = -W- I_s/(2b), tt = W+/b^2.
+// Closed forms (S, C = sin, cos of phi; h = (1 - C)/phi^2):
+//   I_c = S/phi, I_s = phi h, I_ss = (phi - S C)/(2 phi), I_cc = 1 - I_ss, I_cs = S^2/(2 phi),
+//   J_x = I_c - h, J_y = (S - phi C)/phi^2, J_xx = (S^2 - 2 S I_s + I_ss)/phi^2,
+//   J_yy = (1/2 + C^2 - 3 S C/(2 phi))/phi^2, J_xy = (S^2/(2 phi) - S C + C (1 - C)/phi)/phi^2,
+//   J_cx = I_c^2/2, J_cy = I_ss/phi, J_sy = I_s^2/2, J_sx = I_c I_s - J_cy.
+// Several of them cancel catastrophically as phi -> 0 (J_yy ~ 2 phi^2/15 out of O(1) terms), so
+// below |phi| = 1 the seven basic functions are evaluated from their Taylor series instead.
+
+namespace odo {
+namespace {
+
+using Mat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+
+// Series/closed-form switch. At |phi| = 1 the closed forms lose at most ~2e-15 (relative) and the
+// series below are truncated where the next term is < 1e-18 of the first.
+constexpr double kSeriesLimit = 1.0;
+
+// Taylor coefficients in z = phi^2 of the seven basic functions, from term-by-term integration of
+// the integrands' series (tools/gen_error_model_series.py prints them).
+constexpr double kSinc[] = {1.0,
+                            -0.16666666666666666,
+                            0.008333333333333333,
+                            -0.0001984126984126984,
+                            2.7557319223985893e-06,
+                            -2.505210838544172e-08,
+                            1.6059043836821613e-10,
+                            -7.647163731819816e-13,
+                            2.8114572543455206e-15,
+                            -8.22063524662433e-18,
+                            1.9572941063391263e-20};
+// h = (1 - cos phi)/phi^2
+constexpr double kH[] = {0.5,
+                         -0.041666666666666664,
+                         0.001388888888888889,
+                         -2.48015873015873e-05,
+                         2.755731922398589e-07,
+                         -2.08767569878681e-09,
+                         1.1470745597729725e-11,
+                         -4.779477332387385e-14,
+                         1.5619206968586225e-16,
+                         -4.110317623312165e-19};
+// g1 = I_ss / phi^2
+constexpr double kG1[] = {0.3333333333333333,      -0.06666666666666667,   0.006349206349206349,
+                          -0.0003527336860670194,  1.282667949334616e-05,  -3.2888921777810664e-07,
+                          6.264556529106794e-09,   -9.212583131039402e-11, 1.0774951030455441e-12,
+                          -1.0261858124243278e-14, 8.11214080967848e-17,   -5.408093873118987e-19,
+                          3.081534970438169e-21};
+// g2 = J_y / phi
+constexpr double kG2[] = {0.3333333333333333,      -0.03333333333333333,   0.0011904761904761906,
+                          -2.2045855379188714e-05, 2.505210838544172e-07,  -1.9270852604185937e-09,
+                          1.0706029224547743e-11,  -4.498331606952833e-14, 1.4797143443923793e-16,
+                          -3.9145882126782523e-19, 8.509974375387505e-22};
+// g3 = J_xx
+constexpr double kG3[] = {0.3333333333333333,     -0.15,
+                          0.025793650793650792,   -0.0021219135802469135,
+                          0.00010266354016354016, -3.289213358657803e-06,
+                          7.517620778202789e-08,  -1.289767261260025e-09,
+                          1.72399380899992e-11,   -1.8471348538226112e-13,
+                          1.6224282392990994e-15, -1.1897806649800776e-17,
+                          7.395683947418985e-20};
+// g4 = J_yy / phi^2
+constexpr double kG4[] = {0.13333333333333333,     -0.025396825396825397,   0.0021164021164021165,
+                          -0.00010261343594676929, 3.2888921777810667e-06,  -7.517467834928152e-08,
+                          1.2897616383455163e-09,  -1.7239921648728706e-11, 1.84713446236379e-13,
+                          -1.622428161935696e-15,  1.1897806520861771e-17,  -7.395683929051606e-20};
+// g5 = J_xy / phi
+constexpr double kG5[] = {0.20833333333333334,    -0.06805555555555555,    0.007961309523809523,
+                          -0.000494102733686067,  1.9242106915718025e-05,  -5.168373843969083e-07,
+                          1.0179952154571863e-08, -1.5354320837605974e-10, 1.8317420862091875e-12,
+                          -1.772502855882662e-14, 1.4196246578111098e-16,  -9.568166108006477e-19,
+                          5.502741021919477e-21};
+
+template <std::size_t N>
+inline double horner(const double (&c)[N], double z) noexcept {
+  double r = c[N - 1];
+  for (std::size_t i = N - 1; i-- > 0;) r = r * z + c[i];
+  return r;
+}
+
+}  // namespace
+
+Status check_error_model(const ErrorModelParams& k) {
+  auto check = [](const char* field, double v) -> Status {
+    if (std::isfinite(v) && v >= 0.0 && v <= kErrorModelKMax) return Ok{};
+    std::ostringstream m;
+    m << field << " = " << v << " m^(1/2) is outside the allowed range [0, " << kErrorModelKMax
+      << "] m^(1/2)";
+    return make_error(Errc::kInvalidArgument, m.str());
+  };
+  if (auto s = check("k_left", k.k_left); !s) return s;
+  return check("k_right", k.k_right);
+}
+
+ArcTerms arc_terms(double phi) noexcept {
+  const double z = phi * phi;
+  double sinc, h, g1, g2, g3, g4, g5;
+  if (std::fabs(phi) < kSeriesLimit) {
+    sinc = horner(kSinc, z);
+    h = horner(kH, z);
+    g1 = horner(kG1, z);
+    g2 = horner(kG2, z);
+    g3 = horner(kG3, z);
+    g4 = horner(kG4, z);
+    g5 = horner(kG5, z);
+  } else {
+    const double s = std::sin(phi), c = std::cos(phi);
+    const double inv = 1.0 / phi, inv2 = inv * inv;
+    sinc = s * inv;
+    h = (1.0 - c) * inv2;
+    const double i_ss = 0.5 * (phi - s * c) * inv;
+    g1 = i_ss * inv2;
+    g2 = (s - phi * c) * inv2 * inv;
+    g3 = (s * s - 2.0 * s * (1.0 - c) * inv + i_ss) * inv2;
+    g4 = (0.5 + c * c - 1.5 * s * c * inv) * inv2 * inv2;
+    g5 = (0.5 * s * s * inv - s * c + c * (1.0 - c) * inv) * inv2 * inv;
+  }
+  ArcTerms t;
+  t.i_c = sinc;
+  t.i_s = phi * h;
+  t.i_ss = z * g1;
+  t.i_cc = 1.0 - t.i_ss;
+  t.i_cs = 0.5 * phi * sinc * sinc;
+  t.j_x = sinc - h;
+  t.j_y = phi * g2;
+  t.j_xx = g3;
+  t.j_yy = z * g4;
+  t.j_xy = phi * g5;
+  t.j_cx = 0.5 * sinc * sinc;
+  t.j_cy = phi * g1;
+  t.j_sy = 0.5 * t.i_s * t.i_s;
+  t.j_sx = t.i_c * t.i_s - t.j_cy;
+  return t;
+}
+
+namespace {
+
+// local_input_covariance: Cov(U) in the arc's start frame plus the arc's displacement there.
+inline Mat3 local_input_covariance(double d_left, double d_right, double b,
+                                   const ErrorModelParams& k, const ArcTerms& t) noexcept {
+  const double w_l = k.k_left * k.k_left * std::fabs(d_left);
+  const double w_r = k.k_right * k.k_right * std::fabs(d_right);
+  const double wp = w_l + w_r, wm = w_l - w_r;
+  const double a = 0.5 * (d_left + d_right) / b;
+  const double inv_b = 1.0 / b;
+  Mat3 q;
+  q(0, 0) = wp * (0.25 * t.i_cc + a * a * t.j_yy) + wm * a * t.j_cy;
+  q(1, 1) = wp * (0.25 * t.i_ss + a * a * t.j_xx) - wm * a * t.j_sx;
+  q(0, 1) = q(1, 0) = wp * (0.25 * t.i_cs - a * a * t.j_xy) + 0.5 * wm * a * (t.j_sy - t.j_cx);
+  q(2, 2) = wp * inv_b * inv_b;
+  q(0, 2) = q(2, 0) = -(wp * a * t.j_y + 0.5 * wm * t.i_c) * inv_b;
+  q(1, 2) = q(2, 1) = (wp * a * t.j_x - 0.5 * wm * t.i_s) * inv_b;
+  return q;
+}
+
+}  // namespace
+
+Cov3 arc_input_covariance(double d_left, double d_right, double b,
+                          const ErrorModelParams& k) noexcept {
+  Cov3 out{};
+  if (!(std::isfinite(d_left) && std::isfinite(d_right) && b > 0.0 && std::isfinite(b))) {
+    return out;
+  }
+  const ArcTerms t = arc_terms((d_right - d_left) / b);
+  Eigen::Map<Mat3>(out.data()) = local_input_covariance(d_left, d_right, b, k, t);
+  return out;
+}
+
+void propagate_arc(Cov3& cov, double theta0, double d_left, double d_right, double b,
+                   const ErrorModelParams& k) noexcept {
+  // A non-finite travel or wheelbase would poison the covariance for good; such a tick (which the
+  // loop never produces) adds nothing.
+  if (!(std::isfinite(d_left) && std::isfinite(d_right) && b > 0.0 && std::isfinite(b) &&
+        std::isfinite(theta0))) {
+    return;
+  }
+  const ArcTerms t = arc_terms((d_right - d_left) / b);
+  const Mat3 q = local_input_covariance(d_left, d_right, b, k, t);
+  const double s0 = std::sin(theta0), c0 = std::cos(theta0);
+  // Displacement of the arc: D (I_c, I_s) in the start frame, rotated by theta0.
+  const double d = 0.5 * (d_left + d_right);
+  const double lx = d * t.i_c, ly = d * t.i_s;
+  const double dx = c0 * lx - s0 * ly, dy = s0 * lx + c0 * ly;
+  Mat3 f = Mat3::Identity();
+  f(0, 2) = -dy;  // Eq. 16: x depends on the start heading through -dy ...
+  f(1, 2) = dx;   // ... and y through +dx
+  Mat3 rot = Mat3::Identity();
+  rot(0, 0) = c0;
+  rot(0, 1) = -s0;
+  rot(1, 0) = s0;
+  rot(1, 1) = c0;
+  Eigen::Map<Mat3> p(cov.data());
+  const Mat3 next = f * p * f.transpose() + rot * q * rot.transpose();
+  // Keep the result exactly symmetric so round-off cannot accumulate into asymmetry.
+  p = 0.5 * (next + next.transpose());
+}
+
+}  // namespace odo

@@ -1,0 +1,348 @@
+// Chong-Kleeman error model: hand-derived values, consistency, brute-force agreement, stability.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "loglog_slope.hpp"
+#include "odo/odometry/error_model.hpp"
+#include "odo/odometry/pose.hpp"
+
+namespace odo {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kL = 0.00040, kR = 0.00058;  // the paper's fitted values [m^(1/2)]
+constexpr double kB = 0.34;                   // LabMate wheelbase [m]
+const ErrorModelParams kParams{kL, kR};
+
+enum { XX = 0, XY = 1, XT = 2, YY = 4, YT = 5, TT = 8 };
+
+// expect_cov_near: every entry within rel * sqrt(P_ii P_jj) (for the diagonal: rel * P_ii), i.e.
+// relative to the scale of the entry's correlation, so exactly-zero entries are handled.
+void expect_cov_near(const Cov3& a, const Cov3& b, double rel, const char* what) {
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double scale = std::sqrt(std::fabs(b[4 * i]) * std::fabs(b[4 * j]));
+      EXPECT_LE(std::fabs(a[3 * i + j] - b[3 * i + j]), rel * scale + 1e-300)
+          << what << ": entry (" << i << "," << j << ") " << a[3 * i + j] << " vs " << b[3 * i + j];
+    }
+  }
+}
+
+TEST(ErrorModel, StraightLineHandValues) {
+  // d_L = d_R = D = 10 m, b = 0.34 m. w_L = k_L^2 D = 1.6e-7 * 10 = 1.6e-6 m^2,
+  // w_R = k_R^2 D = 3.364e-7 * 10 = 3.364e-6 m^2, W+ = 4.964e-6, W- = -1.764e-6.
+  // Straight-line limit (derivation in error_model.cpp):
+  //   xx = W+/4 = 1.241e-6                     yy = W+ D^2/(3 b^2) = 4.964e-4/0.3468
+  //   xy = -W- D/(4b) = 1.764e-5/1.36          xt = -W-/(2b) = 1.764e-6/0.68
+  //   yt = W+ D/(2 b^2) = 4.964e-5/0.2312      tt = W+/b^2 = 4.964e-6/0.1156
+  Cov3 p{};
+  propagate_arc(p, 0.0, 10.0, 10.0, kB, kParams);
+  EXPECT_NEAR(p[XX], 1.241e-6, 1e-20);
+  EXPECT_NEAR(p[YY], 4.964e-4 / 0.3468, 1e-17);
+  EXPECT_NEAR(p[XY], 1.764e-5 / 1.36, 1e-18);
+  EXPECT_NEAR(p[XT], 1.764e-6 / 0.68, 1e-19);
+  EXPECT_NEAR(p[YT], 4.964e-5 / 0.2312, 1e-17);
+  EXPECT_NEAR(p[TT], 4.964e-6 / 0.1156, 1e-18);
+  EXPECT_EQ(p[1], p[3]);
+  EXPECT_EQ(p[2], p[6]);
+  EXPECT_EQ(p[5], p[7]);
+}
+
+TEST(ErrorModel, StraightLineRotatedByHeading) {
+  // The same 10 m along heading 90 deg: x and y swap roles (R = [0 -1; 1 0]):
+  //   xx' = yy, yy' = xx, xy' = -xy, xt' = -yt, yt' = xt, tt' = tt.
+  Cov3 p0{}, p90{};
+  propagate_arc(p0, 0.0, 10.0, 10.0, kB, kParams);
+  propagate_arc(p90, kPi / 2, 10.0, 10.0, kB, kParams);
+  EXPECT_NEAR(p90[XX], p0[YY], 1e-15 * p0[YY]);
+  EXPECT_NEAR(p90[YY], p0[XX], 1e-12 * p0[XX]);
+  EXPECT_NEAR(p90[XY], -p0[XY], 1e-12 * std::fabs(p0[XY]));
+  EXPECT_NEAR(p90[XT], -p0[YT], 1e-15 * p0[YT]);
+  EXPECT_NEAR(p90[YT], p0[XT], 1e-12 * p0[XT]);
+  EXPECT_DOUBLE_EQ(p90[TT], p0[TT]);
+}
+
+TEST(ErrorModel, OnTheSpotHalfTurnHandValues) {
+  // d_L = -b pi/2, d_R = +b pi/2: phi = pi, D = 0. With b = 0.34: |d| = 0.17 pi each,
+  // w_L = 1.6e-7 * 0.17 pi, w_R = 3.364e-7 * 0.17 pi. At phi = pi: I_cc = I_ss = 1/2, I_cs = 0,
+  // I_c = sin(pi)/pi = 0, I_s = (1 - cos pi)/pi = 2/pi. On-the-spot limit:
+  //   xx = W+ I_cc/4 = W+/8, yy = W+/8, xy = 0, xt = -W- I_c/(2b) = 0,
+  //   yt = -W- I_s/(2b) = -W-/(pi b), tt = W+/b^2.
+  const double wl = 1.6e-7 * 0.17 * kPi, wr = 3.364e-7 * 0.17 * kPi;
+  const double wp = wl + wr, wm = wl - wr;
+  Cov3 p{};
+  propagate_arc(p, 0.0, -kB * kPi / 2, kB * kPi / 2, kB, kParams);
+  EXPECT_NEAR(p[XX], wp / 8, 1e-15 * wp);
+  EXPECT_NEAR(p[YY], wp / 8, 1e-15 * wp);
+  EXPECT_NEAR(p[XY], 0.0, 1e-15 * wp);
+  EXPECT_NEAR(p[XT], 0.0, 1e-15 * wp);
+  EXPECT_NEAR(p[YT], -wm / (kPi * kB), 1e-15 * wp);
+  EXPECT_NEAR(p[TT], wp / (kB * kB), 1e-14 * wp);
+}
+
+TEST(ErrorModel, QuarterCircleHandValues) {
+  // Left quarter circle of centre radius 1 m (the ArcStep test's wheels): d_L = 0.83 pi/2,
+  // d_R = 1.17 pi/2, phi = pi/2, D = pi/2, a = D/b = pi/0.68. At phi = pi/2 (S = 1, C = 0):
+  //   I_c = I_s = 2/pi, I_cc = I_ss = 1/2, I_cs = 1/pi, J_x = (2 pi - 4)/pi^2, J_y = 4/pi^2,
+  //   J_xx = (3/2 - 4/pi) 4/pi^2, J_yy = 2/pi^2, J_xy = 4/pi^3, J_cx = J_sy = 2/pi^2,
+  //   J_cy = 1/pi, J_sx = (4 - pi)/pi^2.
+  const double pi = kPi, pi2 = pi * pi;
+  const ArcTerms t = arc_terms(pi / 2);
+  EXPECT_NEAR(t.i_c, 2 / pi, 1e-15);
+  EXPECT_NEAR(t.i_s, 2 / pi, 1e-15);
+  EXPECT_NEAR(t.i_cc, 0.5, 1e-15);
+  EXPECT_NEAR(t.i_ss, 0.5, 1e-15);
+  EXPECT_NEAR(t.i_cs, 1 / pi, 1e-15);
+  EXPECT_NEAR(t.j_x, (2 * pi - 4) / pi2, 1e-15);
+  EXPECT_NEAR(t.j_y, 4 / pi2, 1e-15);
+  EXPECT_NEAR(t.j_xx, (1.5 - 4 / pi) * 4 / pi2, 1e-15);
+  EXPECT_NEAR(t.j_yy, 2 / pi2, 1e-15);
+  EXPECT_NEAR(t.j_xy, 4 / (pi2 * pi), 1e-15);
+  EXPECT_NEAR(t.j_cx, 2 / pi2, 1e-15);
+  EXPECT_NEAR(t.j_sy, 2 / pi2, 1e-15);
+  EXPECT_NEAR(t.j_cy, 1 / pi, 1e-15);
+  EXPECT_NEAR(t.j_sx, (4 - pi) / pi2, 1e-15);
+
+  // Assemble by hand: w_L = 1.6e-7 * 0.83 pi/2, w_R = 3.364e-7 * 1.17 pi/2.
+  const double wl = 1.6e-7 * 0.83 * pi / 2, wr = 3.364e-7 * 1.17 * pi / 2;
+  const double wp = wl + wr, wm = wl - wr, a = (pi / 2) / kB;
+  const double xx = wp * (0.5 / 4 + a * a * 2 / pi2) + wm * a / pi;
+  const double yy = wp * (0.5 / 4 + a * a * (1.5 - 4 / pi) * 4 / pi2) - wm * a * (4 - pi) / pi2;
+  const double xy = wp * (1 / (4 * pi) - a * a * 4 / (pi2 * pi)) + 0.5 * wm * a * 0.0;
+  const double xt = -(wp * a * 4 / pi2 + 0.5 * wm * 2 / pi) / kB;
+  const double yt = (wp * a * (2 * pi - 4) / pi2 - 0.5 * wm * 2 / pi) / kB;
+  const Cov3 q = arc_input_covariance(0.83 * pi / 2, 1.17 * pi / 2, kB, kParams);
+  const Cov3 hand{xx, xy, xt, xy, yy, yt, xt, yt, wp / (kB * kB)};
+  expect_cov_near(q, hand, 1e-14, "quarter circle");
+}
+
+TEST(ErrorModel, SeriesAndClosedFormsMeetAtTheSwitch) {
+  // |phi| = 1 switches from the Taylor series to the closed forms; both sides must agree.
+  for (double sign : {1.0, -1.0}) {
+    const ArcTerms lo = arc_terms(sign * std::nextafter(1.0, 0.0));
+    const ArcTerms hi = arc_terms(sign * 1.0);
+    const double* a = &lo.i_c;
+    const double* b = &hi.i_c;
+    for (std::size_t i = 0; i < sizeof(ArcTerms) / sizeof(double); ++i) {
+      EXPECT_NEAR(a[i], b[i], 4e-15 * std::fabs(b[i])) << "term " << i << " sign " << sign;
+    }
+  }
+}
+
+TEST(ErrorModel, ZeroTurnLimits) {
+  // phi = 0: I_c = 1, I_s = 0, I_cc = 1, I_ss = 0, I_cs = 0, J_x = int (1-u) = 1/2, J_y = 0,
+  // J_xx = int (1-u)^2 = 1/3, J_yy = J_xy = 0, J_cx = 1/2, J_cy = J_sx = J_sy = 0.
+  const ArcTerms t = arc_terms(0.0);
+  EXPECT_EQ(t.i_c, 1.0);
+  EXPECT_EQ(t.i_s, 0.0);
+  EXPECT_EQ(t.i_cc, 1.0);
+  EXPECT_EQ(t.i_ss, 0.0);
+  EXPECT_EQ(t.j_x, 0.5);
+  EXPECT_NEAR(t.j_xx, 1.0 / 3.0, 1e-16);
+  EXPECT_EQ(t.j_cx, 0.5);
+  EXPECT_EQ(t.j_yy, 0.0);
+  EXPECT_EQ(t.j_sx, 0.0);
+}
+
+struct Case {
+  const char* name;
+  double d_left, d_right, theta0;
+};
+
+const std::vector<Case> kCases = {
+    {"straight", 10.0, 10.0, 0.3},
+    {"straight backwards", -10.0, -10.0, -1.0},
+    {"near straight", 10.0, 10.0 + 1e-9, 0.0},
+    {"gentle arc", 5.0, 5.2, 2.0},
+    {"right arc of 540 deg", 1.17 * 3 * kPi, 0.83 * 3 * kPi, 0.0},
+    {"on the spot", -0.5, 0.5, 0.0},
+    {"near on the spot", -0.5, 0.5 + 1e-10, 1.0},
+    {"one wheel still", 0.0, 2.0, 0.0},
+    {"wheels opposite, unequal", -0.3, 1.1, -0.5},
+    {"many turns", 30.0, 60.0, 0.0},
+    {"tiny", 1e-9, 1.1e-9, 0.0},
+};
+
+TEST(ErrorModel, OneSegmentEqualsThousandPieces) {
+  // Consistency (Sec. 4): the same arc in one step or cut into 1000 equal ticks gives the same
+  // covariance, because the closed form is itself the limit of infinitely many pieces.
+  for (const Case& c : kCases) {
+    Cov3 one{}, many{};
+    propagate_arc(one, c.theta0, c.d_left, c.d_right, kB, kParams);
+    Pose2 pose{0.0, 0.0, c.theta0};
+    const int n = 1000;
+    for (int i = 0; i < n; ++i) {
+      propagate_arc(many, pose.theta, c.d_left / n, c.d_right / n, kB, kParams);
+      pose = arc_step(pose, c.d_left / n, c.d_right / n, kB);
+    }
+    expect_cov_near(many, one, 1e-9, c.name);
+  }
+}
+
+TEST(ErrorModel, ConsistentAcrossUnequalPieces) {
+  // A path of two different arcs, cut into uneven pieces, against the two arcs in one step each.
+  Cov3 coarse{}, fine{};
+  Pose2 pose{};
+  const double segs[2][2] = {{4.0, 4.6}, {-2.0, -1.0}};
+  for (const auto& s : segs) {
+    propagate_arc(coarse, pose.theta, s[0], s[1], kB, kParams);
+    pose = arc_step(pose, s[0], s[1], kB);
+  }
+  pose = {};
+  for (const auto& s : segs) {
+    double done = 0.0;
+    for (int i = 1; done < 1.0; ++i) {
+      const double frac = std::min(1.0 - done, 1e-3 * (1 + i % 7));  // 1..7 thousandths
+      propagate_arc(fine, pose.theta, s[0] * frac, s[1] * frac, kB, kParams);
+      pose = arc_step(pose, s[0] * frac, s[1] * frac, kB);
+      done += frac;
+    }
+  }
+  expect_cov_near(fine, coarse, 1e-9, "two arcs, uneven pieces");
+}
+
+// dsinc: derivative of sin(x)/x.
+double dsinc(double x) {
+  if (std::fabs(x) < 1e-2) return -x / 3.0 + x * x * x / 30.0;  // next term x^5/840 < 1e-13
+  return (x * std::cos(x) - std::sin(x)) / (x * x);
+}
+
+// brute_force: Eq. 15 evaluated literally with n discrete steps of the exact arc of Eq. 13
+// (odo::arc_step, the firmware's pose code: chord D sinc(phi/2) along the mean heading
+// m = theta + phi/2), the state Jacobian [1 0 -dy; 0 1 dx; 0 0 1] of each step, the analytic
+// input Jacobian of each step, and Cov(u_i) = diag(k_L^2 |L_i|, k_R^2 |R_i|). With
+// D = (L + R)/2 and phi = (R - L)/b: d/dL = d/dD /2 - d/dphi / b, d/dR = d/dD /2 + d/dphi / b,
+//   dx/dD = sinc cos m, dy/dD = sinc sin m, dtheta/dD = 0,
+//   dx/dphi = D sinc' cos m /2 - chord sin m /2, dy/dphi = D sinc' sin m /2 + chord cos m /2,
+//   dtheta/dphi = 1.
+Cov3 brute_force(const Case& c, int n) {
+  using M3 = Eigen::Matrix3d;
+  M3 p = M3::Zero();
+  Pose2 pose{0.0, 0.0, c.theta0};
+  const double l = c.d_left / n, r = c.d_right / n;
+  const double d = 0.5 * (l + r), phi = (r - l) / kB;
+  const double sinc = phi == 0.0 ? 1.0 : std::sin(phi / 2) / (phi / 2);
+  const double chord = d * sinc;
+  for (int i = 0; i < n; ++i) {
+    const Pose2 next = arc_step(pose, l, r, kB);
+    M3 f = M3::Identity();
+    f(0, 2) = -(next.y - pose.y);
+    f(1, 2) = next.x - pose.x;
+    const double cm = std::cos(pose.theta + phi / 2), sm = std::sin(pose.theta + phi / 2);
+    const Eigen::Vector3d by_d(sinc * cm, sinc * sm, 0.0);
+    const Eigen::Vector3d by_phi(d * dsinc(phi / 2) * cm / 2 - chord * sm / 2,
+                                 d * dsinc(phi / 2) * sm / 2 + chord * cm / 2, 1.0);
+    Eigen::Matrix<double, 3, 2> g;
+    g.col(0) = by_d / 2 - by_phi / kB;
+    g.col(1) = by_d / 2 + by_phi / kB;
+    Eigen::Matrix2d cu = Eigen::Matrix2d::Zero();
+    cu(0, 0) = kL * kL * std::fabs(l);
+    cu(1, 1) = kR * kR * std::fabs(r);
+    p = f * p * f.transpose() + g * cu * g.transpose();
+    pose = next;
+  }
+  Cov3 out;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) out[3 * i + j] = p(i, j);
+  return out;
+}
+
+// worst_rel: largest |a_ij - b_ij| / sqrt(b_ii b_jj).
+double worst_rel(const Cov3& a, const Cov3& b) {
+  double w = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      w = std::max(w, std::fabs(a[3 * i + j] - b[3 * i + j]) / std::sqrt(b[4 * i] * b[4 * j]));
+  return w;
+}
+
+TEST(ErrorModel, AgreesWithBruteForceJacobianPropagation) {
+  // The discrete sum of Eq. 15/16 converges to the closed form like 1/n^2 (each step's curvature
+  // is exact; that a step's noise acts at its start rather than along it is the error). At
+  // n = 80000 steps every entry agrees to 1e-7 of its scale, and going from 20000 to 80000 steps
+  // shrinks the difference about 16-fold wherever it is above round-off.
+  for (const Case& c : kCases) {
+    if (std::fabs(c.d_left) + std::fabs(c.d_right) < 1e-6) continue;  // nothing to resolve
+    Cov3 closed{};
+    propagate_arc(closed, c.theta0, c.d_left, c.d_right, kB, kParams);
+    const double e20 = worst_rel(brute_force(c, 20000), closed);
+    const double e80 = worst_rel(brute_force(c, 80000), closed);
+    EXPECT_LT(e80, 1e-7) << c.name;
+    if (e20 > 1e-8) EXPECT_GT(e20 / e80, 10.0) << c.name << ": " << e20 << " -> " << e80;
+  }
+}
+
+TEST(ErrorModel, FiniteAndPositiveSemidefiniteEverywhere) {
+  // Tiny, huge, equal, opposite, nearly equal and nearly opposite travels, zero, denormal: never
+  // NaN or infinity, and the covariance stays positive semidefinite.
+  const double vals[] = {0.0, 1e-300, -1e-300, 1e-12, -1e-12, 1e-6, 0.01, -0.01, 0.17,
+                         0.5, -0.5,   1.0,     -1.0,  3.0,    1e3,  -1e3, 1e6,   -1e6};
+  const double nudges[] = {0.0, 1e-15, -1e-12, 1e-8};
+  for (double l : vals) {
+    for (double r : vals) {
+      for (double e : nudges) {
+        Cov3 p{};
+        propagate_arc(p, 0.7, l, r + e, kB, kParams);
+        propagate_arc(p, 1e6, r, l - e, kB, kParams);  // a second tick at a huge heading
+        Eigen::Matrix3d m;
+        for (int i = 0; i < 9; ++i) {
+          ASSERT_TRUE(std::isfinite(p[i])) << l << " " << r << " " << e;
+          m(i / 3, i % 3) = p[i];
+        }
+        const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(m).eigenvalues();
+        EXPECT_GE(ev(0), -1e-12 * std::max(ev(2), 1e-300)) << l << " " << r << " " << e;
+      }
+    }
+  }
+  Cov3 p{};
+  propagate_arc(p, 0.0, std::nan(""), 1.0, kB, kParams);
+  propagate_arc(p, 0.0, 1.0, INFINITY, kB, kParams);
+  propagate_arc(p, 0.0, 1.0, 1.0, 0.0, kParams);
+  for (double v : p) EXPECT_EQ(v, 0.0);
+}
+
+TEST(ErrorModel, StraightLineLateralCubicAlongTrackLinear) {
+  // Integrated tick by tick (1 mm ticks) as the loop does: lateral variance ~ D^3, along-track
+  // ~ D (Sec. 4.1). Fitted log-log slopes over 0.5 .. 16 m must be within 2% of 3 and 1.
+  Cov3 p{};
+  std::vector<double> dist, lateral, along;
+  const double tick = 1e-3;
+  long ticks = 0;
+  for (double target : {0.5, 1.0, 2.0, 4.0, 8.0, 16.0}) {
+    while (static_cast<double>(ticks) * tick < target - 1e-9) {
+      propagate_arc(p, 0.0, tick, tick, kB, kParams);
+      ++ticks;
+    }
+    dist.push_back(target);
+    along.push_back(p[XX]);
+    lateral.push_back(p[YY]);
+  }
+  EXPECT_NEAR(test::loglog_slope(dist, lateral), 3.0, 0.02 * 3.0);
+  EXPECT_NEAR(test::loglog_slope(dist, along), 1.0, 0.02 * 1.0);
+}
+
+TEST(ErrorModel, ParameterRanges) {
+  EXPECT_TRUE(check_error_model({0.0004, 0.00058}));
+  EXPECT_TRUE(check_error_model({0.0, 0.1}));
+  auto bad = check_error_model({-1e-4, 0.00058});
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("k_left = -0.0001"), std::string::npos);
+  EXPECT_NE(bad.error().message.find("[0, 0.1]"), std::string::npos);
+  EXPECT_FALSE(check_error_model({0.0004, std::nan("")}));
+  EXPECT_FALSE(check_error_model({0.0004, 0.2}));
+}
+
+TEST(PoseCovariance, ResetZeroes) {
+  PoseCovariance pc(kParams);
+  pc.step(0.0, 1.0, 1.1, kB);
+  EXPECT_GT(pc.cov()[TT], 0.0);
+  pc.reset();
+  for (double v : pc.cov()) EXPECT_EQ(v, 0.0);
+}
+
+}  // namespace
+}  // namespace odo
