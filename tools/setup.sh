@@ -2,6 +2,8 @@
 # setup.sh - install the Debian 12 packages this project needs (only the missing ones).
 #   tools/setup.sh            build + demo dependencies
 #   tools/setup.sh --tests    plus everything the test suite uses
+#   tools/setup.sh --cross    plus the arm64/armhf cross builds (cross compilers, qemu-user, the
+#                             :arm64/:armhf -dev packages; adds the two dpkg architectures)
 # Runs apt-get only when something is missing. `apt-get update` may fail on one mirror list once
 # a foreign architecture is configured; that is tolerated and a missing package still fails loudly.
 set -euo pipefail
@@ -10,11 +12,28 @@ build_pkgs=(g++ cmake make pkg-config python3 libeigen3-dev libgpiod-dev libtoml
   libcli11-dev nlohmann-json3-dev)
 test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind
   rt-tests stress-ng systemd)  # cyclictest + load for tools/jitter.sh; systemd-analyze verify
+# Cross builds (toolchains/, presets cross-aarch64 and cross-armhf) and the package checks
+# (tests/package/: check_deb.sh uses dpkg-shlibdeps, file, systemd-analyze; fresh_install.sh
+# uses debootstrap).
+cross_pkgs=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user dpkg-dev file systemd
+  debootstrap)
+cross_archs=(arm64 armhf)
+# Target libraries linked into the binaries or tests (Multi-Arch: same; one per architecture).
+# Eigen, CLI11 and nlohmann-json are Architecture: all headers: the native package serves all.
+cross_arch_pkgs=(libgpiod-dev libtomlplusplus-dev libgtest-dev libgmock-dev)
 
 want=("${build_pkgs[@]}")
+add_archs=()
 for arg in "$@"; do
   case $arg in
     --tests) want+=("${test_pkgs[@]}") ;;
+    --cross)
+      want+=("${cross_pkgs[@]}")
+      for a in "${cross_archs[@]}"; do
+        for p in "${cross_arch_pkgs[@]}"; do want+=("$p:$a"); done
+        dpkg --print-foreign-architectures | grep -qx "$a" || add_archs+=("$a")
+      done
+      ;;
     *) echo "setup.sh: unknown option $arg" >&2; exit 2 ;;
   esac
 done
@@ -30,5 +49,9 @@ fi
 SUDO=
 if [ "$(id -u)" != 0 ]; then SUDO=sudo; fi
 echo "setup.sh: installing ${missing[*]}"
+for a in "${add_archs[@]}"; do
+  echo "setup.sh: dpkg --add-architecture $a"
+  $SUDO dpkg --add-architecture "$a"
+done
 $SUDO apt-get update -qq || echo "setup.sh: apt-get update reported an error (continuing; see above)" >&2
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -62,6 +62,12 @@ void read_realtime(TableReader t, RealtimeSection& s) {
   t.finish();
 }
 
+void read_calibration(TableReader t, CalibrationSection& s) {
+  s.store = t.string("store", s.store);
+  s.backend = t.choice("backend", s.backend, {"auto", "file", "nvmem", "mtd"});
+  t.finish();
+}
+
 }  // namespace
 
 Result<Config> parse_config(std::string_view text, std::string_view source) {
@@ -83,6 +89,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_encoder(root.sub("encoder"), c.encoder);
   read_sim(root.sub("sim"), c.sim);
   read_realtime(root.sub("realtime"), c.realtime);
+  read_calibration(root.sub("calibration"), c.calibration);
   root.finish();
   if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
   return c;

@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "odo/firmware/calibration_io.hpp"
+#include "odo/firmware/calibration_reload.hpp"
 #include "odo/firmware/config.hpp"
 #include "odo/firmware/loop.hpp"
 #include "odo/firmware/realtime_setup.hpp"
@@ -77,6 +79,12 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
     err << "odometryd: " << cfg->source << ": robot: " << kin.error().message << "\n";
     return 2;
   }
+  // The store's corrections on top of the nominal robot (the rig keeps the nominal one).
+  const AppliedCalibration cal =
+      read_and_apply(cfg->robot, cfg->calibration.store, cfg->calibration.backend);
+  (cal.state == 2 ? err : log) << "odometryd: " << cal.report << "\n";
+  auto calibrated = Kinematics::create(cal.params);
+  if (!calibrated) calibrated = *kin;
   auto rig = Rig::create(*cfg, *kin, o.virtual_time);
   if (!rig) {
     err << "odometryd: " << rig.error().message << "\n";
@@ -84,20 +92,26 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
   }
   LoopConfig lc;
   lc.rate_hz = cfg->loop.rate_hz;
-  auto created = OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock());
+  auto created = OdometryLoop::create(lc, *calibrated, rig->encoder(), rig->clock());
   if (!created) {
     err << "odometryd: " << cfg->source << ": " << created.error().message << "\n";
     return 2;
   }
   std::unique_ptr<OdometryLoop> loop = std::move(created).value();
   if (TickObserver* t = rig->truth_observer()) loop->add_observer(t);
+  CalibrationHandover cal_handover(cal.state);
+  cal_handover.attach(loop.get());
+  loop->add_observer(&cal_handover);
+  CalibrationReloader reloader(cal_handover, cfg->robot, cfg->calibration.store,
+                               cfg->calibration.backend, log);
+  if (o.reload != nullptr) reloader.start(*o.reload);
 
-  const KinematicParams& p = kin->params();
+  const KinematicParams& p = calibrated->params();
   log << "odometryd: config " << cfg->source << "\n"
       << "odometryd: encoders: " << rig->describe() << "\n"
       << "odometryd: kinematics: Dn=" << p.wheel_diameter << " m, Ce=" << p.counts_per_rev
       << ", n=" << p.gear_ratio << ", b=" << p.wheelbase << " m, c_l=" << p.c_l << ", c_r=" << p.c_r
-      << " (nominal values from the config)\n"
+      << (cal.state == 1 ? " (calibrated)\n" : " (nominal values from the config)\n")
       << "odometryd: loop " << cfg->loop.rate_hz << " Hz on "
       << (o.virtual_time ? "virtual time" : "CLOCK_MONOTONIC") << std::endl;
 
@@ -156,15 +170,8 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
   watchdog->start();
   loop->run(from_seconds(duration), stop);
   watchdog->stop();
-
-  if (status.joinable()) {
-    {
-      std::lock_guard lk(m);
-      done = true;
-    }
-    cv.notify_all();
-    status.join();
-  }
+  reloader.stop();
+  stop_status();
 
   const LoopSnapshot& s = loop->snapshot();
   const LoopStats& st = loop->stats();
@@ -207,6 +214,7 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
     j["implausible_jumps"] = s.encoder_counters.implausible_jumps;
     j["stale_events"] = s.encoder_counters.stale_events;
     j["read_errors"] = s.encoder_counters.read_errors;
+    j["calibration_state"] = s.calibration_state;
     if (s.has_truth) {
       j["truth"] = {{"x", s.truth.x}, {"y", s.truth.y}, {"theta", wrap_angle(s.truth.theta)}};
       j["position_error"] = position_error(s);

@@ -30,13 +30,14 @@ bool OdometryLoop::add_observer(TickObserver* o) noexcept {
 }
 
 void OdometryLoop::start() noexcept {
-  start_ = clock_->now();
-  const EncoderSample s = enc_->read(start_);
+  const EncoderSample s = enc_->read(clock_->now());
   prev_left_ = s.left;
   prev_right_ = s.right;
   prev_stamp_ = s.stamp;
-  // The first deadline is one period after the reference reading, however long that took.
-  deadline_ = clock_->now() + period_;
+  // Loop time starts once the reference counts are latched, however long that read took; the
+  // first deadline is one period later.
+  start_ = clock_->now();
+  deadline_ = start_ + period_;
   snap_.encoder_flags = s.flags;
   snap_.encoder_counters = s.counters;
 }

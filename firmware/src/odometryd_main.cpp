@@ -9,8 +9,12 @@
 
 namespace {
 std::atomic<bool> g_stop{false};
+std::atomic<bool> g_reload{false};
 extern "C" void on_stop_signal(int) {
   g_stop.store(true);
+}
+extern "C" void on_reload_signal(int) {
+  g_reload.store(true);
 }
 }  // namespace
 
@@ -46,5 +50,8 @@ int main(int argc, char** argv) {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
+  sa.sa_handler = on_reload_signal;  // SIGHUP: re-read the calibration store
+  sigaction(SIGHUP, &sa, nullptr);
+  o.reload = &g_reload;
   return odo::fw::run_daemon(o, g_stop, std::cout, std::cerr);
 }

@@ -12,5 +12,7 @@ inline constexpr int kExitBadInput = 2;
 
 // add_replay: `odomctl replay` (integrate a log of raw counts).
 void add_replay(CLI::App& app, int& exit_code);
+// add_calib: `odomctl calib show|set|import|export|reset` (the calibration store).
+void add_calib(CLI::App& app, int& exit_code);
 
 }  // namespace odo::ctl

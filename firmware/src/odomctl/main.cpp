@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("odomctl ") + odo::fw::kVersion);
   int exit_code = odo::ctl::kExitOk;
   odo::ctl::add_replay(app, exit_code);
+  odo::ctl::add_calib(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -39,6 +39,12 @@ struct RealtimeSection {
   bool required = false;        // true: refuse to start when a requested part cannot be applied
 };
 
+// Where the calibration record lives ([calibration]); see calibration_io.hpp.
+struct CalibrationSection {
+  std::string store = "/var/lib/odometryd/calibration.bin";  // "" = no store: nominal values
+  std::string backend = "auto";                              // auto | file | nvmem | mtd
+};
+
 struct Config {
   std::string source = "<built-in>";  // file the config came from
   LoopSection loop;
@@ -46,6 +52,7 @@ struct Config {
   EncoderSection encoder;
   SimSection sim;
   RealtimeSection realtime;
+  CalibrationSection calibration;
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.

@@ -15,6 +15,9 @@ struct DaemonOptions {
   bool json = false;   // one JSON object on stdout at exit
   bool quiet = false;  // no status lines
   bool stats = false;  // timing statistics table at exit
+  bool json = false;                    // one JSON object on stdout at exit
+  bool quiet = false;                   // no status lines
+  std::atomic<bool>* reload = nullptr;  // set (e.g. by SIGHUP) to re-read the calibration store
 };
 
 // run_daemon: runs the firmware until stop, duration or signal; returns the process exit code.

@@ -1,0 +1,74 @@
+// The calibration record: what the robot learned about itself (UMBmark factors, effective
+// wheelbase, corrected wheel diameter, scaling error) and where it came from, plus its
+// byte-exact, CRC-protected, extensible on-medium encoding. Pure code, no I/O.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "odo/hal/result.hpp"
+
+namespace odo::calib {
+
+struct CalibrationRecord {
+  std::uint64_t sequence = 0;       // assigned by the store: newer records have larger numbers
+  bool cleared = false;             // a reset marker: "no calibration" (written by `calib reset`)
+  double c_l = 1.0;                 // UMBmark correction factor, left wheel (Eq. 6.33)
+  double c_r = 1.0;                 // UMBmark correction factor, right wheel (Eq. 6.34)
+  std::optional<double> wheelbase;  // effective wheelbase b_new [m] (Eq. 6.28)
+  std::optional<double> wheel_diameter;  // corrected nominal wheel diameter Dn* [m] (App. B)
+  std::optional<double> e_s;             // scaling error E_s = L_calc / L_actual (Eq. B.1)
+  // Provenance.
+  std::int64_t time = 0;               // when the values were obtained [s since 1970, UTC]
+  std::string method;                  // how: "umbmark", "set", "import", ... (<= 15 bytes)
+  std::optional<double> e_max_before;  // E_max,syst before the calibration [m] (Eq. 3.4)
+  std::optional<double> e_max_after;   // E_max,syst after (measured or predicted) [m]
+  std::uint32_t runs = 0;              // number of UMBmark runs (cw + ccw) behind the values
+
+  bool operator==(const CalibrationRecord&) const = default;
+};
+
+// Encoding, version 1 (all little-endian; offsets in bytes):
+//   0 magic "ODCL"  4 version u16  6 length u16 (whole record incl. CRC)  8 sequence u64
+//  16 flags u32  20 runs u32  24 time i64  32 c_l  40 c_r  48 wheelbase  56 wheel_diameter
+//  64 e_s  72 e_max_before  80 e_max_after (f64 IEEE-754)  88 method char[16]
+//  length-4: CRC-32 (IEEE 802.3) of bytes [0, length-4).
+// Extension rule: a later version appends its fields after byte 104 and raises version and
+// length; every reader decodes the version-1 fields of any record with version >= 1 and
+// length >= 108 and skips (but CRC-checks) the rest, so no record is ever lost to an upgrade.
+inline constexpr std::uint32_t kRecordMagic = 0x4C43444FU;  // bytes 'O' 'D' 'C' 'L'
+inline constexpr std::uint16_t kRecordVersion = 1;
+inline constexpr std::size_t kRecordV1Bytes = 108;
+inline constexpr std::size_t kMethodBytes = 16;
+
+// crc32: CRC-32/ISO-HDLC (zlib's crc32; "123456789" -> 0xCBF43926).
+std::uint32_t crc32(std::span<const std::uint8_t> data) noexcept;
+
+// encode_record: the version-1 bytes of `r` (kRecordV1Bytes long). Fails when the method text
+// is longer than 15 bytes or a value is not finite.
+Result<std::vector<std::uint8_t>> encode_record(const CalibrationRecord& r);
+
+// decode_record: parses a record at the start of `bytes` (a slot). Errc::kCorrupt with the
+// reason (magic, version, length, CRC, non-finite value) when it is not a valid record.
+Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes);
+
+// Allowed ranges of the stored values (checked by every writer and by the daemon).
+struct RecordLimits {
+  static constexpr double kFactorMin = 0.9, kFactorMax = 1.1;          // c_l, c_r
+  static constexpr double kWheelbaseMin = 0.01, kWheelbaseMax = 20.0;  // [m]
+  static constexpr double kDiameterMin = 0.005, kDiameterMax = 5.0;    // [m]
+  static constexpr double kScalingMin = 0.8, kScalingMax = 1.25;       // E_s
+  static constexpr double kEmaxMin = 0.0, kEmaxMax = 100.0;            // [m]
+  static constexpr std::uint32_t kRunsMax = 1000000;
+};
+
+// validate_record: every value finite and inside RecordLimits; the error names the field and
+// the allowed range.
+Status validate_record(const CalibrationRecord& r);
+
+}  // namespace odo::calib

@@ -1,0 +1,189 @@
+#include "odo/calibration/record.hpp"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+namespace odo::calib {
+namespace {
+
+constexpr std::array<std::uint32_t, 256> make_crc_table() {
+  std::array<std::uint32_t, 256> t{};
+  for (std::uint32_t i = 0; i < 256; ++i) {
+    std::uint32_t c = i;
+    for (int k = 0; k < 8; ++k) c = (c & 1U) ? 0xEDB88320U ^ (c >> 1) : c >> 1;
+    t[i] = c;
+  }
+  return t;
+}
+constexpr auto kCrcTable = make_crc_table();
+
+// Flag bits: which optional fields are present.
+constexpr std::uint32_t kFlagCleared = 1U << 0;
+constexpr std::uint32_t kFlagWheelbase = 1U << 1;
+constexpr std::uint32_t kFlagDiameter = 1U << 2;
+constexpr std::uint32_t kFlagScaling = 1U << 3;
+constexpr std::uint32_t kFlagEmaxBefore = 1U << 4;
+constexpr std::uint32_t kFlagEmaxAfter = 1U << 5;
+
+// Little-endian field access, independent of the host's byte order.
+template <class T>
+void put(std::vector<std::uint8_t>& b, std::size_t off, T v) {
+  std::uint64_t u = 0;
+  if constexpr (std::is_same_v<T, double>) {
+    u = std::bit_cast<std::uint64_t>(v);
+  } else {
+    u = static_cast<std::uint64_t>(v);
+  }
+  for (std::size_t i = 0; i < sizeof(T); ++i) b[off + i] = static_cast<std::uint8_t>(u >> (8 * i));
+}
+
+template <class T>
+T get(std::span<const std::uint8_t> b, std::size_t off) {
+  std::uint64_t u = 0;
+  for (std::size_t i = 0; i < sizeof(T); ++i)
+    u |= static_cast<std::uint64_t>(b[off + i]) << (8 * i);
+  if constexpr (std::is_same_v<T, double>) {
+    return std::bit_cast<double>(u);
+  } else {
+    return static_cast<T>(u);
+  }
+}
+
+Error corrupt(const std::string& why) {
+  return make_error(Errc::kCorrupt, why);
+}
+
+Status check_range(const char* field, double v, double lo, double hi, const char* unit) {
+  if (std::isfinite(v) && v >= lo && v <= hi) return Ok{};
+  std::ostringstream m;
+  m << field << " = " << v << " is outside the allowed range [" << lo << ", " << hi << "]"
+    << (*unit ? " " : "") << unit;
+  return make_error(Errc::kInvalidArgument, m.str());
+}
+
+}  // namespace
+
+std::uint32_t crc32(std::span<const std::uint8_t> data) noexcept {
+  std::uint32_t c = 0xFFFFFFFFU;
+  for (std::uint8_t b : data) c = kCrcTable[(c ^ b) & 0xFFU] ^ (c >> 8);
+  return c ^ 0xFFFFFFFFU;
+}
+
+Result<std::vector<std::uint8_t>> encode_record(const CalibrationRecord& r) {
+  if (r.method.size() >= kMethodBytes)
+    return make_error(Errc::kInvalidArgument, "method \"" + r.method + "\" is longer than " +
+                                                  std::to_string(kMethodBytes - 1) + " bytes");
+  const double values[] = {r.c_l,
+                           r.c_r,
+                           r.wheelbase.value_or(0.0),
+                           r.wheel_diameter.value_or(0.0),
+                           r.e_s.value_or(0.0),
+                           r.e_max_before.value_or(0.0),
+                           r.e_max_after.value_or(0.0)};
+  for (double v : values)
+    if (!std::isfinite(v)) return make_error(Errc::kInvalidArgument, "a value is not finite");
+  std::uint32_t flags = 0;
+  if (r.cleared) flags |= kFlagCleared;
+  if (r.wheelbase) flags |= kFlagWheelbase;
+  if (r.wheel_diameter) flags |= kFlagDiameter;
+  if (r.e_s) flags |= kFlagScaling;
+  if (r.e_max_before) flags |= kFlagEmaxBefore;
+  if (r.e_max_after) flags |= kFlagEmaxAfter;
+
+  std::vector<std::uint8_t> b(kRecordV1Bytes, 0);
+  put<std::uint32_t>(b, 0, kRecordMagic);
+  put<std::uint16_t>(b, 4, kRecordVersion);
+  put<std::uint16_t>(b, 6, static_cast<std::uint16_t>(kRecordV1Bytes));
+  put<std::uint64_t>(b, 8, r.sequence);
+  put<std::uint32_t>(b, 16, flags);
+  put<std::uint32_t>(b, 20, r.runs);
+  put<std::int64_t>(b, 24, r.time);
+  for (std::size_t i = 0; i < 7; ++i) put<double>(b, 32 + 8 * i, values[i]);
+  std::memcpy(b.data() + 88, r.method.data(), r.method.size());
+  put<std::uint32_t>(b, kRecordV1Bytes - 4,
+                     crc32(std::span<const std::uint8_t>(b.data(), kRecordV1Bytes - 4)));
+  return b;
+}
+
+Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
+  if (bytes.size() < kRecordV1Bytes) return corrupt("shorter than a version-1 record");
+  const auto magic = get<std::uint32_t>(bytes, 0);
+  if (magic != kRecordMagic) {
+    std::ostringstream m;
+    m << "no record magic (found 0x" << std::hex << magic << ")";
+    return corrupt(m.str());
+  }
+  const auto version = get<std::uint16_t>(bytes, 4);
+  const auto length = get<std::uint16_t>(bytes, 6);
+  if (version < 1) return corrupt("format version 0 is not valid");
+  if (length < kRecordV1Bytes || length > bytes.size())
+    return corrupt("length " + std::to_string(length) + " outside [" +
+                   std::to_string(kRecordV1Bytes) + ", " + std::to_string(bytes.size()) + "]");
+  const auto stored = get<std::uint32_t>(bytes, length - 4U);
+  const auto computed = crc32(bytes.first(length - 4U));
+  if (stored != computed) {
+    std::ostringstream m;
+    m << "CRC mismatch (stored 0x" << std::hex << stored << ", computed 0x" << computed << ")";
+    return corrupt(m.str());
+  }
+  CalibrationRecord r;
+  r.sequence = get<std::uint64_t>(bytes, 8);
+  const auto flags = get<std::uint32_t>(bytes, 16);
+  r.runs = get<std::uint32_t>(bytes, 20);
+  r.time = get<std::int64_t>(bytes, 24);
+  double v[7];
+  for (std::size_t i = 0; i < 7; ++i) {
+    v[i] = get<double>(bytes, 32 + 8 * i);
+    if (!std::isfinite(v[i])) return corrupt("a stored value is not finite");
+  }
+  r.cleared = (flags & kFlagCleared) != 0;
+  r.c_l = v[0];
+  r.c_r = v[1];
+  if (flags & kFlagWheelbase) r.wheelbase = v[2];
+  if (flags & kFlagDiameter) r.wheel_diameter = v[3];
+  if (flags & kFlagScaling) r.e_s = v[4];
+  if (flags & kFlagEmaxBefore) r.e_max_before = v[5];
+  if (flags & kFlagEmaxAfter) r.e_max_after = v[6];
+  const auto* m = reinterpret_cast<const char*>(bytes.data() + 88);
+  r.method.assign(m, strnlen(m, kMethodBytes - 1));
+  return r;
+}
+
+Status validate_record(const CalibrationRecord& r) {
+  using L = RecordLimits;
+  if (auto s = check_range("c_l", r.c_l, L::kFactorMin, L::kFactorMax, ""); !s) return s;
+  if (auto s = check_range("c_r", r.c_r, L::kFactorMin, L::kFactorMax, ""); !s) return s;
+  if (r.wheelbase)
+    if (auto s = check_range("wheelbase", *r.wheelbase, L::kWheelbaseMin, L::kWheelbaseMax, "m");
+        !s)
+      return s;
+  if (r.wheel_diameter)
+    if (auto s =
+            check_range("wheel_diameter", *r.wheel_diameter, L::kDiameterMin, L::kDiameterMax, "m");
+        !s)
+      return s;
+  if (r.e_s)
+    if (auto s = check_range("e_s", *r.e_s, L::kScalingMin, L::kScalingMax, ""); !s) return s;
+  if (r.e_max_before)
+    if (auto s = check_range("e_max_syst_before", *r.e_max_before, L::kEmaxMin, L::kEmaxMax, "m");
+        !s)
+      return s;
+  if (r.e_max_after)
+    if (auto s = check_range("e_max_syst_after", *r.e_max_after, L::kEmaxMin, L::kEmaxMax, "m"); !s)
+      return s;
+  if (r.runs > L::kRunsMax)
+    return make_error(Errc::kInvalidArgument, "runs = " + std::to_string(r.runs) +
+                                                  " is outside the allowed range [0, " +
+                                                  std::to_string(L::kRunsMax) + "]");
+  if (r.time < 0)
+    return make_error(Errc::kInvalidArgument,
+                      "time = " + std::to_string(r.time) + " is before 1970 (allowed: >= 0 s)");
+  if (r.method.size() >= kMethodBytes)
+    return make_error(Errc::kInvalidArgument, "method \"" + r.method + "\" is longer than " +
+                                                  std::to_string(kMethodBytes - 1) + " bytes");
+  return Ok{};
+}
+
+}  // namespace odo::calib

@@ -1,0 +1,168 @@
+// Calibration JSON formats and applying a stored record to the kinematics.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <nlohmann/json.hpp>
+
+#include "odo/calibration/store.hpp"
+#include "odo/firmware/calibration_io.hpp"
+#include "odo/firmware/calibration_reload.hpp"
+
+namespace odo::fw {
+namespace {
+
+using calib::CalibrationRecord;
+using calib::LoadResult;
+using calib::StoreStatus;
+
+KinematicParams nominal() {
+  KinematicParams p;
+  p.wheel_diameter = 0.15;
+  p.counts_per_rev = 2048;
+  p.gear_ratio = 16;
+  p.wheelbase_nominal = p.wheelbase = 0.34;
+  return p;
+}
+
+TEST(CalibrationIo, ImportsUmbmarkComputeOutput) {
+  // The keys `odomctl umbmark compute --json` prints; unknown ones (alpha, beta, ...) ignored.
+  const char* text =
+      R"({"c_l":0.99925,"c_r":1.00075,"b_new":0.33702,"e_max_syst":0.232,"n_cw":5,"n_ccw":5,
+          "alpha":0.0012,"beta":-0.0004,"e_d":1.0015,"e_b":0.9912})";
+  auto r = parse_calibration_json(text, "u.json", 1795000000);
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_DOUBLE_EQ(r->c_l, 0.99925);
+  EXPECT_DOUBLE_EQ(r->c_r, 1.00075);
+  ASSERT_TRUE(r->wheelbase);
+  EXPECT_DOUBLE_EQ(*r->wheelbase, 0.33702);
+  ASSERT_TRUE(r->e_max_before);
+  EXPECT_DOUBLE_EQ(*r->e_max_before, 0.232);
+  EXPECT_EQ(r->runs, 10U);  // 5 cw + 5 ccw
+  EXPECT_EQ(r->method, "umbmark");
+  EXPECT_EQ(r->time, 1795000000);
+  EXPECT_FALSE(r->wheel_diameter);
+}
+
+TEST(CalibrationIo, ExportImportRoundTrip) {
+  CalibrationRecord r;
+  r.sequence = 7;
+  r.c_l = 0.998;
+  r.c_r = 1.002;
+  r.wheelbase = 0.337;
+  r.wheel_diameter = 0.1502;
+  r.e_s = 0.9987;
+  r.time = 1790000000;
+  r.method = "umbmark";
+  r.e_max_before = 0.3;
+  r.e_max_after = 0.02;
+  r.runs = 10;
+  auto back = parse_calibration_json(export_json(r), "e.json", 0);
+  ASSERT_TRUE(back) << back.error().message;
+  r.sequence = 0;  // the store assigns sequence numbers; import does not carry them
+  EXPECT_EQ(*back, r);
+}
+
+TEST(CalibrationIo, BadInputNamesTheField) {
+  auto r = parse_calibration_json(R"({"c_l":1.3,"c_r":1.0})", "x.json", 0);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("x.json"), std::string::npos);
+  EXPECT_NE(r.error().message.find("c_l"), std::string::npos);
+  EXPECT_NE(r.error().message.find("[0.9, 1.1]"), std::string::npos);
+  r = parse_calibration_json(R"({"c_l":"one","c_r":1.0})", "x.json", 0);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("field c_l: expected a number"), std::string::npos);
+  r = parse_calibration_json(R"({"c_l":1.0})", "x.json", 0);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("c_r is missing"), std::string::npos);
+  r = parse_calibration_json(R"({"c_l":1.0,"c_r":1.0,"b_new":-0.3})", "x.json", 0);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("wheelbase"), std::string::npos);
+  EXPECT_FALSE(parse_calibration_json("{not json", "x.json", 0));
+  EXPECT_FALSE(parse_calibration_json("[1,2]", "x.json", 0));
+  r = parse_calibration_json(R"({"status":"corrupt","c_l":null,"c_r":null})", "s.json", 0);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("corrupt"), std::string::npos);
+}
+
+TEST(CalibrationIo, ShowJsonHasTheRequiredKeys) {
+  LoadResult l;
+  l.status = StoreStatus::kOk;
+  CalibrationRecord r;
+  r.sequence = 4;
+  r.c_l = 0.999;
+  r.c_r = 1.001;
+  r.wheelbase = 0.337;
+  l.record = r;
+  l.slot = 1;
+  auto j = nlohmann::json::parse(show_json(l));
+  EXPECT_EQ(j["status"], "ok");
+  EXPECT_EQ(j["sequence"], 4);
+  EXPECT_EQ(j["c_l"], 0.999);
+  EXPECT_EQ(j["c_r"], 1.001);
+  EXPECT_EQ(j["wheelbase"], 0.337);
+  EXPECT_TRUE(j["wheel_diameter"].is_null());
+  LoadResult bad;
+  bad.status = StoreStatus::kCorrupt;
+  j = nlohmann::json::parse(show_json(bad));
+  EXPECT_EQ(j["status"], "corrupt");
+  EXPECT_TRUE(j["c_l"].is_null());  // no made-up values for a corrupt store
+}
+
+TEST(CalibrationIo, ApplyUsesStoredValuesOnlyWhenOk) {
+  LoadResult l;
+  l.status = StoreStatus::kOk;
+  CalibrationRecord r;
+  r.sequence = 2;
+  r.c_l = 0.999;
+  r.c_r = 1.001;
+  r.wheelbase = 0.337;
+  l.record = r;
+  AppliedCalibration a = apply_calibration(nominal(), Result<LoadResult>(l), "test");
+  EXPECT_EQ(a.state, 1);
+  EXPECT_EQ(a.sequence, 2U);
+  EXPECT_DOUBLE_EQ(a.params.c_l, 0.999);
+  EXPECT_DOUBLE_EQ(a.params.wheelbase, 0.337);
+  EXPECT_DOUBLE_EQ(a.params.wheelbase_nominal, 0.34);
+  EXPECT_DOUBLE_EQ(a.params.wheel_diameter, 0.15);  // not stored: nominal kept
+
+  l.status = StoreStatus::kCorrupt;
+  l.record.reset();
+  a = apply_calibration(nominal(), Result<LoadResult>(l), "test");
+  EXPECT_EQ(a.state, 2);
+  EXPECT_DOUBLE_EQ(a.params.c_l, 1.0);
+  EXPECT_NE(a.report.find("ERROR"), std::string::npos);
+  EXPECT_NE(a.report.find("NOMINAL"), std::string::npos);
+
+  a = apply_calibration(nominal(), Result<LoadResult>(make_error(Errc::kIo, "EACCES")), "test");
+  EXPECT_EQ(a.state, 2);
+
+  l.status = StoreStatus::kUncalibrated;
+  a = apply_calibration(nominal(), Result<LoadResult>(l), "test");
+  EXPECT_EQ(a.state, 0);
+  EXPECT_NE(a.report.find("nominal values"), std::string::npos);
+}
+
+TEST(CalibrationHandover, AppliedOnTheLoopThreadBetweenTicks) {
+  // Without a loop attached the observer only stamps the state; an offer is taken on the next
+  // tick and the state changes with it.
+  CalibrationHandover h(0);
+  LoopSnapshot snap;
+  h.on_tick(snap);
+  EXPECT_EQ(snap.calibration_state, 0);
+  std::atomic<bool> stop{false};
+  auto k = Kinematics::create(nominal());
+  ASSERT_TRUE(k);
+  ASSERT_TRUE(h.offer(*k, 1, stop));
+  EXPECT_EQ(h.applied(), 0U);
+  h.on_tick(snap);
+  EXPECT_EQ(snap.calibration_state, 1);
+  EXPECT_EQ(h.applied(), 1U);
+  ASSERT_TRUE(h.offer(*k, 2, stop));
+  stop = true;
+  EXPECT_FALSE(h.offer(*k, 1, stop));  // previous offer not yet taken, and stopping
+  h.on_tick(snap);
+  EXPECT_EQ(snap.calibration_state, 2);
+}
+
+}  // namespace
+}  // namespace odo::fw
