@@ -12,11 +12,9 @@ struct DaemonOptions {
   double duration = 0.0;    // [s] of loop time; 0: until SIGINT/SIGTERM (or scenario end + 1 s
                             // with --virtual-time, which cannot be interrupted otherwise)
   bool virtual_time = false;
-  bool json = false;   // one JSON object on stdout at exit
-  bool quiet = false;  // no status lines
-  bool stats = false;  // timing statistics table at exit
   bool json = false;                    // one JSON object on stdout at exit
   bool quiet = false;                   // no status lines
+  bool stats = false;                   // timing statistics table at exit
   std::atomic<bool>* reload = nullptr;  // set (e.g. by SIGHUP) to re-read the calibration store
 };
 
