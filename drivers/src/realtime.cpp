@@ -54,6 +54,12 @@ RealtimeItem lock_memory(bool want) {
     it.detail = "off (lock_memory = false): page faults may delay ticks";
     return it;
   }
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer's interceptor turns mlockall into a no-op that reports success.
+  it.outcome = RtOutcome::kFailed;
+  it.detail = "not available in an AddressSanitizer build (its mlockall does nothing)";
+  return it;
+#endif
   if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
     it.outcome = RtOutcome::kApplied;
     return it;
