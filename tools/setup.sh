@@ -8,7 +8,8 @@ set -euo pipefail
 
 build_pkgs=(g++ cmake make pkg-config python3 libeigen3-dev libgpiod-dev libtomlplusplus-dev
   libcli11-dev nlohmann-json3-dev)
-test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind)
+test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind
+  clang-14 libclang-rt-14-dev libfuzzer-14-dev)  # fuzz preset: clang-14 + libFuzzer (TESTING.md)
 
 want=("${build_pkgs[@]}")
 for arg in "$@"; do
