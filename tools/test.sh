@@ -3,6 +3,11 @@
 # Builds and tests, in order:
 #   default     RelWithDebInfo: unit, sim, cli tiers
 #   debug-asan  Debug + AddressSanitizer + UndefinedBehaviorSanitizer: unit, sim, cli tiers
+#   tsan        ThreadSanitizer: unit, sim, cli tiers (every threaded test: TESTING.md)
+#   fuzz        clang-14 libFuzzer + ASan + UBSan: a short run of every fuzz target (ODO_FUZZ_ARGS,
+#               default -max_total_time=20 per target)
+#   soak        the `soak` tier of the default build: 24 h of simulated driving with random
+#               faults in virtual time (ODO_SOAK=0 skips it)
 #   kernel      the `kernel` tier of the default build, inside a QEMU VM with Debian's kernel
 #               (tools/vm-run.sh: vcan, gpio-sim, mtdram); if the VM cannot start, those tests
 #               run on the host, where each one reports itself skipped with the reason
@@ -12,7 +17,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/setup.sh --tests
 jobs=${ODO_JOBS:-$(nproc)}
-configs=${ODO_CONFIGS:-"default debug-asan"}
+configs=${ODO_CONFIGS:-"default debug-asan tsan fuzz"}
 status=0
 summary=()
 for c in $configs; do
@@ -20,9 +25,19 @@ for c in $configs; do
   t0=$(date +%s)
   cmake --preset "$c" >/dev/null
   cmake --build --preset "$c" -j"$jobs"
-  if ctest --preset "$c" -j"$jobs" --label-regex 'unit|sim|cli'; then r=ok; else r=FAILED; status=1; fi
+  labels='unit|sim|cli'
+  if [[ $c == fuzz ]]; then labels=fuzz; fi
+  if ctest --preset "$c" -j"$jobs" --label-regex "$labels"; then r=ok; else r=FAILED; status=1; fi
   summary+=("$c: $r ($(($(date +%s) - t0)) s)")
 done
+if [[ " $configs " == *" default "* && ${ODO_SOAK:-1} == 1 ]]; then
+  echo "=== soak tier ==="
+  t0=$(date +%s)
+  log=build/default/soak.log
+  if ctest --test-dir build/default -L soak -V >"$log" 2>&1; then r=ok; else r=FAILED; status=1; tail -40 "$log"; fi
+  grep -o 'soak: seed.*' "$log" || true
+  summary+=("soak: $r ($(($(date +%s) - t0)) s)")
+fi
 if [[ " $configs " == *" default "* && ${ODO_KERNEL:-1} == 1 ]]; then
   echo "=== kernel tier (VM harness) ==="
   t0=$(date +%s)

@@ -1,6 +1,8 @@
 #include "odo/firmware/config.hpp"
 
-#include <fstream>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <sstream>
 
 #include "odo/firmware/toml_reader.hpp"
@@ -79,11 +81,24 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
 }
 
 Result<Config> load_config(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return make_error(Errc::kNotFound, path + ": cannot open config file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_config(text.str(), path);
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) {
+    return make_error(Errc::kNotFound,
+                      path + ": cannot open config file (" + std::strerror(errno) + ")");
+  }
+  std::string text;
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+  // A read error (e.g. the path is a directory: EISDIR) must not pass for an empty file, which
+  // would silently mean "all defaults".
+  const bool failed = std::ferror(f) != 0;
+  const int err = errno;
+  std::fclose(f);
+  if (failed) {
+    return make_error(Errc::kIo, path + ": cannot read config file (" + std::strerror(err) + ")");
+  }
+  return parse_config(text, path);
 }
 
 }  // namespace odo::fw
