@@ -55,11 +55,38 @@ void read_sim(TableReader t, SimSection& s) {
   t.finish();
 }
 
+// first_non_ascii: the first byte >= 0x80 as "line N, column C (byte 0xXX)", or "" if none.
+// The config is plain ASCII: toml++ 3.3 (Debian 12) reaches __builtin_unreachable() on some
+// non-ASCII characters (upstream issues #190 and #295; found here by fuzz_config), so such a
+// file never reaches the TOML parser.
+std::string first_non_ascii(std::string_view text) {
+  int line = 1, column = 1;
+  for (const char ch : text) {
+    const auto byte = static_cast<unsigned char>(ch);
+    if (byte >= 0x80) {
+      char where[80];
+      std::snprintf(where, sizeof where, "%d: column %d: byte 0x%02X", line, column, byte);
+      return where;
+    }
+    if (ch == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return {};
+}
+
 }  // namespace
 
 Result<Config> parse_config(std::string_view text, std::string_view source) {
   Config c = default_config();
   c.source = std::string(source);
+  if (const std::string bad = first_non_ascii(text); !bad.empty()) {
+    return make_error(Errc::kParse, std::string(source) + ":" + bad +
+                                        " is not ASCII (the config file must be plain ASCII)");
+  }
   toml::table parsed;
   try {
     // toml++ reports syntax errors by exception; this is configure time, not the loop path.

@@ -122,7 +122,19 @@ TEST(ConfigErrors, TomlSyntaxErrorsNameTheLine) {
   expect_error("\n\n[robot\n", "bad.toml:3: TOML syntax error");
   expect_error("[loop]\nrate_hz = 1_00_\n", "bad.toml:2: TOML syntax error");
   expect_error(std::string("[loop]\nrate_hz = 100\x00\n", 22), "bad.toml:2: TOML syntax error");
-  expect_error("[loop]\nrate_hz = 100 # caf\xe9\n", "bad.toml:2: TOML syntax error");
+}
+
+TEST(ConfigErrors, NonAsciiNeverReachesTheTomlParser) {
+  // Regression (fuzz_config): U+2EFF (UTF-8 e2 bb bf) before a key made toml++ 3.3 reach
+  // __builtin_unreachable() (undefined behaviour; upstream issues #190, #295), as do U+00A7
+  // after a line-ending backslash and other characters. Any byte >= 0x80 is refused with its
+  // position before parsing ("rate_hz = 100 # caf" is 19 characters, the e-acute is column 20).
+  expect_error(
+      "\xe2\xbb\xbfl8np = {wh=\"idle\"",
+      "bad.toml:1: column 1: byte 0xE2 is not ASCII (the config file must be plain ASCII)");
+  expect_error("[sim]\nscenario = \"\"\"\\\n\xc2\xa7\"\"\"\n", "bad.toml:3: column 1: byte 0xC2");
+  expect_error("[loop]\nrate_hz = 100 # caf\xe9\n",
+               "bad.toml:2: column 20: byte 0xE9 is not ASCII");
 }
 
 TEST(ConfigErrors, FirstErrorWinsAndNothingIsHalfApplied) {
