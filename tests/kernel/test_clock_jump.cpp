@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <thread>
@@ -65,6 +66,8 @@ TEST(ClockJump, WallClockStepsDoNotReachTheLoop) {
   EXPECT_NEAR(fwd, 2 * 86400.0, 1.0);
 
   ASSERT_EQ(rc, 0) << err.str();
+  std::printf("clock jump: steps %+.0f s and %+.0f s; %.2f s monotonic wall time; odometryd: %s",
+              back, fwd, wall, out.str().c_str());
   const auto j = nlohmann::json::parse(out.str());
   // Neither stopped early (forward step) nor hung (backward step): 3 s of loop time, taken in
   // about 3 s of monotonic time (the rest is start-up under the VM's emulated CPU).
