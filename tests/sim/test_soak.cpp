@@ -136,6 +136,8 @@ TEST(Soak, ODO_SOAK_NAME) {
   double max_heading_err = 0.0, max_pos_err = 0.0, max_pos_ratio = 0.0, budget = 0.0;
   double max_pos_err_clean = 0.0;  // at stops after a motion without freeze or glitch
   bool window_faulty = false;
+  double worst_err = 0.0, worst_budget = 0.0;  // the stop closest to its budget
+  bool worst_faulty = false;
   std::size_t stop = 0;
   TimeNs armed_delay = 0;
   bool freeze_l = false, freeze_r = false, frozen_since_correct = false;
@@ -255,7 +257,10 @@ TEST(Soak, ODO_SOAK_NAME) {
       max_pos_err = std::max(max_pos_err, perr);
       if (!window_faulty) max_pos_err_clean = std::max(max_pos_err_clean, perr);
       window_faulty = false;
-      if (budget > 0) max_pos_ratio = std::max(max_pos_ratio, perr / budget);
+      if (budget > 0 && perr / budget > max_pos_ratio) {
+        max_pos_ratio = perr / budget;
+        worst_err = perr, worst_budget = budget, worst_faulty = window_faulty;
+      }
       ASSERT_LE(perr, budget) << "tick " << s.tick << " at " << to_seconds(s.stamp) << " s";
       if (perr > 0.0) {
         loop->request_pose({t.x, t.y, s.pose.theta});
@@ -282,12 +287,14 @@ TEST(Soak, ODO_SOAK_NAME) {
       " glitches; missed deadlines %" PRIu64
       "; max heading error %.3g rad (bound %.3g); max "
       "position error at a stop %.3g m (%.3g m after motions without freeze or glitch; max share "
-      "of budget %.2f); %" PRIu64 " re-anchors; allocations in loop %" PRIu64
+      "of budget %.2f: %.3g m of %.3g m, %s); %" PRIu64 " re-anchors; allocations in loop %" PRIu64
       "; RSS pages before start %ld, after 1 h %ld, max later %ld\n",
       seed, hours, st.ticks, prof.stop_begin.size(), inj.slow_reads, inj.read_errors,
       inj.frozen_reads, inj.glitches, st.missed_deadlines, max_heading_err, c_m / b, max_pos_err,
-      max_pos_err_clean, max_pos_ratio, anchors, loop_allocations, rss.front(),
-      rss.size() > 2 ? rss[1] : -1L, rss.size() > 2 ? rss_hourly_max : -1L);
+      max_pos_err_clean, max_pos_ratio, worst_err, worst_budget,
+      worst_faulty ? "a motion with a freeze or glitch" : "a fault-free motion", anchors,
+      loop_allocations, rss.front(), rss.size() > 2 ? rss[1] : -1L,
+      rss.size() > 2 ? rss_hourly_max : -1L);
   EXPECT_EQ(loop_allocations, 0u);
   EXPECT_GT(inj.read_errors, 0u);
   EXPECT_GT(inj.glitches, 0u);
