@@ -2,7 +2,15 @@
 # test.sh - set up and run the whole test suite (README, command 2; CI runs exactly this).
 # Builds and tests, in order:
 #   default     RelWithDebInfo: unit, sim, cli tiers
+#   soak        the `soak` tier of the default build: 24 h of simulated driving with random
+#               faults in virtual time (ODO_SOAK=0 skips it)
+#   kernel      the `kernel` tier of the default build, inside a QEMU VM with Debian's kernel
+#               (tools/vm-run.sh: vcan, gpio-sim, mtdram, at24); if the VM cannot start, those
+#               tests run on the host, where each one reports itself skipped with the reason
 #   debug-asan  Debug + AddressSanitizer + UndefinedBehaviorSanitizer: unit, sim, cli tiers
+#   tsan        ThreadSanitizer: unit, sim, cli tiers (every threaded test: TESTING.md)
+#   fuzz        clang-14 libFuzzer + ASan + UBSan: a short run of every fuzz target (ODO_FUZZ_ARGS,
+#               default -max_total_time=20 per target)
 #   cross-aarch64, cross-armhf
 #               Release -O2 cross builds (toolchains/) of only what those tiers run (target
 #               odo_tier_tests); the unit, sim, cli tiers run under qemu-user
@@ -11,66 +19,122 @@
 #               tests/package/check_deb.sh; the amd64 one is installed, run, verified with
 #               systemd-analyze, removed and purged on this machine (CI is throw-away), and
 #               installed with apt on a fresh debootstrap chroot (tests/package/fresh_install.sh)
-#   kernel      the `kernel` tier of the default build, inside a QEMU VM with Debian's kernel
-#               (tools/vm-run.sh: vcan, gpio-sim, mtdram); if the VM cannot start, those tests
-#               run on the host, where each one reports itself skipped with the reason
 # Environment: ODO_JOBS (parallel build jobs, default nproc), ODO_CONFIGS (space-separated
-# subset of the configurations above), ODO_PACKAGES=0 (no package checks), ODO_FRESH_INSTALL=0
-# (no chroot install).
+# subset of the configurations above), ODO_SOAK=0, ODO_KERNEL=0, ODO_PACKAGES=0 (skip those
+# stages), ODO_FRESH_INSTALL=0 (no chroot install).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=${ODO_JOBS:-$(nproc)}
-configs=${ODO_CONFIGS:-"default debug-asan cross-aarch64 cross-armhf"}
+configs=${ODO_CONFIGS:-"default debug-asan tsan fuzz cross-aarch64 cross-armhf"}
 if [[ " $configs " == *" cross-"* ]]; then tools/setup.sh --tests --cross; else tools/setup.sh --tests; fi
+T_ALL=$(date +%s)
 status=0
 summary=()
-for c in $configs; do
+n_pass=0 n_fail=0 n_skip=0  # over every ctest run, for the closing line
+
+# counted LOG CMD...: runs CMD (a ctest run, possibly inside the VM), output to the terminal and
+# LOG, and adds its "N% tests passed, F tests failed out of T" figures to the totals.
+counted() {
+  local log=$1 rc line total failed skipped; shift
+  set +e
+  "$@" 2>&1 | tee "$log"
+  rc=${PIPESTATUS[0]}
+  set -e
+  line=$(grep -E '[0-9]+% tests passed, [0-9]+ tests failed out of [0-9]+' "$log" | tail -1 || true)
+  if [[ -n $line ]]; then
+    total=$(sed -E 's/.* out of ([0-9]+).*/\1/' <<<"$line")
+    failed=$(sed -E 's/.*passed, ([0-9]+) tests failed.*/\1/' <<<"$line")
+    skipped=$(grep -cE '\*\*\*Skipped' "$log" || true)
+    n_pass=$((n_pass + total - failed - skipped)) n_fail=$((n_fail + failed))
+    n_skip=$((n_skip + skipped))
+  elif [[ $rc != 0 ]]; then
+    n_fail=$((n_fail + 1))  # the run itself failed before any test reported
+  fi
+  return "$rc"
+}
+
+stage_config() {  # build one configuration and run its ctest tiers
+  local c=$1 t0 r labels
   echo "=== configuration $c ==="
   t0=$(date +%s)
   cmake --preset "$c" >/dev/null
-  cmake --build --preset "$c" -j"$jobs"
-  if ctest --preset "$c" -j"$jobs" --label-regex 'unit|sim|cli'; then r=ok; else r=FAILED; status=1; fi
+  if cmake --build --preset "$c" -j"$jobs"; then
+    labels='unit|sim|cli'
+    if [[ $c == fuzz ]]; then labels=fuzz; fi
+    if counted "build/$c/ctest-tiers.log" ctest --preset "$c" -j"$jobs" --label-regex "$labels"
+    then r=ok; else r=FAILED; status=1; fi
+  else
+    r="FAILED (build)"; status=1; n_fail=$((n_fail + 1))
+  fi
   summary+=("$c: $r ($(($(date +%s) - t0)) s)")
-done
-if [[ " $configs " == *" default "* && ${ODO_KERNEL:-1} == 1 ]]; then
+}
+
+stage_soak() {
+  local t0 r
+  echo "=== soak tier ==="
+  t0=$(date +%s)
+  if counted build/default/soak.log ctest --test-dir build/default -L soak -V >/dev/null
+  then r=ok; else r=FAILED; status=1; tail -40 build/default/soak.log; fi
+  grep -o 'soak: seed.*' build/default/soak.log || true
+  summary+=("soak: $r ($(($(date +%s) - t0)) s)")
+}
+
+stage_kernel() {
+  local t0 r prep
   echo "=== kernel tier (VM harness) ==="
   t0=$(date +%s)
   if prep=$(tools/vm-run.sh --prepare 2>&1); then
     # One vCPU: with two, gpio-sim edges can be lost under TCG (see tools/vm-run.md).
-    if ODO_IN_VM=1 tools/vm-run.sh --cpus 1 --mem 1G --timeout 1800 -- \
-        ctest --test-dir build/default -L kernel --output-on-failure; then r=ok; else r=FAILED; status=1; fi
+    if ODO_IN_VM=1 counted build/default/kernel.log tools/vm-run.sh --cpus 1 --mem 1G \
+        --timeout 1800 -- ctest --test-dir build/default -L kernel --output-on-failure
+    then r=ok; else r=FAILED; status=1; fi
   else
     echo "kernel tier: the VM harness is unavailable; kernel tests will report SKIPPED:"
     echo "$prep" | tail -5
-    if ctest --test-dir build/default -L kernel --output-on-failure; then r="skipped (no VM)"; else r=FAILED; status=1; fi
+    if counted build/default/kernel.log ctest --test-dir build/default -L kernel --output-on-failure
+    then r="skipped (no VM)"; else r=FAILED; status=1; fi
   fi
   summary+=("kernel: $r ($(($(date +%s) - t0)) s)")
-fi
+}
+
+stage_package() {  # the Debian package of one build tree
+  local c=$1 t0 r log deb rc
+  echo "=== package of $c ==="
+  t0=$(date +%s)
+  log=build/$c/package.log
+  # ctest exits 0 for a skipped test; the summary then says why from the test output.
+  if ODO_PACKAGE_INSTALL=1 counted "$log" ctest --test-dir "build/$c" -L package \
+      --output-on-failure -V >/dev/null
+  then r=ok; else r=FAILED; status=1; fi
+  grep -E '^[0-9]+: (FAIL|SKIPPED|size|package|check_deb)' "$log" | cut -d' ' -f2- || true
+  grep -Eq '^[0-9]+: SKIPPED|check_deb .*SKIPPED' "$log" && r="$r (part skipped, see above)"
+  summary+=("package $c: $r ($(($(date +%s) - t0)) s)")
+  if [[ $c == default && ${ODO_FRESH_INSTALL:-1} == 1 ]]; then
+    # The amd64 package on a freshly bootstrapped Debian 12 (chroot): Depends from the mirror.
+    echo "=== fresh install (debootstrap chroot) ==="
+    t0=$(date +%s)
+    deb=$(ls -t build/default/diffodom_*_amd64.deb | head -1)
+    rc=0; tests/package/fresh_install.sh "$deb" || rc=$?
+    case $rc in 0) r=ok ;; 77) r="skipped (see above)"; n_skip=$((n_skip + 1)) ;;
+      *) r=FAILED; status=1; n_fail=$((n_fail + 1)) ;; esac
+    [[ $rc == 0 ]] && n_pass=$((n_pass + 1))
+    summary+=("fresh install amd64: $r ($(($(date +%s) - t0)) s)")
+  fi
+}
+
+for c in $configs; do
+  stage_config "$c"
+  if [[ $c == default ]]; then
+    [[ ${ODO_SOAK:-1} == 1 ]] && stage_soak
+    [[ ${ODO_KERNEL:-1} == 1 ]] && stage_kernel
+  fi
+done
 if [[ ${ODO_PACKAGES:-1} == 1 ]]; then
   for c in $configs; do
-    [[ $c == default || $c == cross-* ]] || continue
-    echo "=== package of $c ==="
-    t0=$(date +%s)
-    # ctest exits 0 for a skipped test; the summary then says why from the test output.
-    if ODO_PACKAGE_INSTALL=1 ctest --test-dir "build/$c" -L package --output-on-failure -V \
-        >"build/$c/package.log" 2>&1
-    then r=ok; else r=FAILED; status=1; fi
-    # Every check is in build/$c/package.log; show failures, skips, sizes and the count.
-    log=build/$c/package.log
-    grep -E '^[0-9]+: (FAIL|SKIPPED|size|package|check_deb)' "$log" | cut -d' ' -f2- || true
-    grep -Eq '^[0-9]+: SKIPPED|check_deb .*SKIPPED' "$log" && r="$r (part skipped, see above)"
-    summary+=("package $c: $r ($(($(date +%s) - t0)) s)")
-    if [[ $c == default && ${ODO_FRESH_INSTALL:-1} == 1 ]]; then
-      # The amd64 package on a freshly bootstrapped Debian 12 (chroot): Depends from the mirror.
-      echo "=== fresh install (debootstrap chroot) ==="
-      t0=$(date +%s)
-      deb=$(ls -t build/default/diffodom_*_amd64.deb | head -1)
-      rc=0; tests/package/fresh_install.sh "$deb" || rc=$?
-      case $rc in 0) r=ok ;; 77) r="skipped (see above)" ;; *) r=FAILED; status=1 ;; esac
-      summary+=("fresh install amd64: $r ($(($(date +%s) - t0)) s)")
-    fi
+    [[ $c == default || $c == cross-* ]] && stage_package "$c"
   done
 fi
-echo "=== summary ==="
+echo "=== summary ($(($(date +%s) - T_ALL)) s in all) ==="
 printf '%s\n' "${summary[@]}"
+echo "all stages: $n_pass passed, $n_fail failed, $n_skip skipped"
 exit $status

@@ -1,6 +1,8 @@
 #include "odo/firmware/config.hpp"
 
-#include <fstream>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <sstream>
 
 #include "odo/firmware/toml_reader.hpp"
@@ -115,11 +117,38 @@ void read_error_model(TableReader t, ErrorModelParams& k) {
   t.finish();
 }
 
+// first_non_ascii: the first byte >= 0x80 as "line N, column C (byte 0xXX)", or "" if none.
+// The config is plain ASCII: toml++ 3.3 (Debian 12) reaches __builtin_unreachable() on some
+// non-ASCII characters (upstream issues #190 and #295; found here by fuzz_config), so such a
+// file never reaches the TOML parser.
+std::string first_non_ascii(std::string_view text) {
+  int line = 1, column = 1;
+  for (const char ch : text) {
+    const auto byte = static_cast<unsigned char>(ch);
+    if (byte >= 0x80) {
+      char where[80];
+      std::snprintf(where, sizeof where, "%d: column %d: byte 0x%02X", line, column, byte);
+      return where;
+    }
+    if (ch == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return {};
+}
+
 }  // namespace
 
 Result<Config> parse_config(std::string_view text, std::string_view source) {
   Config c = default_config();
   c.source = std::string(source);
+  if (const std::string bad = first_non_ascii(text); !bad.empty()) {
+    return make_error(Errc::kParse, std::string(source) + ":" + bad +
+                                        " is not ASCII (the config file must be plain ASCII)");
+  }
   toml::table parsed;
   try {
     // toml++ reports syntax errors by exception; this is configure time, not the loop path.
@@ -146,11 +175,24 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
 }
 
 Result<Config> load_config(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return make_error(Errc::kNotFound, path + ": cannot open config file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_config(text.str(), path);
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) {
+    return make_error(Errc::kNotFound,
+                      path + ": cannot open config file (" + std::strerror(errno) + ")");
+  }
+  std::string text;
+  char buf[4096];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+  // A read error (e.g. the path is a directory: EISDIR) must not pass for an empty file, which
+  // would silently mean "all defaults".
+  const bool failed = std::ferror(f) != 0;
+  const int err = errno;
+  std::fclose(f);
+  if (failed) {
+    return make_error(Errc::kIo, path + ": cannot read config file (" + std::strerror(err) + ")");
+  }
+  return parse_config(text, path);
 }
 
 }  // namespace odo::fw

@@ -74,6 +74,21 @@ TEST(NormaliseReading, RejectsOutOfRange) {
   EXPECT_FALSE(normalise_reading(1LL << 24, 24).ok());
 }
 
+TEST(NormaliseReading, SixtyThreeBitsWithoutOverflow) {
+  // Regression (fuzz_replay): for 63 bits the unsigned range [0, 2^63 - 1] is every non-negative
+  // int64 and the signed range starts at -2^62; computing 2 * 2^62 overflowed (UBSan).
+  const std::int64_t kMax = INT64_MAX, kHalf = std::int64_t{1} << 62;
+  EXPECT_EQ(*normalise_reading(kMax, 63), -1);  // 2^63 - 1 is all 63 bits set: -1 signed
+  EXPECT_EQ(*normalise_reading(kHalf, 63), -kHalf);
+  EXPECT_EQ(*normalise_reading(-kHalf, 63), -kHalf);
+  EXPECT_EQ(*normalise_reading(4, 63), 4);
+  auto r = normalise_reading(-kHalf - 1, 63);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("[-4611686018427387904, 9223372036854775807]"),
+            std::string::npos)
+      << r.error().message;
+}
+
 TEST(CounterBits, RangeIsSixteenToSixtyFour) {
   EXPECT_TRUE(check_counter_bits(16).ok());
   EXPECT_TRUE(check_counter_bits(64).ok());

@@ -1,0 +1,166 @@
+// Fault matrix, "config with each kind of error": every kind of mistake a config file can hold is
+// rejected with a message naming the file, the line, the field and what was expected, and every
+// numeric setting is checked at both ends of its documented range (README, configuration
+// reference). The daemon turns each of these into exit status 2 (tests/cli/test_cli.sh).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "odo/firmware/config.hpp"
+
+namespace odo::fw {
+namespace {
+
+struct NumericKey {
+  const char* table;
+  const char* key;
+  const char* below;  // TOML literal just below the range
+  const char* above;  // just above
+  const char* range;  // as printed in the message
+};
+
+// Every numeric setting with its documented range (README "Configuration reference").
+constexpr NumericKey kNumeric[] = {
+    {"loop", "rate_hz", "49.9", "2000.5", "[50, 2000] Hz"},
+    {"loop", "status_period", "-0.1", "3601", "[0, 3600] s"},
+    {"robot", "wheel_diameter", "0.004", "5.1", "[0.005, 5] m"},
+    {"robot", "counts_per_rev", "0.5", "2e9", "[1, 1e+09] counts"},
+    {"robot", "gear_ratio", "0.0009", "10001", "[0.001, 10000]"},
+    {"robot", "wheelbase", "0.009", "20.5", "[0.01, 20] m"},
+    {"robot", "c_l", "0.49", "1.51", "[0.5, 1.5]"},
+    {"robot", "c_r", "0.49", "1.51", "[0.5, 1.5]"},
+    {"sim", "side", "0.09", "100.1", "[0.1, 100] m"},
+    {"sim", "speed", "0.009", "5.1", "[0.01, 5] m/s"},
+    {"sim", "turn_rate", "0.04", "10.1", "[0.05, 10] rad/s"},
+    {"sim", "pause", "-1", "61", "[0, 60] s"},
+};
+
+std::string doc(const NumericKey& k, const char* value) {
+  // The value sits on line 3 so that the line number in the message is checked too.
+  return std::string("# test\n[") + k.table + "]\n" + k.key + " = " + value + "\n";
+}
+
+void expect_error(const std::string& text, const std::string& expect) {
+  auto c = parse_config(text, "bad.toml");
+  ASSERT_FALSE(c.ok()) << text;
+  EXPECT_NE(c.error().message.find(expect), std::string::npos)
+      << "message: " << c.error().message << "\nexpected: " << expect;
+}
+
+TEST(ConfigErrors, EveryNumberBelowItsRange) {
+  for (const auto& k : kNumeric) {
+    expect_error(doc(k, k.below), std::string("bad.toml:3: ") + k.table + "." + k.key + " = " +
+                                      k.below + " is outside the allowed range " + k.range);
+  }
+}
+
+TEST(ConfigErrors, EveryNumberAboveItsRange) {
+  for (const auto& k : kNumeric) {
+    // 2e9 prints as 2e+09: compare up to the value.
+    expect_error(doc(k, k.above), std::string("bad.toml:3: ") + k.table + "." + k.key + " = ");
+    expect_error(doc(k, k.above), std::string("is outside the allowed range ") + k.range);
+  }
+}
+
+TEST(ConfigErrors, EveryNumberRejectsNanInfAndText) {
+  for (const auto& k : kNumeric) {
+    const std::string field = std::string("bad.toml:3: ") + k.table + "." + k.key;
+    expect_error(doc(k, "nan"), field + " = nan is outside the allowed range");
+    expect_error(doc(k, "inf"), field + " = inf is outside the allowed range");
+    expect_error(doc(k, "-inf"), field + " = -inf is outside the allowed range");
+    expect_error(doc(k, "\"1.0\""), field + " must be a number");
+    expect_error(doc(k, "true"), field + " must be a number");
+    expect_error(doc(k, "[1.0]"), field + " must be a number");
+    expect_error(doc(k, "1979-05-27"), field + " must be a number");
+  }
+}
+
+TEST(ConfigErrors, IntegerSettingRejectsFractionsAndRange) {
+  expect_error("[sim]\n\ncounter_bits = 32.0\n", "bad.toml:3: sim.counter_bits must be an integer");
+  expect_error("[sim]\ncounter_bits = 15\n",
+               "bad.toml:2: sim.counter_bits = 15 is outside the allowed range [16, 64]");
+  expect_error("[sim]\ncounter_bits = 65\n",
+               "bad.toml:2: sim.counter_bits = 65 is outside the allowed range [16, 64]");
+  expect_error("[sim]\ncounter_bits = \"32\"\n", "bad.toml:2: sim.counter_bits must be an integer");
+}
+
+TEST(ConfigErrors, ChoicesNameTheAllowedWords) {
+  expect_error("[encoder]\nbackend = \"Sim\"\n",
+               "bad.toml:2: encoder.backend = \"Sim\" is not one of: sim, hctl1100, gpio, can");
+  expect_error("[encoder]\nbackend = 1\n", "bad.toml:2: encoder.backend must be a string");
+  expect_error("[sim]\nrobot = \"labmate2\"\n",
+               "bad.toml:2: sim.robot = \"labmate2\" is not one of: labmate, nominal");
+  expect_error("[sim]\nscenario = \"circle\"\n",
+               "bad.toml:2: sim.scenario = \"circle\" is not one of: square-ccw, square-cw, "
+               "squares, idle");
+}
+
+TEST(ConfigErrors, UnknownKeysAndTablesEverywhere) {
+  for (const char* table : {"loop", "robot", "encoder", "sim"}) {
+    expect_error(std::string("[") + table + "]\n\nbogus = 1\n",
+                 std::string("bad.toml:3: ") + table + ".bogus is not a known setting (misspelt?)");
+  }
+  expect_error("rate_hz = 100\n", "bad.toml:1: rate_hz is not a known setting");
+  expect_error("[calibration]\nc_l = 1.0\n", "calibration is not a known setting");
+  expect_error("[loop.sub]\nx = 1\n", "loop.sub is not a known setting");
+}
+
+TEST(ConfigErrors, SectionOfTheWrongShape) {
+  expect_error("loop = 3\n", "bad.toml:1: loop must be a table");
+  expect_error("robot = [1, 2]\n", "bad.toml:1: robot must be a table");
+  expect_error("[[sim]]\nside = 1.0\n", "sim must be a table");
+}
+
+TEST(ConfigErrors, TomlSyntaxErrorsNameTheLine) {
+  expect_error("[loop]\nrate_hz = \n", "bad.toml:2: TOML syntax error");
+  expect_error("[loop]\nrate_hz = 100\nrate_hz = 200\n", "bad.toml:3: TOML syntax error");
+  expect_error("[loop]\n[loop]\n", "bad.toml:2: TOML syntax error");
+  expect_error("[sim]\nscenario = \"squares\n", "bad.toml:2: TOML syntax error");
+  expect_error("\n\n[robot\n", "bad.toml:3: TOML syntax error");
+  expect_error("[loop]\nrate_hz = 1_00_\n", "bad.toml:2: TOML syntax error");
+  expect_error(std::string("[loop]\nrate_hz = 100\x00\n", 22), "bad.toml:2: TOML syntax error");
+}
+
+TEST(ConfigErrors, NonAsciiNeverReachesTheTomlParser) {
+  // Regression (fuzz_config): U+2EFF (UTF-8 e2 bb bf) before a key made toml++ 3.3 reach
+  // __builtin_unreachable() (undefined behaviour; upstream issues #190, #295), as do U+00A7
+  // after a line-ending backslash and other characters. Any byte >= 0x80 is refused with its
+  // position before parsing ("rate_hz = 100 # caf" is 19 characters, the e-acute is column 20).
+  expect_error(
+      "\xe2\xbb\xbfl8np = {wh=\"idle\"",
+      "bad.toml:1: column 1: byte 0xE2 is not ASCII (the config file must be plain ASCII)");
+  expect_error("[sim]\nscenario = \"\"\"\\\n\xc2\xa7\"\"\"\n", "bad.toml:3: column 1: byte 0xC2");
+  expect_error("[loop]\nrate_hz = 100 # caf\xe9\n",
+               "bad.toml:2: column 20: byte 0xE9 is not ASCII");
+}
+
+TEST(ConfigErrors, FirstErrorWinsAndNothingIsHalfApplied) {
+  // Two mistakes: the first (line 2) is reported; no Config comes back at all, so nothing of a
+  // bad file can reach the loop.
+  auto c = parse_config("[loop]\nrate_hz = 1\n[robot]\nwheelbase = 99\n", "bad.toml");
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.error().message.find("bad.toml:2: loop.rate_hz"), std::string::npos)
+      << c.error().message;
+}
+
+TEST(ConfigErrors, FileMissingOrUnreadable) {
+  auto missing = load_config("/nonexistent/odometryd.toml");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_EQ(missing.error().message,
+            "/nonexistent/odometryd.toml: cannot open config file (No such file or directory)");
+  // A directory opens but cannot be read: an error, not an empty file meaning "all defaults"
+  // (it was the latter before this test).
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("odo_cfg_dir_" + std::to_string(::getpid()) + ".toml");
+  std::filesystem::create_directory(dir);
+  auto d = load_config(dir.string());
+  std::filesystem::remove(dir);
+  ASSERT_FALSE(d.ok());
+  EXPECT_EQ(d.error().message, dir.string() + ": cannot read config file (Is a directory)");
+}
+
+}  // namespace
+}  // namespace odo::fw
