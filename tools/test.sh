@@ -107,7 +107,7 @@ stage_package() {  # the Debian package of one build tree
       --output-on-failure -V >/dev/null
   then r=ok; else r=FAILED; status=1; fi
   grep -E '^[0-9]+: (FAIL|SKIPPED|size|package|check_deb)' "$log" | cut -d' ' -f2- || true
-  grep -Eq '^[0-9]+: SKIPPED|check_deb .*SKIPPED' "$log" && r="$r (part skipped, see above)"
+  if grep -Eq '^[0-9]+: SKIPPED|check_deb .*SKIPPED' "$log"; then r="$r (part skipped, see above)"; fi
   summary+=("package $c: $r ($(($(date +%s) - t0)) s)")
   if [[ $c == default && ${ODO_FRESH_INSTALL:-1} == 1 ]]; then
     # The amd64 package on a freshly bootstrapped Debian 12 (chroot): Depends from the mirror.
@@ -117,7 +117,7 @@ stage_package() {  # the Debian package of one build tree
     rc=0; tests/package/fresh_install.sh "$deb" || rc=$?
     case $rc in 0) r=ok ;; 77) r="skipped (see above)"; n_skip=$((n_skip + 1)) ;;
       *) r=FAILED; status=1; n_fail=$((n_fail + 1)) ;; esac
-    [[ $rc == 0 ]] && n_pass=$((n_pass + 1))
+    if [[ $rc == 0 ]]; then n_pass=$((n_pass + 1)); fi
     summary+=("fresh install amd64: $r ($(($(date +%s) - t0)) s)")
   fi
 }
@@ -125,13 +125,13 @@ stage_package() {  # the Debian package of one build tree
 for c in $configs; do
   stage_config "$c"
   if [[ $c == default ]]; then
-    [[ ${ODO_SOAK:-1} == 1 ]] && stage_soak
-    [[ ${ODO_KERNEL:-1} == 1 ]] && stage_kernel
+    if [[ ${ODO_SOAK:-1} == 1 ]]; then stage_soak; fi
+    if [[ ${ODO_KERNEL:-1} == 1 ]]; then stage_kernel; fi
   fi
 done
 if [[ ${ODO_PACKAGES:-1} == 1 ]]; then
   for c in $configs; do
-    [[ $c == default || $c == cross-* ]] && stage_package "$c"
+    if [[ $c == default || $c == cross-* ]]; then stage_package "$c"; fi
   done
 fi
 echo "=== summary ($(($(date +%s) - T_ALL)) s in all) ==="
