@@ -99,12 +99,14 @@ TEST(ConfigErrors, ChoicesNameTheAllowedWords) {
 }
 
 TEST(ConfigErrors, UnknownKeysAndTablesEverywhere) {
-  for (const char* table : {"loop", "robot", "encoder", "sim"}) {
+  for (const char* table : {"loop", "robot", "encoder", "sim", "realtime", "calibration",
+                            "hctl1100", "gpio", "error_model"}) {
     expect_error(std::string("[") + table + "]\n\nbogus = 1\n",
                  std::string("bad.toml:3: ") + table + ".bogus is not a known setting (misspelt?)");
   }
   expect_error("rate_hz = 100\n", "bad.toml:1: rate_hz is not a known setting");
-  expect_error("[calibration]\nc_l = 1.0\n", "calibration is not a known setting");
+  expect_error("[calibraton]\nstore = \"\"\n", "calibraton is not a known setting");
+  expect_error("[calibration]\nc_l = 1.0\n", "bad.toml:2: calibration.c_l is not a known setting");
   expect_error("[loop.sub]\nx = 1\n", "loop.sub is not a known setting");
 }
 
