@@ -39,6 +39,27 @@ std::vector<std::array<double, 2>> ellipse_points(const Cov3& c, int i, int j, d
   return pts;
 }
 
+// xml_escape: text content for the SVG (titles name "Chong & Kleeman").
+std::string xml_escape(const std::string& t) {
+  std::string out;
+  for (char ch : t) {
+    switch (ch) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      default:
+        out += ch;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string error_ellipse_svg(const std::vector<PoseError>& errors, const Cov3& predicted,
@@ -49,7 +70,8 @@ std::string error_ellipse_svg(const std::vector<PoseError>& errors, const Cov3& 
   s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
     << "\" font-family=\"sans-serif\" font-size=\"11\">\n"
     << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << kMargin << "\" y=\"18\" font-size=\"13\">" << title << "</text>\n"
+    << "<text x=\"" << kMargin << "\" y=\"18\" font-size=\"13\">" << xml_escape(title)
+    << "</text>\n"
     << "<text x=\"" << kMargin << "\" y=\"34\">dots: runs; solid: 95% ellipse of the sample; "
     << "dashed: 95% ellipse predicted by the closed form (both around the sample mean)</text>\n";
   for (int p = 0; p < 3; ++p) {

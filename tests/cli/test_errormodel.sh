@@ -35,8 +35,11 @@ check "validate svg: 3 panels x 2 ellipses" $?
 [ "$(wc -l <"$tmp/runs.csv")" = 301 ]; check "validate csv rows" $?
 
 # The run CSV feeds the fit.
-run "$ODOMCTL" errormodel validate --runs 400 --seed 11 --csv "$tmp/ob.csv" >/dev/null 2>&1
+run "$ODOMCTL" errormodel validate --runs 400 --seed 11 --csv "$tmp/ob.csv" --plot "$tmp/ob.svg" \
+  >/dev/null 2>&1
 check "validate outback exit 0" $?
+python3 -c "import sys, xml.dom.minidom as m; m.parse(sys.argv[1])" "$tmp/ob.svg"
+check "validate outback svg is well-formed XML" $?
 run "$ODOMCTL" errormodel fit "$tmp/ob.csv" --distance 10 --wheelbase 0.34 --json >"$tmp/out" 2>"$tmp/err"
 check "fit exit 0" $?
 python3 - "$tmp/out" <<'PY'
