@@ -1,0 +1,69 @@
+// SocketCanBus: a CanBus on a Linux SocketCAN interface (can0, vcan0, ...) through a raw socket
+// (PF_CAN, SOCK_RAW, CAN_RAW). Non-blocking both ways: a full transmit queue (ENOBUFS, EAGAIN)
+// or a link that is down drops the frame and says so; when the link comes back, sending resumes
+// by itself (an interface that vanished is re-opened by name, at most once per retry period).
+// Receive filters are installed in the kernel (CAN_RAW_FILTER), so frames the firmware does not
+// want never reach user space. Linux types stay in the .cpp.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "odo/hal/can_bus.hpp"
+#include "odo/hal/result.hpp"
+
+namespace odo::drivers {
+
+// CanFilter: a frame is received when (frame id & mask) == (id & mask) and the frame's
+// extended flag equals `extended` (as CAN_RAW_FILTER with CAN_EFF_FLAG in the mask).
+struct CanFilter {
+  std::uint32_t id = 0;
+  std::uint32_t mask = 0x7FF;
+  bool extended = false;
+};
+
+struct SocketCanOptions {
+  std::string interface = "can0";
+  // Receive filters; empty = receive nothing (a transmit-only socket).
+  std::vector<CanFilter> filters;
+  bool receive_own = false;    // also receive frames this socket sent (tests)
+  double reopen_period = 1.0;  // [s] between attempts to re-open a vanished interface
+  int rx_buffer_bytes = 0;     // SO_RCVBUF, 0 = kernel default
+};
+
+// SocketCanCounters: cumulative since open; read from the thread that sends/receives.
+struct SocketCanCounters {
+  std::uint64_t sent = 0;
+  std::uint64_t tx_queue_full = 0;  // dropped: ENOBUFS / EAGAIN
+  std::uint64_t tx_link_down = 0;   // dropped: ENETDOWN / ENXIO / ENODEV
+  std::uint64_t tx_errors = 0;      // dropped: any other errno
+  std::uint64_t received = 0;
+  std::uint64_t reopens = 0;  // successful re-opens after the interface vanished
+};
+
+class SocketCanBus final : public CanBus {
+ public:
+  ~SocketCanBus() override;
+  // open: binds a raw socket to the named interface; errors name the interface and the errno.
+  static Result<std::unique_ptr<SocketCanBus>> open(const SocketCanOptions& o);
+
+  CanTx send(const CanFrame& f) noexcept override;
+  // receive: the stamp is CLOCK_MONOTONIC at the time of the read [ns].
+  bool receive(CanFrame& out) noexcept override;
+
+  const SocketCanCounters& counters() const noexcept { return counters_; }
+  const std::string& interface() const noexcept { return opts_.interface; }
+
+ private:
+  explicit SocketCanBus(SocketCanOptions o);
+  Status reopen() noexcept;
+
+  SocketCanOptions opts_;
+  int fd_ = -1;
+  std::int64_t next_reopen_ns_ = 0;
+  SocketCanCounters counters_;
+};
+
+}  // namespace odo::drivers
