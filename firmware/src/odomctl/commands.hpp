@@ -16,5 +16,7 @@ void add_replay(CLI::App& app, int& exit_code);
 void add_calib(CLI::App& app, int& exit_code);
 // add_errormodel: `odomctl errormodel validate|fit` (Chong-Kleeman error model).
 void add_errormodel(CLI::App& app, int& exit_code);
+// add_umbmark: `odomctl umbmark compute|scale|simulate` (UMBmark calibration).
+void add_umbmark(CLI::App& app, int& exit_code);
 
 }  // namespace odo::ctl
