@@ -36,7 +36,7 @@ struct UmbmarkSimOptions {
 // The floor and reference of --noise paper (README "UMBmark calibration" shows the resulting
 // sigma): roughness bumps every ~2 cm with heights uniform in [0, kPaperRoughness], the
 // reference ("sonar calibrator") with standard deviations 2 mm and 0.4 deg.
-inline constexpr double kPaperRoughness = 0.0012;          // [m]
+inline constexpr double kPaperRoughness = 0.0013;          // [m]
 inline constexpr double kReferenceSigmaXy = 0.002;         // [m]
 inline constexpr double kReferenceSigmaTheta = 0.0069813;  // [rad] = 0.4 deg
 // Travel loss of one extended-UMBmark bump: the report's 0.44 deg per 10 mm bump on a LabMate
