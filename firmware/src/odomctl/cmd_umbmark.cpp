@@ -193,17 +193,6 @@ void add_scale(CLI::App& parent, int& exit_code) {
   });
 }
 
-bool write_file(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary);
-  f << text;
-  f.close();
-  if (!f) {
-    std::cerr << "odomctl umbmark simulate: " << path << ": cannot write\n";
-    return false;
-  }
-  return true;
-}
-
 // store_result: saves the final factors as a record (method umbmark-sim) in the store at `path`.
 bool store_result(const std::string& path, const fw::UmbmarkSimResult& r) {
   auto s = fw::open_calibration_store(path, "auto");
@@ -289,7 +278,7 @@ void add_simulate(CLI::App& parent, int& exit_code) {
       title << "UMBmark on the simulated " << o->sim.robot << ": " << o->sim.runs
             << " cw + ccw squares of " << o->sim.side << " m, noise " << o->sim.noise << ", seed "
             << o->sim.seed;
-      if (!write_file(o->plot, fw::umbmark_svg(*r, title.str()))) {
+      if (!write_output_file(o->plot, fw::umbmark_svg(*r, title.str()), "umbmark simulate")) {
         exit_code = kExitFailed;
         return;
       }
