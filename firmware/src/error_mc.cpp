@@ -6,6 +6,7 @@
 
 #include "odo/firmware/error_model_tools.hpp"
 #include "odo/firmware/loop.hpp"
+#include "odo/firmware/seed.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_encoder.hpp"
 #include "odo/sim/virtual_clock.hpp"
@@ -30,14 +31,6 @@ sim::Scenario make_path(const McOptions& o) {
   const double t = kArcRadius * kArcAngle / o.speed;
   const double q = o.wheelbase / (2.0 * kArcRadius);
   return {{t, w * (1.0 - q), w * (1.0 + q)}};
-}
-
-// seed_of: an independent 64-bit seed for run i (splitmix64 of seed and i).
-std::uint64_t seed_of(std::uint64_t seed, std::uint64_t i) {
-  std::uint64_t z = seed * 0x9E3779B97F4A7C15ULL + i + 0x632BE59BD9B4E019ULL;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31);
 }
 
 }  // namespace

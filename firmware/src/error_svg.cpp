@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "odo/firmware/error_model_tools.hpp"
+#include "odo/firmware/svg.hpp"
 
 namespace odo::fw {
 namespace {
@@ -37,27 +38,6 @@ std::vector<std::array<double, 2>> ellipse_points(const Cov3& c, int i, int j, d
         {mx + u * std::cos(phi) - v * std::sin(phi), my + u * std::sin(phi) + v * std::cos(phi)});
   }
   return pts;
-}
-
-// xml_escape: text content for the SVG (titles name "Chong & Kleeman").
-std::string xml_escape(const std::string& t) {
-  std::string out;
-  for (char ch : t) {
-    switch (ch) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      default:
-        out += ch;
-    }
-  }
-  return out;
 }
 
 }  // namespace

@@ -45,7 +45,7 @@ for bad in "--cl 1.3:c_l" "--cr nan:c_r" "--wheelbase 0:wheelbase" "--wheel-diam
   run "$ODOMCTL" calib set "${S[@]}" $opt >"$tmp/out" 2>"$tmp/err"
   rc=$?; [ $rc = 2 ]; check "set $opt exit 2 (got $rc)" $?
   grep -q "$field" "$tmp/err" && grep -q "allowed range" "$tmp/err"
-  check "set $opt names $field and range: $(cat "$tmp/err")" $?
+  st=$?; check "set $opt names $field and range: $(cat "$tmp/err")" $st
   cmp -s "$tmp/cal.bin" "$tmp/before.bin"; check "set $opt leaves the store untouched" $?
 done
 run "$ODOMCTL" calib set "${S[@]}" --cl abc >/dev/null 2>&1
@@ -59,7 +59,7 @@ cat >"$tmp/umb.json" <<'J'
  "alpha": 0.0012, "beta": -0.0004}
 J
 run "$ODOMCTL" calib import "${S[@]}" "$tmp/umb.json" >/dev/null 2>"$tmp/err"
-check "import umbmark exit 0 $(cat "$tmp/err")" $?
+st=$?; check "import umbmark exit 0 $(cat "$tmp/err")" $st
 run "$ODOMCTL" calib export "${S[@]}" >"$tmp/exp.json"
 check "export exit 0" $?
 [ "$(jget "$tmp/exp.json" wheelbase)" = 0.33702 ] && [ "$(jget "$tmp/exp.json" provenance.runs)" = 10 ] &&
@@ -82,7 +82,7 @@ echo '{"c_l": 0.5, "c_r": 1.0}' >"$tmp/bad.json"
 run "$ODOMCTL" calib import "${S[@]}" "$tmp/bad.json" >/dev/null 2>"$tmp/err"
 rc=$?; [ $rc = 2 ]; check "import out of range exit 2 (got $rc)" $?
 grep -q "bad.json: c_l = 0.5 is outside the allowed range \[0.9, 1.1\]" "$tmp/err"
-check "import names file, field, range: $(cat "$tmp/err")" $?
+st=$?; check "import names file, field, range: $(cat "$tmp/err")" $st
 echo '{"c_l": 0.99' >"$tmp/trunc.json"
 run "$ODOMCTL" calib import "${S[@]}" "$tmp/trunc.json" >/dev/null 2>&1
 rc=$?; [ $rc = 2 ]; check "import malformed JSON exit 2 (got $rc)" $?
@@ -94,7 +94,7 @@ run "$ODOMETRYD" --config "$tmp/d.toml" --virtual-time --duration 1 --json >"$tm
 check "odometryd with store exit 0" $?
 [ "$(jget "$tmp/out" calibration_state)" = 1 ]; check "odometryd calibration_state 1" $?
 grep -q "calibration $tmp/cal.bin (file): ok, sequence 4: c_l=0.99925" "$tmp/err"
-check "odometryd reports the store: $(grep calibration "$tmp/err")" $?
+st=$?; check "odometryd reports the store: $(grep calibration "$tmp/err")" $st
 if [ -z "${CROSS_EMULATOR:-}" ]; then
   "$ODOMETRYD" --config "$tmp/d.toml" --duration 4 >"$tmp/live" 2>&1 &
   pid=$!
@@ -105,7 +105,7 @@ if [ -z "${CROSS_EMULATOR:-}" ]; then
   kill -INT $pid; wait $pid
   check "odometryd survives SIGHUP and stops cleanly" $?
   grep -q "SIGHUP: calibration .*ok, sequence 5: c_l=0.997" "$tmp/live"
-  check "odometryd re-reads the store on SIGHUP: $(grep SIGHUP "$tmp/live")" $?
+  st=$?; check "odometryd re-reads the store on SIGHUP: $(grep SIGHUP "$tmp/live")" $st
 fi
 
 # reset: uncalibrated again; export refuses; odometryd runs nominal.

@@ -31,17 +31,6 @@ void print_table(std::ostream& out, const Cov3& predicted, const Cov3& sample) {
   out << "units: m^2, m^2, m rad; rad^2 (SI)\n";
 }
 
-bool write_file(const std::string& path, const std::string& text, const char* what) {
-  std::ofstream f(path, std::ios::binary);
-  f << text;
-  f.close();
-  if (!f) {
-    std::cerr << "odomctl errormodel " << what << ": " << path << ": cannot write\n";
-    return false;
-  }
-  return true;
-}
-
 void add_validate(CLI::App& parent, int& exit_code) {
   struct Opts {
     fw::McOptions mc;
@@ -83,10 +72,10 @@ void add_validate(CLI::App& parent, int& exit_code) {
       title << "Chong-Kleeman error model, " << r->runs
             << " runs: " << fw::path_description(o->mc.path) << "; k_L = " << o->mc.k.k_left
             << ", k_R = " << o->mc.k.k_right << " m^(1/2), b = " << o->mc.wheelbase << " m";
-      if (!write_file(
+      if (!write_output_file(
               o->plot,
               fw::error_ellipse_svg(r->errors, r->predicted, r->sample, r->mean, title.str()),
-              "validate")) {
+              "errormodel validate")) {
         exit_code = kExitFailed;
         return;
       }
@@ -94,7 +83,7 @@ void add_validate(CLI::App& parent, int& exit_code) {
     if (!o->csv.empty()) {
       std::ostringstream text;
       fw::write_run_errors(text, r->errors);
-      if (!write_file(o->csv, text.str(), "validate")) {
+      if (!write_output_file(o->csv, text.str(), "errormodel validate")) {
         exit_code = kExitFailed;
         return;
       }

@@ -2,6 +2,9 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <fstream>
+#include <iostream>
+#include <string>
 
 namespace odo::ctl {
 
@@ -10,11 +13,26 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailed = 1;
 inline constexpr int kExitBadInput = 2;
 
+// write_output_file: writes `text` to `path`; on failure says "odomctl <cmd>: <path>: cannot
+// write" on stderr and returns false.
+inline bool write_output_file(const std::string& path, const std::string& text, const char* cmd) {
+  std::ofstream f(path, std::ios::binary);
+  f << text;
+  f.close();
+  if (!f) {
+    std::cerr << "odomctl " << cmd << ": " << path << ": cannot write\n";
+    return false;
+  }
+  return true;
+}
+
 // add_replay: `odomctl replay` (integrate a log of raw counts).
 void add_replay(CLI::App& app, int& exit_code);
 // add_calib: `odomctl calib show|set|import|export|reset` (the calibration store).
 void add_calib(CLI::App& app, int& exit_code);
 // add_errormodel: `odomctl errormodel validate|fit` (Chong-Kleeman error model).
 void add_errormodel(CLI::App& app, int& exit_code);
+// add_umbmark: `odomctl umbmark compute|scale|simulate` (UMBmark calibration).
+void add_umbmark(CLI::App& app, int& exit_code);
 
 }  // namespace odo::ctl
