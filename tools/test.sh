@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # test.sh - set up and run the whole test suite (README, command 2; CI runs exactly this).
 # Builds and tests, in order:
-#   default     RelWithDebInfo: unit, sim, cli tiers
+#   default     RelWithDebInfo: unit, sim, cli tiers and the UMBmark noise study (label study)
 #   soak        the `soak` tier of the default build: 24 h of simulated driving with random
 #               faults in virtual time (ODO_SOAK=0 skips it)
 #   kernel      the `kernel` tier of the default build, inside a QEMU VM with Debian's kernel
@@ -60,6 +60,8 @@ stage_config() {  # build one configuration and run its ctest tiers
   cmake --preset "$c" >/dev/null
   if cmake --build --preset "$c" -j"$jobs"; then
     labels='unit|sim|cli'
+    # The UMBmark 20-seed noise study: seconds natively, so only in the native default build.
+    if [[ $c == default ]]; then labels='unit|sim|cli|study'; fi
     if [[ $c == fuzz ]]; then labels=fuzz; fi
     if counted "build/$c/ctest-tiers.log" ctest --preset "$c" -j"$jobs" --label-regex "$labels"
     then r=ok; else r=FAILED; status=1; fi
