@@ -172,6 +172,7 @@ TEST(SocketCan, FullTransmitQueueDropsAndCountsWithoutBlocking) {
   // vcan transmits synchronously, so its queue never fills by itself. A token-bucket qdisc of
   // 1 kbit/s holding one packet stands in for a slow controller: the kernel refuses the rest
   // with ENOBUFS (qdisc drop) or EAGAIN (socket send buffer), exactly as a busy can0 does.
+  run("modprobe sch_tbf 2>/dev/null");  // qdisc modules are not auto-loaded in the VM
   ASSERT_EQ(run("tc qdisc replace dev " + v.name + " root tbf rate 1kbit burst 64 limit 64"), 0);
   SocketCanOptions o;
   o.interface = v.name;
