@@ -31,6 +31,12 @@ bool CanFrameRing::push(const CanFrame& f) noexcept {
   return true;
 }
 
+void CanFrameRing::push_wait(const CanFrame& f) noexcept {
+  while (head_.load(std::memory_order_relaxed) - tail_.load(std::memory_order_acquire) > mask_)
+    std::this_thread::yield();
+  push(f);
+}
+
 bool CanFrameRing::pop(CanFrame& out) noexcept {
   const std::uint64_t t = tail_.load(std::memory_order_relaxed);
   if (t == head_.load(std::memory_order_acquire)) return false;
@@ -72,7 +78,10 @@ Result<std::unique_ptr<CanLogWriter>> CanLogWriter::open(const std::string& path
   if (f == nullptr)
     return make_error(
         Errc::kIo, path + ": cannot open the CAN log for writing (" + std::strerror(errno) + ")");
-  return std::unique_ptr<CanLogWriter>(new CanLogWriter(f, std::move(iface)));
+  std::unique_ptr<CanLogWriter> w(new CanLogWriter(f, std::move(iface)));
+  w->buffer_.resize(1 << 16);
+  std::setvbuf(f, w->buffer_.data(), _IOFBF, w->buffer_.size());
+  return w;
 }
 
 void CanLogWriter::start(std::int64_t epoch_ns) {
@@ -120,7 +129,7 @@ void CanBroadcaster::send(const CanFrame& f, std::int64_t loop_time) noexcept {
       if (log_ != nullptr && wire_ == nullptr) {
         CanFrame l = f;
         l.stamp = loop_time;
-        log_->push(l);
+        log_frame(l);
       }
       break;
     case CanTx::kQueueFull:
@@ -141,7 +150,7 @@ void CanBroadcaster::drain_wire(std::int64_t loop_time) noexcept {
   while (wire_->drain_tx(f)) {
     if (log_ != nullptr) {
       f.stamp = loop_time;
-      log_->push(f);
+      log_frame(f);
     }
   }
 }
@@ -260,7 +269,8 @@ CanLink::~CanLink() {
 }
 
 Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loop_hz,
-                                                 OdometryLoop& loop, const std::string& can_log) {
+                                                 OdometryLoop& loop, const std::string& can_log,
+                                                 bool virtual_time) {
   std::unique_ptr<CanLink> link(new CanLink());
   if (s.bus == "none") {
     if (!can_log.empty())
@@ -284,6 +294,7 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
   } else {
     auto port = std::make_unique<sim::SimCanPort>();
     wire = port.get();
+    link->sim_port_ = wire;
     link->bus_ = std::move(port);
     iface = "sim0";
   }
@@ -296,6 +307,7 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
   o.base_id = static_cast<std::uint32_t>(s.base_id);
   o.node_id = s.node_id;
   o.set_pose = s.set_pose;
+  o.lossless_log = virtual_time;
   auto div = [&](double hz) {
     const std::int64_t d = can::divisor_for(loop_hz, hz);
     return d > 0 ? static_cast<std::uint32_t>(d) : 0u;
@@ -321,9 +333,13 @@ void CanLink::start(std::int64_t epoch_ns) {
   if (log_) log_->start(epoch_ns);
 }
 
-void CanLink::finish(const LoopSnapshot& snap) {
-  bc_->send_final(snap);
+void CanLink::close_log() {
   if (log_) log_->stop();
+}
+
+void CanLink::finish(const LoopSnapshot& snap) {
+  send_final(snap);
+  close_log();
 }
 
 }  // namespace odo::fw

@@ -120,7 +120,7 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
   loop->add_observer(&cal_handover);
   // CAN pose broadcast ([can], --can-log): an observer after the calibration hand-over, so the
   // status frame carries this tick's calibration state.
-  auto can_link = CanLink::create(cfg->can, cfg->loop.rate_hz, *loop, o.can_log);
+  auto can_link = CanLink::create(cfg->can, cfg->loop.rate_hz, *loop, o.can_log, o.virtual_time);
   if (!can_link) {
     err << "odometryd: " << cfg->source << ": " << can_link.error().message << "\n";
     return 2;

@@ -32,6 +32,9 @@ class CanFrameRing {
   explicit CanFrameRing(std::size_t capacity_pow2 = 4096);
   // push: loop thread; false (and counted) when full.
   bool push(const CanFrame& f) noexcept;
+  // push_wait: loop thread in virtual time only (no deadlines to keep): waits for space, so a
+  // run faster than real time loses no frame from the log.
+  void push_wait(const CanFrame& f) noexcept;
   // pop: consumer thread; false when empty.
   bool pop(CanFrame& out) noexcept;
   std::uint64_t dropped() const noexcept { return dropped_.load(std::memory_order_relaxed); }
@@ -66,6 +69,7 @@ class CanLogWriter {
   CanLogWriter(std::FILE* f, std::string iface) : file_(f), iface_(std::move(iface)) {}
   void drain() noexcept;
   std::FILE* file_;
+  std::vector<char> buffer_;  // stdio buffer, allocated at open: fwrite never allocates
   std::string iface_;
   CanFrameRing ring_;
   std::int64_t epoch_ns_ = 0;
@@ -99,6 +103,7 @@ struct CanBroadcastOptions {
   CanDivisors div;
   bool set_pose = true;             // accept set-pose commands
   std::size_t max_rx_per_tick = 8;  // receive() calls per tick at most (a flood cannot stall us)
+  bool lossless_log = false;        // virtual time: wait for the log writer instead of dropping
 };
 
 class CanBroadcaster final : public TickObserver {
@@ -125,6 +130,12 @@ class CanBroadcaster final : public TickObserver {
   void send_status(const LoopSnapshot& s, bool stopping) noexcept;
   void send_timing(const LoopSnapshot& s) noexcept;
   void drain_wire(std::int64_t loop_time) noexcept;
+  void log_frame(const CanFrame& f) noexcept {
+    if (o_.lossless_log)
+      log_->push_wait(f);
+    else
+      log_->push(f);
+  }
   std::uint32_t id(can::Msg m) const noexcept { return can::frame_id(o_.base_id, o_.node_id, m); }
 
   CanBroadcastOptions o_;
@@ -145,19 +156,28 @@ class CanLink {
  public:
   ~CanLink();
   // create: null (and ok) for bus = "none" with no log; errors name the interface.
+  // virtual_time: the log waits for its writer rather than dropping (no deadlines to keep).
   static Result<std::unique_ptr<CanLink>> create(const CanSection& s, double loop_hz,
-                                                 OdometryLoop& loop, const std::string& can_log);
+                                                 OdometryLoop& loop, const std::string& can_log,
+                                                 bool virtual_time = false);
   // start: the log thread (call just before the loop runs).
   void start(std::int64_t epoch_ns);
-  // finish: final frames with the stopping status, then the log flushed and closed.
+  // send_final: final frames with the stopping status (loop thread, after run()).
+  void send_final(const LoopSnapshot& snap) noexcept { bc_->send_final(snap); }
+  // close_log: writes what is queued and closes the log (joins its thread).
+  void close_log();
+  // finish: send_final, then close_log.
   void finish(const LoopSnapshot& snap);
   const CanBroadcastCounters& counters() const noexcept { return bc_->counters(); }
   std::uint64_t log_written() const noexcept { return log_ ? log_->written() : 0; }
   std::uint64_t log_dropped() const noexcept { return log_ ? log_->ring().dropped() : 0; }
   const std::string& describe() const noexcept { return describe_; }
+  // sim_port: the simulated bus port (bus = "sim"), for tests that inject commands; else null.
+  sim::SimCanPort* sim_port() noexcept { return sim_port_; }
 
  private:
   CanLink() = default;
+  sim::SimCanPort* sim_port_ = nullptr;
   std::unique_ptr<CanBus> bus_;
   std::unique_ptr<CanLogWriter> log_;
   std::unique_ptr<CanBroadcaster> bc_;
