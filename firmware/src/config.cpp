@@ -129,10 +129,8 @@ void read_can(TableReader t, CanSection& s, double loop_hz) {
   s.base_id = static_cast<int>(t.integer("base_id", s.base_id, 0, 1024));
   if (s.base_id % 16 != 0)
     t.reject("base_id", "= " + std::to_string(s.base_id) + " must be a multiple of 16");
-  else if (!can::valid_addressing(static_cast<std::uint32_t>(s.base_id), s.node_id))
-    t.reject("node_id",
-             "= " + std::to_string(s.node_id) +
-                 " puts the node's ids above 0x7FF: base_id + 16 * node_id must be <= 2032");
+  // The ranges keep every node's block of 16 ids inside 11 bits.
+  static_assert(can::frame_id(1024, can::kMaxNodeId, can::Msg::kSetPose) + 7 <= 0x7FF);
   for (auto [key, rate] :
        {std::pair{"pose_hz", &s.pose_hz}, std::pair{"velocity_hz", &s.velocity_hz},
         std::pair{"uncertainty_hz", &s.uncertainty_hz}, std::pair{"status_hz", &s.status_hz},

@@ -17,4 +17,7 @@ void add_calib(CLI::App& app, int& exit_code);
 // add_errormodel: `odomctl errormodel validate|fit` (Chong-Kleeman error model).
 void add_errormodel(CLI::App& app, int& exit_code);
 
+// add_decode: `odomctl decode FILE [--csv]` (candump -L log of the CAN pose protocol).
+void add_decode(CLI::App& app, int& exit_code);
+
 }  // namespace odo::ctl
