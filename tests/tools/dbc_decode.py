@@ -3,11 +3,12 @@
 is not in Debian 12). It knows nothing of the firmware's source: it parses the DBC file's BO_,
 SG_ and VAL_ lines and decodes every frame of the log with them.
 
-usage: dbc_decode.py DBC LOG [--expect JSON_FILE] [--resolution-check]
+usage: dbc_decode.py DBC LOG [--expect JSON_FILE] [--series CSV_FILE]
 Prints one JSON object: frame counts per message, the last value of every signal, pose groups
 (complete, lost by sequence gaps, incomplete) and the final complete pose group.
 With --expect FILE (odometryd --json output): exit 1 unless the final pose group equals the
 daemon's final x, y, theta within half the DBC resolution (+1e-9), and every frame was known.
+With --series FILE: every complete pose group as CSV (time,seq,x,y,theta).
 """
 import json
 import math
@@ -68,6 +69,7 @@ def main(argv):
     final = None
     prev_seq = None
     out_of_range = []
+    series = []
     with open(argv[2], encoding='ascii') as f:
         for n, line in enumerate(f, 1):
             line = line.strip()
@@ -89,6 +91,7 @@ def main(argv):
                 if v < s['min'] - 1e-9 or v > s['max'] + 1e-9:
                     out_of_range.append(f"{n}: {s['name']}={v}")
             last.update(vals)
+            stamp = float(m.group(1) + '.' + m.group(2))
             if msg['name'] in ('PoseX', 'PoseYTheta'):
                 seq = int(vals['seq'])
                 g = groups.setdefault(seq, {})
@@ -102,6 +105,7 @@ def main(argv):
                 if {'x', 'y', 'theta'} <= g.keys():
                     complete += 1
                     final = dict(g, seq=seq)
+                    series.append((stamp, seq, g['x'], g['y'], g['theta']))
                     del groups[seq]
     incomplete = len(groups)
     res = {'frames': sum(counts.values()) + unknown, 'unknown_frames': unknown,
@@ -125,6 +129,11 @@ def main(argv):
         res['compare'] = res_pose
         if unknown or out_of_range or not final:
             rc = 1
+    if '--series' in argv:
+        with open(argv[argv.index('--series') + 1], 'w') as f:
+            f.write('time,seq,x,y,theta\n')
+            for row in series:
+                f.write('%.6f,%d,%.4f,%.4f,%.4f\n' % row)
     print(json.dumps(res, sort_keys=True))
     return rc
 
