@@ -160,8 +160,7 @@ void CanBroadcaster::poll_commands() noexcept {
   for (std::size_t i = 0; i < o_.max_rx_per_tick && bus_->receive(f); ++i) {
     int node = 0;
     can::Msg m{};
-    if (!o_.set_pose || !can::split_id(o_.base_id, f, node, m) || node != o_.node_id ||
-        m != can::Msg::kSetPose)
+    if (!can::split_id(o_.base_id, f, node, m) || node != o_.node_id || m != can::Msg::kSetPose)
       continue;  // not for us (a SocketCAN filter normally keeps these out)
     can::SetPoseCmd cmd;
     if (!can::decode_set_pose(f, cmd)) {
@@ -240,7 +239,7 @@ void CanBroadcaster::on_tick(LoopSnapshot& s) noexcept {
   // receiver that sees the ack also sees the new pose in the same or a later pose group.
   ack_ = static_cast<std::uint8_t>(ack_ + pending_ack_);
   pending_ack_ = 0;
-  poll_commands();
+  if (o_.set_pose) poll_commands();
   const std::uint64_t t = s.tick;
   const CanDivisors& d = o_.div;
   if (d.pose != 0 && t % d.pose == 0) send_pose_group(s);
