@@ -5,6 +5,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "odo/firmware/can_protocol.hpp"
 #include "odo/firmware/toml_reader.hpp"
 
 namespace odo::fw {
@@ -117,6 +118,37 @@ void read_error_model(TableReader t, ErrorModelParams& k) {
   t.finish();
 }
 
+// ---- [can] (CAN pose broadcast) ----
+void read_can(TableReader t, CanSection& s, double loop_hz) {
+  s.bus = t.choice("bus", s.bus, {"sim", "socketcan", "none"});
+  s.interface = t.string("interface", s.interface);
+  if (s.interface.empty() || s.interface.size() > 15)
+    t.reject("interface",
+             "= \"" + s.interface + "\" must be 1..15 characters (a network interface)");
+  s.node_id = static_cast<int>(t.integer("node_id", s.node_id, 0, can::kMaxNodeId));
+  s.base_id = static_cast<int>(t.integer("base_id", s.base_id, 0, 1024));
+  if (s.base_id % 16 != 0)
+    t.reject("base_id", "= " + std::to_string(s.base_id) + " must be a multiple of 16");
+  // The ranges keep every node's block of 16 ids inside 11 bits.
+  static_assert(can::frame_id(1024, can::kMaxNodeId, can::Msg::kSetPose) + 7 <= 0x7FF);
+  for (auto [key, rate] :
+       {std::pair{"pose_hz", &s.pose_hz}, std::pair{"velocity_hz", &s.velocity_hz},
+        std::pair{"uncertainty_hz", &s.uncertainty_hz}, std::pair{"status_hz", &s.status_hz},
+        std::pair{"timing_hz", &s.timing_hz}}) {
+    *rate = t.number(key, *rate, 0.0, 2000.0, "Hz");
+    if (t.ok() && can::divisor_for(loop_hz, *rate) < 0) {
+      std::ostringstream o;
+      o << "= " << *rate
+        << " Hz must be 0 or loop.rate_hz / n for a whole n >= 1 (loop.rate_hz = " << loop_hz
+        << ")";
+      t.reject(key, o.str());
+    }
+  }
+  s.set_pose = t.boolean("set_pose", s.set_pose);
+  s.reopen_period = t.number("reopen_period", s.reopen_period, 0.01, 60.0, "s");
+  t.finish();
+}
+
 // first_non_ascii: the first byte >= 0x80 as "line N, column C (byte 0xXX)", or "" if none.
 // The config is plain ASCII: toml++ 3.3 (Debian 12) reaches __builtin_unreachable() on some
 // non-ASCII characters (upstream issues #190 and #295; found here by fuzz_config), so such a
@@ -169,6 +201,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_hctl1100(root.sub("hctl1100"), c.hctl1100);
   read_gpio(root.sub("gpio"), c.gpio);
   read_error_model(root.sub("error_model"), c.error_model);
+  read_can(root.sub("can"), c.can, c.loop.rate_hz);
   root.finish();
   if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
   return c;

@@ -1,5 +1,7 @@
 #include "odo/firmware/daemon.hpp"
 
+#include <time.h>
+
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -14,6 +16,7 @@
 
 #include "odo/firmware/calibration_io.hpp"
 #include "odo/firmware/calibration_reload.hpp"
+#include "odo/firmware/can_broadcast.hpp"
 #include "odo/firmware/config.hpp"
 #include "odo/firmware/loop.hpp"
 #include "odo/firmware/realtime_setup.hpp"
@@ -115,6 +118,14 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
   CalibrationHandover cal_handover(cal.state);
   cal_handover.attach(loop.get());
   loop->add_observer(&cal_handover);
+  // CAN pose broadcast ([can], --can-log): an observer after the calibration hand-over, so the
+  // status frame carries this tick's calibration state.
+  auto can_link = CanLink::create(cfg->can, cfg->loop.rate_hz, *loop, o.can_log, o.virtual_time);
+  if (!can_link) {
+    err << "odometryd: " << cfg->source << ": " << can_link.error().message << "\n";
+    return 2;
+  }
+  std::unique_ptr<CanLink> can = std::move(can_link).value();
   CalibrationReloader reloader(cal_handover, cfg->robot, cfg->calibration.store,
                                cfg->calibration.backend, log);
   if (o.reload != nullptr) reloader.start(*o.reload);
@@ -125,6 +136,7 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
       << "odometryd: kinematics: Dn=" << p.wheel_diameter << " m, Ce=" << p.counts_per_rev
       << ", n=" << p.gear_ratio << ", b=" << p.wheelbase << " m, c_l=" << p.c_l << ", c_r=" << p.c_r
       << (cal.state == 1 ? " (calibrated)\n" : " (nominal values from the config)\n")
+      << "odometryd: can: " << (can ? can->describe() : std::string("off")) << "\n"
       << "odometryd: loop " << cfg->loop.rate_hz << " Hz on "
       << (o.virtual_time ? "virtual time" : "CLOCK_MONOTONIC") << std::endl;
 
@@ -181,7 +193,14 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
     return 1;
   }
   watchdog->start();
+  if (can) {
+    timespec wall{};
+    clock_gettime(CLOCK_REALTIME, &wall);
+    can->start(static_cast<std::int64_t>(wall.tv_sec) * kNsPerSecond + wall.tv_nsec);
+  }
   loop->run(from_seconds(duration), stop);
+  // Clean stop (signal or end of --duration): the final pose and a status frame that says so.
+  if (can) can->finish(loop->snapshot());
   watchdog->stop();
   reloader.stop();
   stop_status();
@@ -228,6 +247,17 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
     j["stale_events"] = s.encoder_counters.stale_events;
     j["read_errors"] = s.encoder_counters.read_errors;
     j["calibration_state"] = s.calibration_state;
+    if (can) {
+      const CanBroadcastCounters& c = can->counters();
+      j["can"] = {{"sent", c.sent},
+                  {"dropped_queue_full", c.dropped_queue_full},
+                  {"dropped_link_down", c.dropped_link_down},
+                  {"dropped_error", c.dropped_error},
+                  {"set_pose_applied", c.set_pose_applied},
+                  {"set_pose_rejected", c.set_pose_rejected},
+                  {"log_written", can->log_written()},
+                  {"log_dropped", can->log_dropped()}};
+    }
     if (s.has_truth) {
       j["truth"] = {{"x", s.truth.x}, {"y", s.truth.y}, {"theta", wrap_angle(s.truth.theta)}};
       j["position_error"] = position_error(s);

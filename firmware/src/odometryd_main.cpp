@@ -28,6 +28,9 @@ int main(int argc, char** argv) {
   app.add_flag("--virtual-time", o.virtual_time,
                "run the same loop on a virtual clock as fast as possible (simulation only)");
   app.add_flag("--json", o.json, "print one JSON object with the final state at exit");
+  app.add_option("--can-log", o.can_log,
+                 "write every CAN frame sent to FILE in candump -L format (also with the "
+                 "simulated bus)");
   app.add_flag("--quiet", o.quiet, "no status lines");
   app.add_flag("--stats", o.stats,
                "print wake-up latency and compute time statistics (min, mean, p99, p99.9, max) "

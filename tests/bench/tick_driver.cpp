@@ -1,21 +1,27 @@
 // tick_driver: runs N loop ticks for instruction counting with callgrind
-// (tools/callgrind_tick.sh). Usage: tick_driver sim|counting N
+// (tools/callgrind_tick.sh). Usage: tick_driver sim|counting N [all]
 //   sim       the simulated robot on a long arc (as BM_LoopTick)
 //   counting  a counter-register encoder (as BM_LoopTickFirmwareOnly)
+// The CAN broadcaster is attached as in odometryd with the simulated bus: default rates at
+// 1 kHz (pose and velocity every 20th tick, uncertainty and status every 100th, timing every
+// 1000th), the wire drained every tick; `all` sends every message on every tick (worst case).
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
 
 #include "counting_encoder.hpp"
+#include "odo/firmware/can_broadcast.hpp"
 #include "odo/firmware/loop.hpp"
 #include "odo/sim/robot.hpp"
+#include "odo/sim/sim_can_bus.hpp"
 #include "odo/sim/sim_encoder.hpp"
 #include "odo/sim/virtual_clock.hpp"
 
 int main(int argc, char** argv) {
-  if (argc != 3 || (std::strcmp(argv[1], "sim") != 0 && std::strcmp(argv[1], "counting") != 0)) {
-    std::fprintf(stderr, "usage: tick_driver sim|counting N\n");
+  if (argc < 3 || argc > 4 || (argc == 4 && std::strcmp(argv[3], "all") != 0) ||
+      (std::strcmp(argv[1], "sim") != 0 && std::strcmp(argv[1], "counting") != 0)) {
+    std::fprintf(stderr, "usage: tick_driver sim|counting N [all]\n");
     return 2;
   }
   const long n = std::atol(argv[2]);
@@ -31,10 +37,17 @@ int main(int argc, char** argv) {
                                               : static_cast<odo::EncoderSource&>(count_enc);
   odo::sim::VirtualClock clock;
   auto loop = odo::fw::OdometryLoop::create(odo::fw::LoopConfig{1000.0}, k, enc, clock).value();
+  odo::sim::SimCanPort port;
+  odo::fw::CanBroadcastOptions co;
+  co.div = argc == 4 ? odo::fw::CanDivisors{1, 1, 1, 1, 1}
+                     : odo::fw::CanDivisors{20, 20, 100, 100, 1000};
+  odo::fw::CanBroadcaster can(co, port, loop.get(), &port, nullptr);
+  loop->add_observer(&can);
   loop->start();
   for (long i = 0; i < n; ++i) loop->tick();
   const odo::Pose2& p = loop->odometry().pose();
-  std::printf("ticks=%llu x=%.6f y=%.6f theta=%.6f\n",
-              static_cast<unsigned long long>(loop->stats().ticks), p.x, p.y, p.theta);
+  std::printf("ticks=%llu x=%.6f y=%.6f theta=%.6f can_sent=%llu\n",
+              static_cast<unsigned long long>(loop->stats().ticks), p.x, p.y, p.theta,
+              static_cast<unsigned long long>(can.counters().sent));
   return 0;
 }

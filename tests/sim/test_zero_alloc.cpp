@@ -8,9 +8,12 @@
 #include <memory>
 #include <new>
 
+#include "odo/firmware/can_broadcast.hpp"
+#include "odo/firmware/can_protocol.hpp"
 #include "odo/firmware/config.hpp"
 #include "odo/firmware/loop.hpp"
 #include "odo/firmware/rig.hpp"
+#include "odo/sim/sim_can_bus.hpp"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define ODO_COUNT_MALLOC 0
@@ -299,6 +302,13 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   auto loop = fw::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
   ASSERT_NE(rig->truth_observer(), nullptr);
   loop->add_observer(rig->truth_observer());
+  // The CAN broadcast at the default rates on the simulated bus, with the candump log (its
+  // writer thread formats and writes frames while the window is open) and set-pose commands.
+  const std::string can_log = ::testing::TempDir() + "zero_alloc_can.log";
+  auto can = fw::CanLink::create(cfg.can, cfg.loop.rate_hz, *loop, can_log);
+  ASSERT_TRUE(can.ok()) << can.error().message;
+  ASSERT_NE((*can)->sim_port(), nullptr);
+  (*can)->start(0);
   loop->start();
 
   constexpr std::uint64_t kTicks = 200'000;  // 200 s at 1 kHz: both squares, then standstill
@@ -310,13 +320,30 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
       loop->tick();
       // The status thread's side of the hand-over too, now and then.
       if ((i & 1023) == 0 && loop->snapshots().latest(reader)) ++published;
+      if (i == 150'000) {  // a set-pose command (reset to zero) arrives on the bus
+        CanFrame cmd;
+        fw::can::encode_set_pose(
+            fw::can::frame_id(fw::can::kDefaultBaseId, cfg.can.node_id, fw::can::Msg::kSetPose),
+            fw::can::SetPoseCmd{true, 0, 0, 0}, cmd);
+        (*can)->sim_port()->inject(cmd);
+      }
     }
+    (*can)->send_final(loop->snapshot());  // the clean-stop frames: no allocation either
     w.disarm();
+    (*can)->close_log();  // joins the writer thread and closes the file: frees, off the loop path
     EXPECT_EQ(g_allocs.load(), 0u) << "heap allocations during " << kTicks << " ticks";
     EXPECT_EQ(g_frees.load(), 0u) << "heap deallocations during " << kTicks << " ticks";
   }
-  // It really ran: every tick counted, motion integrated, statistics kept.
+  // It really ran: every tick counted, motion integrated, statistics kept, frames sent.
   EXPECT_EQ(loop->stats().ticks, kTicks);
+  // 50 + 50 + 50 + 10 + 10 + 1 frames per second of loop time, plus the six final frames.
+  EXPECT_EQ((*can)->counters().sent, 171u * (kTicks / 1000) + 6u);
+  EXPECT_EQ((*can)->counters().dropped(), 0u);
+  EXPECT_EQ((*can)->counters().set_pose_applied, 1u);
+  // The writer runs on wall time and the loop here is faster than real time: what the ring
+  // could not hold is counted, never waited for.
+  EXPECT_EQ((*can)->log_written() + (*can)->log_dropped(), (*can)->counters().sent);
+  EXPECT_GT((*can)->log_written(), 4096u);
   EXPECT_GT(published, 100u);
   ASSERT_LT(rig->scenario_duration(), 199.0);
   EXPECT_NEAR(loop->odometry().distance(), 32.0, 0.2);  // two 4 m squares: 32 m of legs

@@ -36,6 +36,12 @@ constexpr NumericKey kNumeric[] = {
     {"sim", "speed", "0.009", "5.1", "[0.01, 5] m/s"},
     {"sim", "turn_rate", "0.04", "10.1", "[0.05, 10] rad/s"},
     {"sim", "pause", "-1", "61", "[0, 60] s"},
+    {"can", "pose_hz", "-0.1", "2000.5", "[0, 2000] Hz"},
+    {"can", "velocity_hz", "-0.1", "2000.5", "[0, 2000] Hz"},
+    {"can", "uncertainty_hz", "-0.1", "2000.5", "[0, 2000] Hz"},
+    {"can", "status_hz", "-0.1", "2000.5", "[0, 2000] Hz"},
+    {"can", "timing_hz", "-0.1", "2000.5", "[0, 2000] Hz"},
+    {"can", "reopen_period", "0.009", "60.1", "[0.01, 60] s"},
 };
 
 std::string doc(const NumericKey& k, const char* value) {
@@ -98,9 +104,42 @@ TEST(ConfigErrors, ChoicesNameTheAllowedWords) {
                "squares, idle");
 }
 
+// [can]: integers, choices, the interface name, addressing and rates that must divide the loop.
+TEST(ConfigErrors, CanSection) {
+  expect_error("[can]\nnode_id = 64\n",
+               "bad.toml:2: can.node_id = 64 is outside the allowed range [0, 63]");
+  expect_error("[can]\nnode_id = -1\n",
+               "bad.toml:2: can.node_id = -1 is outside the allowed range [0, 63]");
+  expect_error("[can]\nnode_id = 1.5\n", "bad.toml:2: can.node_id must be an integer");
+  expect_error("[can]\nbase_id = 1040\n",
+               "bad.toml:2: can.base_id = 1040 is outside the allowed range [0, 1024]");
+  expect_error("[can]\nbase_id = -16\n",
+               "bad.toml:2: can.base_id = -16 is outside the allowed range [0, 1024]");
+  expect_error("[can]\nbase_id = 1032\n", "bad.toml:2: can.base_id = 1032 is outside");
+  expect_error("[can]\n\nbase_id = 520\n",
+               "bad.toml:3: can.base_id = 520 must be a multiple of 16");
+  expect_error("[can]\nbus = \"slcan\"\n",
+               "bad.toml:2: can.bus = \"slcan\" is not one of: sim, socketcan, none");
+  expect_error("[can]\ninterface = \"\"\n", "bad.toml:2: can.interface = \"\" must be 1..15");
+  expect_error("[can]\ninterface = \"a_very_long_name0\"\n",
+               "bad.toml:2: can.interface = \"a_very_long_name0\" must be 1..15 characters");
+  expect_error("[can]\nset_pose = 1\n", "bad.toml:2: can.set_pose must be true or false");
+  // Rates: 0 (off) or the loop rate divided by a whole number.
+  expect_error("[can]\npose_hz = 30\n",
+               "bad.toml:2: can.pose_hz = 30 Hz must be 0 or loop.rate_hz / n for a whole n >= 1 "
+               "(loop.rate_hz = 100)");
+  expect_error("[loop]\nrate_hz = 200\n[can]\nstatus_hz = 300\n",
+               "bad.toml:4: can.status_hz = 300 Hz must be 0 or loop.rate_hz / n");
+  for (const char* ok : {"[can]\npose_hz = 0\n", "[can]\npose_hz = 100\n",
+                         "[loop]\nrate_hz = 200\n[can]\npose_hz = 40\ntiming_hz = 0.5\n",
+                         "[can]\nbus = \"none\"\n", "[can]\nbase_id = 0\nnode_id = 63\n"}) {
+    EXPECT_TRUE(parse_config(ok, "ok.toml").ok()) << ok;
+  }
+}
+
 TEST(ConfigErrors, UnknownKeysAndTablesEverywhere) {
   for (const char* table : {"loop", "robot", "encoder", "sim", "realtime", "calibration",
-                            "hctl1100", "gpio", "error_model"}) {
+                            "hctl1100", "gpio", "error_model", "can"}) {
     expect_error(std::string("[") + table + "]\n\nbogus = 1\n",
                  std::string("bad.toml:3: ") + table + ".bogus is not a known setting (misspelt?)");
   }

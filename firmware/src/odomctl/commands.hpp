@@ -35,4 +35,7 @@ void add_errormodel(CLI::App& app, int& exit_code);
 // add_umbmark: `odomctl umbmark compute|scale|simulate` (UMBmark calibration).
 void add_umbmark(CLI::App& app, int& exit_code);
 
+// add_decode: `odomctl decode FILE [--csv]` (candump -L log of the CAN pose protocol).
+void add_decode(CLI::App& app, int& exit_code);
+
 }  // namespace odo::ctl

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   odo::ctl::add_calib(app, exit_code);
   odo::ctl::add_errormodel(app, exit_code);
   odo::ctl::add_umbmark(app, exit_code);
+  odo::ctl::add_decode(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -86,6 +86,21 @@ struct CalibrationSection {
   std::string backend = "auto";                              // auto | file | nvmem | mtd
 };
 
+// [can]: the CAN pose broadcast (README "CAN protocol"). Rates must divide the loop rate.
+struct CanSection {
+  std::string bus = "sim";         // sim (simulated bus) | socketcan | none
+  std::string interface = "can0";  // bus = "socketcan": the SocketCAN interface
+  int node_id = 1;                 // 0..63: frame ids = base_id + 16 * node_id + message
+  int base_id = 0x400;             // 0..1024, multiple of 16, base_id + 16 * node_id <= 0x7F0
+  double pose_hz = 50.0;           // [Hz] PoseX + PoseYTheta; 0 = off
+  double velocity_hz = 50.0;       // [Hz]
+  double uncertainty_hz = 10.0;    // [Hz]
+  double status_hz = 10.0;         // [Hz]
+  double timing_hz = 1.0;          // [Hz]
+  bool set_pose = true;            // accept set-pose commands addressed to node_id
+  double reopen_period = 1.0;      // [s] 0.01..60: retry period when the interface vanished
+};
+
 struct Config {
   std::string source = "<built-in>";  // file the config came from
   LoopSection loop;
@@ -97,6 +112,7 @@ struct Config {
   Hctl1100Section hctl1100;
   GpioSection gpio;
   ErrorModelParams error_model;  // [error_model]: Chong-Kleeman k_L, k_R [m^(1/2)]
+  CanSection can;
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.

@@ -15,6 +15,7 @@ struct DaemonOptions {
   bool json = false;                    // one JSON object on stdout at exit
   bool quiet = false;                   // no status lines
   bool stats = false;                   // timing statistics table at exit
+  std::string can_log;                  // --can-log: every frame sent, candump -L format
   std::atomic<bool>* reload = nullptr;  // set (e.g. by SIGHUP) to re-read the calibration store
 };
 

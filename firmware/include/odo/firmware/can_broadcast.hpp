@@ -1,0 +1,187 @@
+// CAN pose broadcast (issue 10): a TickObserver that encodes the protocol's frames at their
+// configured rates and sends them through a CanBus without ever blocking, takes set-pose
+// commands addressed to this node, and (optionally) hands every frame sent to a candump-format
+// log written by a thread of its own. README "CAN protocol" documents the frames.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <cstdio>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "odo/firmware/can_protocol.hpp"
+#include "odo/firmware/config.hpp"
+#include "odo/firmware/loop.hpp"
+#include "odo/hal/can_bus.hpp"
+#include "odo/hal/result.hpp"
+
+namespace odo::sim {
+class SimCanPort;
+}
+
+namespace odo::fw {
+
+// CanFrameRing: single-producer (loop thread) single-consumer (log thread) ring of frames,
+// allocated once; a full ring drops the frame and counts it.
+class CanFrameRing {
+ public:
+  explicit CanFrameRing(std::size_t capacity_pow2 = 4096);
+  // push: loop thread; false (and counted) when full.
+  bool push(const CanFrame& f) noexcept;
+  // push_wait: loop thread in virtual time only (no deadlines to keep): waits for space, so a
+  // run faster than real time loses no frame from the log.
+  void push_wait(const CanFrame& f) noexcept;
+  // pop: consumer thread; false when empty.
+  bool pop(CanFrame& out) noexcept;
+  std::uint64_t dropped() const noexcept { return dropped_.load(std::memory_order_relaxed); }
+
+ private:
+  std::vector<CanFrame> buf_;
+  std::size_t mask_;
+  std::atomic<std::uint64_t> head_{0};  // next write (producer)
+  std::atomic<std::uint64_t> tail_{0};  // next read (consumer)
+  std::atomic<std::uint64_t> dropped_{0};
+};
+
+// format_candump_line: "(sec.usec) iface ID#HEX\n" of candump -L into buf; returns the length.
+std::size_t format_candump_line(char* buf, std::size_t size, std::int64_t wall_ns,
+                                const char* iface, const CanFrame& f) noexcept;
+
+// CanLogWriter: drains a CanFrameRing into a candump -L file from its own thread (every 20 ms),
+// so the loop never does file I/O. Frame stamps are loop time [ns]; the wall-clock time of loop
+// time zero is added.
+class CanLogWriter {
+ public:
+  ~CanLogWriter();
+  static Result<std::unique_ptr<CanLogWriter>> open(const std::string& path, std::string iface);
+  CanFrameRing& ring() noexcept { return ring_; }
+  // start: the thread; epoch_ns = CLOCK_REALTIME at loop time zero [ns].
+  void start(std::int64_t epoch_ns);
+  // stop: joins the thread after writing everything queued; closes the file.
+  void stop();
+  std::uint64_t written() const noexcept { return written_; }
+
+ private:
+  CanLogWriter(std::FILE* f, std::string iface) : file_(f), iface_(std::move(iface)) {}
+  void drain() noexcept;
+  std::FILE* file_;
+  std::vector<char> buffer_;  // stdio buffer, allocated at open: fwrite never allocates
+  std::string iface_;
+  CanFrameRing ring_;
+  std::int64_t epoch_ns_ = 0;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+  std::uint64_t written_ = 0;
+};
+
+// Transmit and command counters; written by the loop thread, read after the run (or for the
+// status frame on the loop thread).
+struct CanBroadcastCounters {
+  std::uint64_t sent = 0;
+  std::uint64_t dropped_queue_full = 0;
+  std::uint64_t dropped_link_down = 0;
+  std::uint64_t dropped_error = 0;
+  std::uint64_t set_pose_applied = 0;   // commands handed to the loop
+  std::uint64_t set_pose_rejected = 0;  // for this node but malformed (length, theta range)
+  std::uint64_t dropped() const noexcept {
+    return dropped_queue_full + dropped_link_down + dropped_error;
+  }
+};
+
+// Per-message rates as divisors of the loop rate (send on ticks where tick % div == 0; 0 = off).
+struct CanDivisors {
+  std::uint32_t pose = 0, velocity = 0, uncertainty = 0, status = 0, timing = 0;
+};
+
+struct CanBroadcastOptions {
+  std::uint32_t base_id = can::kDefaultBaseId;
+  int node_id = can::kDefaultNodeId;
+  CanDivisors div;
+  bool set_pose = true;             // accept set-pose commands
+  std::size_t max_rx_per_tick = 8;  // receive() calls per tick at most (a flood cannot stall us)
+  bool lossless_log = false;        // virtual time: wait for the log writer instead of dropping
+};
+
+class CanBroadcaster final : public TickObserver {
+ public:
+  // bus: where frames go; loop: receives set-pose requests (may be null: commands ignored);
+  // wire: the simulated port to drain every tick (null for a real bus); log: optional ring.
+  CanBroadcaster(const CanBroadcastOptions& o, CanBus& bus, OdometryLoop* loop,
+                 sim::SimCanPort* wire, CanFrameRing* log) noexcept;
+
+  void on_tick(LoopSnapshot& snap) noexcept override;
+  // send_final: the final pose group, velocity, uncertainty, timing and a status frame with the
+  // stopping flag (clean stop); call on the loop thread after run() returned.
+  void send_final(const LoopSnapshot& snap) noexcept;
+
+  const CanBroadcastCounters& counters() const noexcept { return c_; }
+  std::uint8_t seq() const noexcept { return seq_; }
+
+ private:
+  void poll_commands() noexcept;
+  void send(const CanFrame& f, std::int64_t loop_time) noexcept;
+  void send_pose_group(const LoopSnapshot& s) noexcept;
+  void send_velocity(const LoopSnapshot& s) noexcept;
+  void send_uncertainty(const LoopSnapshot& s) noexcept;
+  void send_status(const LoopSnapshot& s, bool stopping) noexcept;
+  void send_timing(const LoopSnapshot& s) noexcept;
+  void drain_wire(std::int64_t loop_time) noexcept;
+  void log_frame(const CanFrame& f) noexcept {
+    if (o_.lossless_log)
+      log_->push_wait(f);
+    else
+      log_->push(f);
+  }
+  std::uint32_t id(can::Msg m) const noexcept { return can::frame_id(o_.base_id, o_.node_id, m); }
+
+  CanBroadcastOptions o_;
+  CanBus* bus_;
+  OdometryLoop* loop_;
+  sim::SimCanPort* wire_;
+  CanFrameRing* log_;
+  CanBroadcastCounters c_;
+  std::uint8_t seq_ = 0;  // pose group counter (first group: 0)
+  bool sent_any_pose_ = false;
+  std::uint8_t ack_ = 0;           // set-pose commands applied (mod 256), in the status frame
+  std::uint32_t pending_ack_ = 0;  // requested this tick, applied at the next one
+};
+
+// CanLink: the [can] section wired up: the bus (simulated port or SocketCAN), the broadcaster
+// registered on the loop, the optional candump log. Built at configure time.
+class CanLink {
+ public:
+  ~CanLink();
+  // create: null (and ok) for bus = "none" with no log; errors name the interface.
+  // virtual_time: the log waits for its writer rather than dropping (no deadlines to keep).
+  static Result<std::unique_ptr<CanLink>> create(const CanSection& s, double loop_hz,
+                                                 OdometryLoop& loop, const std::string& can_log,
+                                                 bool virtual_time = false);
+  // start: the log thread (call just before the loop runs).
+  void start(std::int64_t epoch_ns);
+  // send_final: final frames with the stopping status (loop thread, after run()).
+  void send_final(const LoopSnapshot& snap) noexcept { bc_->send_final(snap); }
+  // close_log: writes what is queued and closes the log (joins its thread).
+  void close_log();
+  // finish: send_final, then close_log.
+  void finish(const LoopSnapshot& snap);
+  const CanBroadcastCounters& counters() const noexcept { return bc_->counters(); }
+  std::uint64_t log_written() const noexcept { return log_ ? log_->written() : 0; }
+  std::uint64_t log_dropped() const noexcept { return log_ ? log_->ring().dropped() : 0; }
+  const std::string& describe() const noexcept { return describe_; }
+  // sim_port: the simulated bus port (bus = "sim"), for tests that inject commands; else null.
+  sim::SimCanPort* sim_port() noexcept { return sim_port_; }
+
+ private:
+  CanLink() = default;
+  sim::SimCanPort* sim_port_ = nullptr;
+  std::unique_ptr<CanBus> bus_;
+  std::unique_ptr<CanLogWriter> log_;
+  std::unique_ptr<CanBroadcaster> bc_;
+  std::string describe_;
+};
+
+}  // namespace odo::fw

@@ -1,0 +1,344 @@
+#include "odo/firmware/can_broadcast.hpp"
+
+#include <time.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "odo/drivers/socketcan_bus.hpp"
+#include "odo/sim/sim_can_bus.hpp"
+
+namespace odo::fw {
+
+// ---- CanFrameRing ----
+
+CanFrameRing::CanFrameRing(std::size_t capacity_pow2) {
+  std::size_t n = 1;
+  while (n < capacity_pow2) n <<= 1;
+  buf_.resize(n);
+  mask_ = n - 1;
+}
+
+bool CanFrameRing::push(const CanFrame& f) noexcept {
+  const std::uint64_t h = head_.load(std::memory_order_relaxed);
+  if (h - tail_.load(std::memory_order_acquire) > mask_) {
+    dropped_.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
+  buf_[h & mask_] = f;
+  head_.store(h + 1, std::memory_order_release);
+  return true;
+}
+
+void CanFrameRing::push_wait(const CanFrame& f) noexcept {
+  while (head_.load(std::memory_order_relaxed) - tail_.load(std::memory_order_acquire) > mask_)
+    std::this_thread::yield();
+  push(f);
+}
+
+bool CanFrameRing::pop(CanFrame& out) noexcept {
+  const std::uint64_t t = tail_.load(std::memory_order_relaxed);
+  if (t == head_.load(std::memory_order_acquire)) return false;
+  out = buf_[t & mask_];
+  tail_.store(t + 1, std::memory_order_release);
+  return true;
+}
+
+// ---- candump -L log ----
+
+std::size_t format_candump_line(char* buf, std::size_t size, std::int64_t wall_ns,
+                                const char* iface, const CanFrame& f) noexcept {
+  const long long sec = wall_ns / 1'000'000'000;
+  const long long usec = (wall_ns % 1'000'000'000) / 1000;
+  int n = f.extended ? std::snprintf(buf, size, "(%lld.%06lld) %s %08X#", sec, usec, iface,
+                                     static_cast<unsigned>(f.id & 0x1FFFFFFFu))
+                     : std::snprintf(buf, size, "(%lld.%06lld) %s %03X#", sec, usec, iface,
+                                     static_cast<unsigned>(f.id & 0x7FFu));
+  if (n < 0 || static_cast<std::size_t>(n) >= size) return 0;
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  const std::size_t len = f.len > 8 ? 8 : f.len;
+  if (static_cast<std::size_t>(n) + 2 * len + 2 > size) return 0;
+  for (std::size_t i = 0; i < len; ++i) {
+    buf[n++] = kHex[f.data[i] >> 4];
+    buf[n++] = kHex[f.data[i] & 0xF];
+  }
+  buf[n++] = '\n';
+  buf[n] = '\0';
+  return static_cast<std::size_t>(n);
+}
+
+CanLogWriter::~CanLogWriter() {
+  stop();
+}
+
+Result<std::unique_ptr<CanLogWriter>> CanLogWriter::open(const std::string& path,
+                                                         std::string iface) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr)
+    return make_error(
+        Errc::kIo, path + ": cannot open the CAN log for writing (" + std::strerror(errno) + ")");
+  std::unique_ptr<CanLogWriter> w(new CanLogWriter(f, std::move(iface)));
+  w->buffer_.resize(1 << 16);
+  std::setvbuf(f, w->buffer_.data(), _IOFBF, w->buffer_.size());
+  return w;
+}
+
+void CanLogWriter::start(std::int64_t epoch_ns) {
+  epoch_ns_ = epoch_ns;
+  thread_ = std::thread([this] {
+    while (!stop_.load(std::memory_order_acquire)) {
+      drain();
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+}
+
+void CanLogWriter::drain() noexcept {
+  CanFrame f;
+  char line[96];
+  while (ring_.pop(f)) {
+    const std::size_t n =
+        format_candump_line(line, sizeof line, epoch_ns_ + f.stamp, iface_.c_str(), f);
+    if (n > 0 && std::fwrite(line, 1, n, file_) == n) ++written_;
+  }
+}
+
+void CanLogWriter::stop() {
+  stop_.store(true, std::memory_order_release);
+  if (thread_.joinable()) thread_.join();
+  if (file_ != nullptr) {
+    drain();
+    std::fclose(file_);
+    file_ = nullptr;
+  }
+}
+
+// ---- CanBroadcaster ----
+
+CanBroadcaster::CanBroadcaster(const CanBroadcastOptions& o, CanBus& bus, OdometryLoop* loop,
+                               sim::SimCanPort* wire, CanFrameRing* log) noexcept
+    : o_(o), bus_(&bus), loop_(loop), wire_(wire), log_(log) {}
+
+void CanBroadcaster::send(const CanFrame& f, std::int64_t loop_time) noexcept {
+  switch (bus_->send(f)) {
+    case CanTx::kSent:
+      ++c_.sent;
+      // A real bus: the frame is on its way, log it now. The simulated bus logs what its wire
+      // takes (drain_wire).
+      if (log_ != nullptr && wire_ == nullptr) {
+        CanFrame l = f;
+        l.stamp = loop_time;
+        log_frame(l);
+      }
+      break;
+    case CanTx::kQueueFull:
+      ++c_.dropped_queue_full;
+      break;
+    case CanTx::kLinkDown:
+      ++c_.dropped_link_down;
+      break;
+    case CanTx::kError:
+      ++c_.dropped_error;
+      break;
+  }
+}
+
+void CanBroadcaster::drain_wire(std::int64_t loop_time) noexcept {
+  if (wire_ == nullptr) return;
+  CanFrame f;
+  while (wire_->drain_tx(f)) {
+    if (log_ != nullptr) {
+      f.stamp = loop_time;
+      log_frame(f);
+    }
+  }
+}
+
+void CanBroadcaster::poll_commands() noexcept {
+  CanFrame f;
+  for (std::size_t i = 0; i < o_.max_rx_per_tick && bus_->receive(f); ++i) {
+    int node = 0;
+    can::Msg m{};
+    if (!can::split_id(o_.base_id, f, node, m) || node != o_.node_id || m != can::Msg::kSetPose)
+      continue;  // not for us (a SocketCAN filter normally keeps these out)
+    can::SetPoseCmd cmd;
+    if (!can::decode_set_pose(f, cmd)) {
+      ++c_.set_pose_rejected;
+      continue;
+    }
+    if (loop_ != nullptr) loop_->request_pose(Pose2{cmd.x, cmd.y, cmd.theta});
+    ++c_.set_pose_applied;
+    ++pending_ack_;
+  }
+}
+
+void CanBroadcaster::send_pose_group(const LoopSnapshot& s) noexcept {
+  if (sent_any_pose_) ++seq_;
+  sent_any_pose_ = true;
+  const can::PoseMsg p{s.pose.x, s.pose.y, s.pose.theta, seq_};
+  CanFrame f;
+  can::encode_pose_x(id(can::Msg::kPoseX), p, f);
+  send(f, s.loop_time);
+  can::encode_pose_y_theta(id(can::Msg::kPoseYTheta), p, f);
+  send(f, s.loop_time);
+}
+
+void CanBroadcaster::send_velocity(const LoopSnapshot& s) noexcept {
+  CanFrame f;
+  can::encode_velocity(id(can::Msg::kVelocity), can::VelocityMsg{s.v, s.w, seq_}, f);
+  send(f, s.loop_time);
+}
+
+void CanBroadcaster::send_uncertainty(const LoopSnapshot& s) noexcept {
+  can::UncertaintyMsg u;
+  u.seq = seq_;
+  if (s.has_cov) {
+    u.sigma_x = std::sqrt(std::max(0.0, s.cov[0]));
+    u.sigma_y = std::sqrt(std::max(0.0, s.cov[4]));
+    u.sigma_theta = std::sqrt(std::max(0.0, s.cov[8]));
+    const double sxy = u.sigma_x * u.sigma_y;
+    u.rho_xy = sxy > 0.0 ? s.cov[1] / sxy : 0.0;
+  } else {
+    u.sigma_x = u.sigma_y = u.sigma_theta = std::nan("");  // unknown: sent as the maximum
+  }
+  CanFrame f;
+  can::encode_uncertainty(id(can::Msg::kUncertainty), u, f);
+  send(f, s.loop_time);
+}
+
+void CanBroadcaster::send_status(const LoopSnapshot& s, bool stopping) noexcept {
+  can::StatusMsg m;
+  m.encoder_flags = static_cast<std::uint8_t>(s.encoder_flags & 0xFFu);
+  m.calibration_state = s.calibration_state;
+  m.stopping = stopping;
+  m.set_pose_ack = ack_;
+  m.missed_deadlines = s.stats.missed_deadlines > 0xFFFFFFFFu
+                           ? 0xFFFFFFFFu
+                           : static_cast<std::uint32_t>(s.stats.missed_deadlines);
+  m.uptime = to_seconds(s.loop_time);
+  CanFrame f;
+  can::encode_status(id(can::Msg::kStatus), m, f);
+  send(f, s.loop_time);
+}
+
+void CanBroadcaster::send_timing(const LoopSnapshot& s) noexcept {
+  can::TimingMsg t;
+  t.wakeup_p99 = to_seconds(s.stats.wakeup_latency.p99);
+  t.wakeup_max = to_seconds(s.stats.wakeup_latency_max);
+  t.compute_max = to_seconds(s.stats.compute_max);
+  const std::uint64_t d = c_.dropped();
+  t.tx_dropped = d > 0xFFFFFFFFu ? 0xFFFFFFFFu : static_cast<std::uint32_t>(d);
+  CanFrame f;
+  can::encode_timing(id(can::Msg::kTiming), t, f);
+  send(f, s.loop_time);
+}
+
+void CanBroadcaster::on_tick(LoopSnapshot& s) noexcept {
+  // Commands taken last tick were applied at the start of this one: acknowledge them now, so a
+  // receiver that sees the ack also sees the new pose in the same or a later pose group.
+  ack_ = static_cast<std::uint8_t>(ack_ + pending_ack_);
+  pending_ack_ = 0;
+  if (o_.set_pose) poll_commands();
+  const std::uint64_t t = s.tick;
+  const CanDivisors& d = o_.div;
+  if (d.pose != 0 && t % d.pose == 0) send_pose_group(s);
+  if (d.velocity != 0 && t % d.velocity == 0) send_velocity(s);
+  if (d.uncertainty != 0 && t % d.uncertainty == 0) send_uncertainty(s);
+  if (d.status != 0 && t % d.status == 0) send_status(s, false);
+  if (d.timing != 0 && t % d.timing == 0) send_timing(s);
+  drain_wire(s.loop_time);
+}
+
+void CanBroadcaster::send_final(const LoopSnapshot& s) noexcept {
+  ack_ = static_cast<std::uint8_t>(ack_ + pending_ack_);
+  pending_ack_ = 0;
+  send_pose_group(s);
+  send_velocity(s);
+  send_uncertainty(s);
+  send_timing(s);
+  send_status(s, true);
+  drain_wire(s.loop_time);
+}
+
+// ---- CanLink ----
+
+CanLink::~CanLink() {
+  if (log_) log_->stop();
+}
+
+Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loop_hz,
+                                                 OdometryLoop& loop, const std::string& can_log,
+                                                 bool virtual_time) {
+  std::unique_ptr<CanLink> link(new CanLink());
+  if (s.bus == "none") {
+    if (!can_log.empty())
+      return make_error(Errc::kInvalidArgument, "--can-log needs a CAN bus: [can] bus is \"none\"");
+    return std::unique_ptr<CanLink>();
+  }
+  sim::SimCanPort* wire = nullptr;
+  std::string iface;
+  if (s.bus == "socketcan") {
+    drivers::SocketCanOptions so;
+    so.interface = s.interface;
+    so.reopen_period = s.reopen_period;
+    if (s.set_pose)
+      so.filters.push_back(drivers::CanFilter{
+          can::frame_id(static_cast<std::uint32_t>(s.base_id), s.node_id, can::Msg::kSetPose),
+          0x7FF, false});
+    auto bus = drivers::SocketCanBus::open(so);
+    if (!bus) return std::move(bus).error();
+    link->bus_ = std::move(bus).value();
+    iface = s.interface;
+  } else {
+    auto port = std::make_unique<sim::SimCanPort>();
+    wire = port.get();
+    link->sim_port_ = wire;
+    link->bus_ = std::move(port);
+    iface = "sim0";
+  }
+  if (!can_log.empty()) {
+    auto w = CanLogWriter::open(can_log, iface);
+    if (!w) return std::move(w).error();
+    link->log_ = std::move(w).value();
+  }
+  CanBroadcastOptions o;
+  o.base_id = static_cast<std::uint32_t>(s.base_id);
+  o.node_id = s.node_id;
+  o.set_pose = s.set_pose;
+  o.lossless_log = virtual_time;
+  auto div = [&](double hz) {
+    const std::int64_t d = can::divisor_for(loop_hz, hz);
+    return d > 0 ? static_cast<std::uint32_t>(d) : 0u;
+  };
+  o.div = CanDivisors{div(s.pose_hz), div(s.velocity_hz), div(s.uncertainty_hz), div(s.status_hz),
+                      div(s.timing_hz)};
+  link->bc_ = std::make_unique<CanBroadcaster>(o, *link->bus_, &loop, wire,
+                                               link->log_ ? &link->log_->ring() : nullptr);
+  if (!loop.add_observer(link->bc_.get()))
+    return make_error(Errc::kInvalidArgument, "can: too many loop observers");
+  char idtxt[16];
+  std::snprintf(idtxt, sizeof idtxt, "0x%03X",
+                can::frame_id(o.base_id, o.node_id, can::Msg::kPoseX));
+  link->describe_ =
+      (s.bus == "socketcan" ? "SocketCAN " + s.interface : std::string("simulated bus")) +
+      ", node " + std::to_string(s.node_id) + ", ids from " + idtxt +
+      (s.set_pose ? ", set-pose on" : ", set-pose off") +
+      (can_log.empty() ? std::string() : ", log " + can_log);
+  return link;
+}
+
+void CanLink::start(std::int64_t epoch_ns) {
+  if (log_) log_->start(epoch_ns);
+}
+
+void CanLink::close_log() {
+  if (log_) log_->stop();
+}
+
+void CanLink::finish(const LoopSnapshot& snap) {
+  send_final(snap);
+  close_log();
+}
+
+}  // namespace odo::fw

@@ -1,0 +1,230 @@
+// CAN broadcast on the simulated bus (sim tier, virtual time). Fault matrix rows "CAN link down"
+// and "full CAN transmit queue": frames are dropped and counted, the loop keeps ticking on time,
+// broadcasting resumes by itself. Also: set-pose commands, the stopping status, sequence counters.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "odo/firmware/can_broadcast.hpp"
+#include "odo/firmware/can_protocol.hpp"
+#include "odo/firmware/config.hpp"
+#include "odo/firmware/loop.hpp"
+#include "odo/firmware/rig.hpp"
+#include "odo/sim/sim_can_bus.hpp"
+
+namespace odo::test {
+namespace {
+
+using fw::can::Msg;
+
+// Bench: the daemon's simulated rig and loop at 100 Hz with a broadcaster on a SimCanPort.
+struct Bench {
+  explicit Bench(const std::string& scenario = "square-ccw", std::size_t tx_cap = 64,
+                 bool drain = true)
+      : cfg(make_cfg(scenario)),
+        kin(*Kinematics::create(cfg.robot)),
+        rig(std::move(fw::Rig::create(cfg, kin, true).value())),
+        loop(fw::OdometryLoop::create(fw::LoopConfig{100.0}, kin, rig.encoder(), rig.clock())
+                 .value()),
+        port(tx_cap, 16),
+        bc(opts(), port, loop.get(), drain ? &port : nullptr, &ring) {
+    loop->add_observer(&bc);
+    loop->start();
+  }
+  static fw::Config make_cfg(const std::string& scenario) {
+    fw::Config c = fw::default_config();
+    c.sim.scenario = scenario;
+    c.sim.robot = "nominal";
+    return c;
+  }
+  static fw::CanBroadcastOptions opts() {
+    fw::CanBroadcastOptions o;
+    o.div = fw::CanDivisors{2, 2, 10, 10, 100};  // the default rates at 100 Hz
+    return o;
+  }
+  // ticks: runs n ticks; returns the frames the wire took (through the log ring).
+  std::vector<CanFrame> ticks(int n) {
+    for (int i = 0; i < n; ++i) loop->tick();
+    return wire_frames();
+  }
+  std::vector<CanFrame> wire_frames() {
+    std::vector<CanFrame> out;
+    CanFrame f;
+    while (ring.pop(f)) out.push_back(f);
+    return out;
+  }
+  fw::Config cfg;
+  Kinematics kin;
+  fw::Rig rig;
+  std::unique_ptr<fw::OdometryLoop> loop;
+  sim::SimCanPort port;
+  fw::CanFrameRing ring{1 << 14};
+  fw::CanBroadcaster bc;
+};
+
+std::uint32_t id(Msg m) {
+  return fw::can::frame_id(0x400, 1, m);
+}
+
+std::vector<std::uint8_t> pose_seqs(const std::vector<CanFrame>& fs) {
+  std::vector<std::uint8_t> s;
+  for (const auto& f : fs)
+    if (f.id == id(Msg::kPoseX)) s.push_back(f.data[7]);
+  return s;
+}
+
+TEST(CanBroadcast, FramesAtTheirRatesAndPoseGroupsShareTheirSequence) {
+  Bench b;
+  const auto fs = b.ticks(100);
+  std::size_t n[16] = {};
+  for (const auto& f : fs) ++n[f.id - 0x410];
+  // 100 ticks (1..100): every 2nd -> 50, every 10th -> 10, every 100th -> 1.
+  EXPECT_EQ(n[0], 50u);
+  EXPECT_EQ(n[1], 50u);
+  EXPECT_EQ(n[2], 50u);
+  EXPECT_EQ(n[3], 10u);
+  EXPECT_EQ(n[4], 10u);
+  EXPECT_EQ(n[5], 1u);
+  // PoseX is immediately followed by PoseYTheta with the same seq; seq steps by one.
+  for (std::size_t i = 0; i + 1 < fs.size(); ++i) {
+    if (fs[i].id != id(Msg::kPoseX)) continue;
+    EXPECT_EQ(fs[i + 1].id, id(Msg::kPoseYTheta));
+    EXPECT_EQ(fs[i + 1].data[7], fs[i].data[7]);
+  }
+  const auto seqs = pose_seqs(fs);
+  for (std::size_t i = 1; i < seqs.size(); ++i)
+    EXPECT_EQ(static_cast<std::uint8_t>(seqs[i - 1] + 1), seqs[i]);
+  EXPECT_EQ(b.bc.counters().sent, fs.size());
+  EXPECT_EQ(b.bc.counters().dropped(), 0u);
+}
+
+TEST(CanBroadcast, LinkDownDropsCountsKeepsTheLoopAndResumes) {
+  Bench b;
+  const auto before = b.ticks(50);
+  const std::uint8_t last_seq = pose_seqs(before).back();
+  b.port.set_link_up(false);
+  const auto during = b.ticks(200);
+  EXPECT_TRUE(during.empty());
+  const auto& c = b.bc.counters();
+  EXPECT_GT(c.dropped_link_down, 0u);
+  EXPECT_EQ(c.dropped_link_down, b.port.counters().tx_down);  // every refusal counted once
+  EXPECT_EQ(c.dropped_queue_full + c.dropped_error, 0u);
+  // The loop kept its rate: every tick ran, none missed.
+  EXPECT_EQ(b.loop->stats().ticks, 250u);
+  EXPECT_EQ(b.loop->stats().missed_deadlines, 0u);
+  b.port.set_link_up(true);
+  const auto after = b.ticks(50);
+  ASSERT_FALSE(after.empty());
+  // The sequence counter ran on while the link was down: a receiver sees the gap (100 groups
+  // lost in 200 ticks) and knows frames were lost.
+  const auto seqs = pose_seqs(after);
+  EXPECT_EQ(static_cast<std::uint8_t>(seqs.front() - last_seq), 101);
+  // The Timing frame reports the drops (every 100th tick; tick 300 is in `after`).
+  bool timing_seen = false;
+  for (const auto& f : after) {
+    if (f.id != id(Msg::kTiming)) continue;
+    fw::can::TimingMsg t;
+    ASSERT_TRUE(fw::can::decode_timing(f, t));
+    EXPECT_EQ(t.tx_dropped, c.dropped_link_down);
+    timing_seen = true;
+  }
+  EXPECT_TRUE(timing_seen);
+}
+
+TEST(CanBroadcast, FullTransmitQueueDropsCountsAndNeverBlocks) {
+  Bench b("square-ccw", /*tx_cap=*/8, /*drain=*/false);  // nobody takes frames off the bus
+  b.ticks(100);
+  const auto& c = b.bc.counters();
+  EXPECT_EQ(c.sent, 8u);
+  EXPECT_GT(c.dropped_queue_full, 100u);
+  EXPECT_EQ(c.dropped_queue_full, b.port.counters().tx_full);
+  EXPECT_EQ(b.loop->stats().ticks, 100u);
+  EXPECT_EQ(b.loop->stats().missed_deadlines, 0u);
+  // The bus frees up: sending resumes at the next tick.
+  CanFrame f;
+  while (b.port.drain_tx(f)) {
+  }
+  const std::uint64_t sent_before = c.sent;
+  b.ticks(2);
+  EXPECT_GT(c.sent, sent_before);
+}
+
+CanFrame set_pose_frame(int node, double x, double y, double th, bool reset = false) {
+  CanFrame f;
+  fw::can::encode_set_pose(fw::can::frame_id(0x400, node, Msg::kSetPose),
+                           fw::can::SetPoseCmd{reset, x, y, th}, f);
+  return f;
+}
+
+std::uint8_t last_ack(const std::vector<CanFrame>& fs) {
+  std::uint8_t ack = 0;
+  for (const auto& f : fs) {
+    fw::can::StatusMsg s;
+    if (f.id == id(Msg::kStatus) && fw::can::decode_status(f, s)) ack = s.set_pose_ack;
+  }
+  return ack;
+}
+
+TEST(CanBroadcast, SetPoseAppliesAtTheNextTickAndIsAcknowledged) {
+  Bench b("idle");
+  b.ticks(9);
+  ASSERT_TRUE(b.port.inject(set_pose_frame(2, 9, 9, 0)));          // another node: ignored
+  ASSERT_TRUE(b.port.inject(set_pose_frame(1, 1.5, -2.25, 0.5)));  // ours
+  b.loop->tick();                                                  // tick 10: command read
+  EXPECT_EQ(b.loop->snapshot().pose.x, 0.0);                       // not yet
+  auto fs = b.wire_frames();
+  EXPECT_EQ(last_ack(fs), 0);  // the status at tick 10 does not claim it yet
+  fs = b.ticks(10);            // ticks 11..20
+  EXPECT_NEAR(b.loop->snapshot().pose.x, 1.5, 1e-12);
+  EXPECT_NEAR(b.loop->snapshot().pose.y, -2.25, 1e-12);
+  EXPECT_NEAR(b.loop->snapshot().pose.theta, 0.5, 1e-12);
+  EXPECT_EQ(last_ack(fs), 1);
+  // The broadcast pose follows.
+  double x = 0;
+  std::uint8_t seq = 0;
+  ASSERT_TRUE(fw::can::decode_pose_x(fs[0], x, seq));
+  EXPECT_NEAR(x, 1.5, fw::can::kPosScale / 2);
+  // Reset (DLC 0), then a malformed command (DLC 3): rejected and counted.
+  ASSERT_TRUE(b.port.inject(set_pose_frame(1, 0, 0, 0, true)));
+  CanFrame bad = set_pose_frame(1, 1, 1, 1);
+  bad.len = 3;
+  ASSERT_TRUE(b.port.inject(bad));
+  fs = b.ticks(10);
+  EXPECT_EQ(b.loop->snapshot().pose.x, 0.0);
+  EXPECT_EQ(b.loop->snapshot().pose.y, 0.0);
+  EXPECT_EQ(last_ack(fs), 2);
+  EXPECT_EQ(b.bc.counters().set_pose_applied, 2u);
+  EXPECT_EQ(b.bc.counters().set_pose_rejected, 1u);
+}
+
+TEST(CanBroadcast, CleanStopSendsFinalPoseThenStoppingStatus) {
+  Bench b;
+  b.ticks(137);
+  b.wire_frames();
+  b.bc.send_final(b.loop->snapshot());
+  const auto fs = b.wire_frames();
+  ASSERT_EQ(fs.size(), 6u);
+  EXPECT_EQ(fs.front().id, id(Msg::kPoseX));
+  EXPECT_EQ(fs.back().id, id(Msg::kStatus));
+  fw::can::StatusMsg st;
+  ASSERT_TRUE(fw::can::decode_status(fs.back(), st));
+  EXPECT_TRUE(st.stopping);
+  EXPECT_DOUBLE_EQ(st.uptime, 1.0);  // 1.37 s of loop time, whole seconds
+  double x = 0, y = 0, th = 0;
+  std::uint8_t s1 = 0, s2 = 0;
+  ASSERT_TRUE(fw::can::decode_pose_x(fs[0], x, s1));
+  ASSERT_TRUE(fw::can::decode_pose_y_theta(fs[1], y, th, s2));
+  EXPECT_EQ(s1, s2);
+  EXPECT_NEAR(x, b.loop->snapshot().pose.x, fw::can::kPosScale / 2 + 1e-12);
+  EXPECT_NEAR(y, b.loop->snapshot().pose.y, fw::can::kPosScale / 2 + 1e-12);
+  // The uncertainty frame carries the error model's standard deviations.
+  fw::can::UncertaintyMsg u;
+  ASSERT_TRUE(fw::can::decode_uncertainty(fs[3], u));
+  ASSERT_TRUE(b.loop->snapshot().has_cov);
+  EXPECT_NEAR(u.sigma_x, std::sqrt(b.loop->snapshot().cov[0]), fw::can::kSigmaPosScale / 2);
+  EXPECT_NEAR(u.sigma_theta, std::sqrt(b.loop->snapshot().cov[8]), fw::can::kSigmaThetaScale / 2);
+}
+
+}  // namespace
+}  // namespace odo::test

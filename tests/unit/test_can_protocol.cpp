@@ -1,0 +1,244 @@
+// CAN pose protocol: every frame round-trips (encode, decode), saturates at its limits, rounds
+// to the nearest step and wraps theta to (-pi, pi]. Expected raw bytes are derived by hand from
+// the layout in README "CAN protocol".
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "odo/firmware/can_protocol.hpp"
+
+namespace odo::fw::can {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr std::uint32_t kId = 0x410;
+
+TEST(CanIds, NodeBlocksAndSplit) {
+  EXPECT_EQ(frame_id(kDefaultBaseId, 1, Msg::kPoseX), 0x410u);
+  EXPECT_EQ(frame_id(kDefaultBaseId, 1, Msg::kSetPose), 0x418u);
+  EXPECT_EQ(frame_id(kDefaultBaseId, 63, Msg::kTiming), 0x7F5u);
+  EXPECT_TRUE(valid_addressing(0x400, 63));
+  EXPECT_FALSE(valid_addressing(0x410, 63));  // above 0x7FF
+  EXPECT_FALSE(valid_addressing(0x404, 1));   // not a multiple of 16
+  EXPECT_FALSE(valid_addressing(0x400, 64));
+  CanFrame f;
+  int node = -1;
+  Msg m{};
+  f.id = 0x435;
+  ASSERT_TRUE(split_id(0x400, f, node, m));
+  EXPECT_EQ(node, 3);
+  EXPECT_EQ(m, Msg::kTiming);
+  f.id = 0x436;  // offsets 6, 7, 9..15 are not ours
+  EXPECT_FALSE(split_id(0x400, f, node, m));
+  f.id = 0x3FF;
+  EXPECT_FALSE(split_id(0x400, f, node, m));
+  f.id = 0x410;
+  f.extended = true;
+  EXPECT_FALSE(split_id(0x400, f, node, m));
+}
+
+TEST(CanPose, RoundTripWithinHalfAStep) {
+  for (double x : {0.0, 1.23456789, -1.23456789, 4000.00004, -199999.99995}) {
+    for (double th : {0.0, 0.5, -3.0, 3.14, -3.14}) {
+      const PoseMsg p{x, -x / 3, th, 77};
+      CanFrame a, b;
+      encode_pose_x(kId, p, a);
+      encode_pose_y_theta(kId + 1, p, b);
+      EXPECT_EQ(a.id, kId);
+      EXPECT_EQ(a.len, 8);
+      double dx = 0, dy = 0, dth = 0;
+      std::uint8_t s1 = 0, s2 = 0;
+      ASSERT_TRUE(decode_pose_x(a, dx, s1));
+      ASSERT_TRUE(decode_pose_y_theta(b, dy, dth, s2));
+      EXPECT_NEAR(dx, x, kPosScale / 2 + 1e-9);
+      EXPECT_NEAR(dy, -x / 3, kPosScale / 2 + 1e-9);
+      EXPECT_NEAR(dth, th, kThetaScale / 2 + 1e-12);
+      EXPECT_EQ(s1, 77);
+      EXPECT_EQ(s2, 77);
+    }
+  }
+}
+
+TEST(CanPose, ByteLayoutByHand) {
+  // x = 1.0001 m -> raw 10001 = 0x00002711, little-endian; y = -0.0001 m -> raw -1 =
+  // 0xFFFFFFFF; theta = -1e-4 rad -> raw -1 = 0xFFFF; seq in byte 7.
+  CanFrame a, b;
+  encode_pose_x(kId, PoseMsg{1.0001, -0.0001, -1e-4, 0xA5}, a);
+  encode_pose_y_theta(kId + 1, PoseMsg{1.0001, -0.0001, -1e-4, 0xA5}, b);
+  const std::array<std::uint8_t, 8> wa{0x11, 0x27, 0, 0, 0, 0, 0, 0xA5};
+  const std::array<std::uint8_t, 8> wb{0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0, 0xA5};
+  EXPECT_EQ(a.data, wa);
+  EXPECT_EQ(b.data, wb);
+}
+
+TEST(CanPose, RoundsToNearestStep) {
+  CanFrame f;
+  double x = 0;
+  std::uint8_t s = 0;
+  encode_pose_x(kId, PoseMsg{0.00014, 0, 0, 0}, f);  // 1.4 steps -> 1
+  ASSERT_TRUE(decode_pose_x(f, x, s));
+  EXPECT_DOUBLE_EQ(x, 1e-4);
+  encode_pose_x(kId, PoseMsg{0.00016, 0, 0, 0}, f);  // 1.6 steps -> 2
+  ASSERT_TRUE(decode_pose_x(f, x, s));
+  EXPECT_DOUBLE_EQ(x, 2e-4);
+  encode_pose_x(kId, PoseMsg{-0.00016, 0, 0, 0}, f);  // symmetric
+  ASSERT_TRUE(decode_pose_x(f, x, s));
+  EXPECT_DOUBLE_EQ(x, -2e-4);
+}
+
+TEST(CanPose, SaturatesAtTheLimits) {
+  CanFrame f;
+  double x = 0;
+  std::uint8_t s = 0;
+  encode_pose_x(kId, PoseMsg{1e9, 0, 0, 0}, f);
+  ASSERT_TRUE(decode_pose_x(f, x, s));
+  EXPECT_DOUBLE_EQ(x, 2147483647 * kPosScale);
+  encode_pose_x(kId, PoseMsg{-1e9, 0, 0, 0}, f);
+  ASSERT_TRUE(decode_pose_x(f, x, s));
+  EXPECT_DOUBLE_EQ(x, -2147483648.0 * kPosScale);
+  // The documented range holds: +-200 km are carried exactly to the step.
+  encode_pose_x(kId, PoseMsg{200000.0, 0, 0, 0}, f);
+  ASSERT_TRUE(decode_pose_x(f, x, s));
+  EXPECT_NEAR(x, 200000.0, 1e-6);
+  encode_pose_x(kId, PoseMsg{std::nan(""), 0, 0, 0}, f);
+  ASSERT_TRUE(decode_pose_x(f, x, s));
+  EXPECT_EQ(x, 0.0);
+}
+
+TEST(CanPose, ThetaWrapsIntoMinusPiPi) {
+  auto roundtrip = [](double th) {
+    CanFrame f;
+    encode_pose_y_theta(kId + 1, PoseMsg{0, 0, th, 0}, f);
+    double y = 0, t = 0;
+    std::uint8_t s = 0;
+    EXPECT_TRUE(decode_pose_y_theta(f, y, t, s));
+    return t;
+  };
+  EXPECT_NEAR(roundtrip(1.5 * kPi), -0.5 * kPi, kThetaScale / 2);
+  EXPECT_NEAR(roundtrip(-1.5 * kPi), 0.5 * kPi, kThetaScale / 2);
+  EXPECT_NEAR(roundtrip(20 * kPi + 0.1), 0.1, kThetaScale / 2 + 1e-9);
+  // +pi and -pi are both sent as +pi (raw 31416): the interval is (-pi, pi].
+  EXPECT_DOUBLE_EQ(roundtrip(kPi), 31416 * kThetaScale);
+  EXPECT_DOUBLE_EQ(roundtrip(-kPi), 31416 * kThetaScale);
+  EXPECT_EQ(theta_raw(-kPi + 0.4e-4), kThetaRawMax);  // rounds to -pi: sent as +pi
+  EXPECT_EQ(theta_raw(-kPi + 0.6e-4), -31415);
+  EXPECT_EQ(theta_raw(std::numeric_limits<double>::infinity()), 0);
+}
+
+TEST(CanVelocity, RoundTripAndSaturation) {
+  CanFrame f;
+  encode_velocity(kId + 2, VelocityMsg{0.2004, -1.2346, 9}, f);
+  VelocityMsg v;
+  ASSERT_TRUE(decode_velocity(f, v));
+  EXPECT_NEAR(v.v, 0.200, 1e-12);
+  EXPECT_NEAR(v.w, -1.235, 1e-12);
+  EXPECT_EQ(v.seq, 9);
+  encode_velocity(kId + 2, VelocityMsg{100.0, -100.0, 0}, f);
+  ASSERT_TRUE(decode_velocity(f, v));
+  EXPECT_DOUBLE_EQ(v.v, 32.767);
+  EXPECT_DOUBLE_EQ(v.w, -32.768);
+}
+
+TEST(CanUncertainty, RoundTripUnknownAndSaturation) {
+  CanFrame f;
+  encode_uncertainty(kId + 3, UncertaintyMsg{0.01234, 0.00056, 0.0012345, -0.456, 3}, f);
+  UncertaintyMsg u;
+  ASSERT_TRUE(decode_uncertainty(f, u));
+  EXPECT_NEAR(u.sigma_x, 0.0123, 1e-12);
+  EXPECT_NEAR(u.sigma_y, 0.0006, 1e-12);
+  EXPECT_NEAR(u.sigma_theta, 0.00123, 1e-12);
+  EXPECT_NEAR(u.rho_xy, -0.46, 1e-12);
+  EXPECT_EQ(u.seq, 3);
+  encode_uncertainty(kId + 3, UncertaintyMsg{100.0, std::nan(""), -1.0, 5.0, 0}, f);
+  ASSERT_TRUE(decode_uncertainty(f, u));
+  EXPECT_DOUBLE_EQ(u.sigma_x, 65535 * kSigmaPosScale);  // saturated
+  EXPECT_DOUBLE_EQ(u.sigma_y, 65535 * kSigmaPosScale);  // unknown
+  EXPECT_DOUBLE_EQ(u.sigma_theta, 0.0);                 // a negative sigma cannot be: 0
+  EXPECT_DOUBLE_EQ(u.rho_xy, 1.0);
+}
+
+TEST(CanStatus, RoundTripBitsAndSaturation) {
+  StatusMsg s;
+  s.encoder_flags = 0x11;
+  s.calibration_state = 2;
+  s.stopping = true;
+  s.set_pose_ack = 200;
+  s.missed_deadlines = 70000;  // saturates at 65535
+  s.uptime = 3600.9;           // whole seconds
+  CanFrame f;
+  encode_status(kId + 4, s, f);
+  const std::array<std::uint8_t, 8> want{0x11, 0x06, 200, 0xFF, 0xFF, 0x10, 0x0E, 0x00};
+  EXPECT_EQ(f.data, want);
+  StatusMsg d;
+  ASSERT_TRUE(decode_status(f, d));
+  EXPECT_EQ(d.encoder_flags, 0x11);
+  EXPECT_EQ(d.calibration_state, 2);
+  EXPECT_TRUE(d.stopping);
+  EXPECT_EQ(d.set_pose_ack, 200);
+  EXPECT_EQ(d.missed_deadlines, 65535u);
+  EXPECT_DOUBLE_EQ(d.uptime, 3600.0);
+  s.uptime = 1e12;
+  encode_status(kId + 4, s, f);
+  ASSERT_TRUE(decode_status(f, d));
+  EXPECT_DOUBLE_EQ(d.uptime, 16777215.0);
+}
+
+TEST(CanTiming, RoundTripInMicroseconds) {
+  CanFrame f;
+  encode_timing(kId + 5, TimingMsg{12.4e-6, 1.5e-3, 0.2, 70000}, f);
+  TimingMsg t;
+  ASSERT_TRUE(decode_timing(f, t));
+  EXPECT_NEAR(t.wakeup_p99, 12e-6, 1e-15);
+  EXPECT_NEAR(t.wakeup_max, 1.5e-3, 1e-15);
+  EXPECT_NEAR(t.compute_max, 0.065535, 1e-15);  // saturated
+  EXPECT_EQ(t.tx_dropped, 65535u);
+}
+
+TEST(CanSetPose, SetResetAndRejects) {
+  CanFrame f;
+  encode_set_pose(kId + 8, SetPoseCmd{false, 12.3456, -7.0004, 1.0}, f);
+  EXPECT_EQ(f.len, 8);
+  SetPoseCmd c;
+  ASSERT_TRUE(decode_set_pose(f, c));
+  EXPECT_FALSE(c.reset);
+  EXPECT_NEAR(c.x, 12.346, 1e-9);
+  EXPECT_NEAR(c.y, -7.000, 1e-9);
+  EXPECT_NEAR(c.theta, 1.0, 1e-12);
+  // Limits of the command: +-8388.607 m, saturating.
+  encode_set_pose(kId + 8, SetPoseCmd{false, 1e6, -1e6, 0}, f);
+  ASSERT_TRUE(decode_set_pose(f, c));
+  EXPECT_DOUBLE_EQ(c.x, 8388.607);
+  EXPECT_DOUBLE_EQ(c.y, -8388.608);
+  // Reset: DLC 0.
+  encode_set_pose(kId + 8, SetPoseCmd{true, 5, 5, 1}, f);
+  EXPECT_EQ(f.len, 0);
+  ASSERT_TRUE(decode_set_pose(f, c));
+  EXPECT_TRUE(c.reset);
+  EXPECT_EQ(c.x, 0.0);
+  // Rejected: other lengths, theta beyond pi.
+  for (std::uint8_t len : {1, 4, 7}) {
+    f.len = len;
+    EXPECT_FALSE(decode_set_pose(f, c)) << int(len);
+  }
+  f.len = 8;
+  f.data[6] = 0x79;  // raw 31417 = 0x7AB9 > 31416
+  f.data[7] = 0x7A;
+  f.data[6] = 0xB9;
+  EXPECT_FALSE(decode_set_pose(f, c));
+}
+
+TEST(CanDivisor, WholeDivisorsOnly) {
+  EXPECT_EQ(divisor_for(100, 50), 2);
+  EXPECT_EQ(divisor_for(100, 100), 1);
+  EXPECT_EQ(divisor_for(100, 0), 0);
+  EXPECT_EQ(divisor_for(100, 1), 100);
+  EXPECT_EQ(divisor_for(100, 30), -1);
+  EXPECT_EQ(divisor_for(100, 200), -1);
+  EXPECT_EQ(divisor_for(100, -1), -1);
+  EXPECT_EQ(divisor_for(1000, 0.5), 2000);
+}
+
+}  // namespace
+}  // namespace odo::fw::can
