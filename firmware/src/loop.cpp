@@ -86,9 +86,11 @@ void OdometryLoop::tick() noexcept {
     // Counts are cumulative, so a late tick simply integrates a longer interval: nothing is lost.
     const std::int64_t dl = wrap_delta(prev_left_, s.left, bits_);
     const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
-    const double theta0 = odom_.pose().theta;
+    // The covariance needs the heading at the start of the tick; the integrator's cached sine
+    // and cosine of it spare a trigonometric call.
+    const double s0 = odom_.sin_theta(), c0 = odom_.cos_theta();
     odom_.update(dl, dr, to_seconds(s.stamp - prev_stamp_));
-    cov_.step(theta0, odom_.last_d_left(), odom_.last_d_right(), odom_.kinematics().wheelbase());
+    cov_.step_sc(s0, c0, odom_.last_d_left(), odom_.last_d_right(), odom_.kinematics().wheelbase());
     prev_left_ = s.left;
     prev_right_ = s.right;
     prev_stamp_ = s.stamp;

@@ -104,11 +104,23 @@ constexpr double kG5[] = {0.20833333333333334,    -0.06805555555555555,    0.007
                           -1.772502855882662e-14, 1.4196246578111098e-16,  -9.568166108006477e-19,
                           5.502741021919477e-21};
 
+// Below |phi| = kShortSeriesLimit (every ordinary tick: 0.05 rad is 5 rad/s at 100 Hz) the first
+// kShortTerms coefficients suffice: the largest omitted term, c_6 z^6 of g3, is 2e-23 of c_0.
+constexpr double kShortSeriesLimit = 0.05;
+constexpr std::size_t kShortTerms = 6;
+
+// horner: the polynomial of the first M coefficients of c at z.
+template <std::size_t M, std::size_t N>
+inline double horner(const double (&c)[N], double z) noexcept {
+  static_assert(M <= N);
+  double r = c[M - 1];
+  for (std::size_t i = M - 1; i-- > 0;) r = r * z + c[i];
+  return r;
+}
+
 template <std::size_t N>
 inline double horner(const double (&c)[N], double z) noexcept {
-  double r = c[N - 1];
-  for (std::size_t i = N - 1; i-- > 0;) r = r * z + c[i];
-  return r;
+  return horner<N, N>(c, z);
 }
 
 }  // namespace
@@ -128,7 +140,15 @@ Status check_error_model(const ErrorModelParams& k) {
 ArcTerms arc_terms(double phi) noexcept {
   const double z = phi * phi;
   double sinc, h, g1, g2, g3, g4, g5;
-  if (std::fabs(phi) < kSeriesLimit) {
+  if (std::fabs(phi) < kShortSeriesLimit) {
+    sinc = horner<kShortTerms>(kSinc, z);
+    h = horner<kShortTerms>(kH, z);
+    g1 = horner<kShortTerms>(kG1, z);
+    g2 = horner<kShortTerms>(kG2, z);
+    g3 = horner<kShortTerms>(kG3, z);
+    g4 = horner<kShortTerms>(kG4, z);
+    g5 = horner<kShortTerms>(kG5, z);
+  } else if (std::fabs(phi) < kSeriesLimit) {
     sinc = horner(kSinc, z);
     h = horner(kH, z);
     g1 = horner(kG1, z);
@@ -201,31 +221,40 @@ Cov3 arc_input_covariance(double d_left, double d_right, double b,
 
 void propagate_arc(Cov3& cov, double theta0, double d_left, double d_right, double b,
                    const ErrorModelParams& k) noexcept {
+  if (!std::isfinite(theta0)) return;
+  propagate_arc(cov, std::sin(theta0), std::cos(theta0), d_left, d_right, b, k);
+}
+
+void propagate_arc(Cov3& cov, double sin_theta0, double cos_theta0, double d_left, double d_right,
+                   double b, const ErrorModelParams& k) noexcept {
   // A non-finite travel or wheelbase would poison the covariance for good; such a tick (which the
   // loop never produces) adds nothing.
   if (!(std::isfinite(d_left) && std::isfinite(d_right) && b > 0.0 && std::isfinite(b) &&
-        std::isfinite(theta0))) {
+        std::isfinite(sin_theta0) && std::isfinite(cos_theta0))) {
     return;
   }
   const ArcTerms t = arc_terms((d_right - d_left) / b);
   const Mat3 q = local_input_covariance(d_left, d_right, b, k, t);
-  const double s0 = std::sin(theta0), c0 = std::cos(theta0);
+  const double s0 = sin_theta0, c0 = cos_theta0;
   // Displacement of the arc: D (I_c, I_s) in the start frame, rotated by theta0.
   const double d = 0.5 * (d_left + d_right);
   const double lx = d * t.i_c, ly = d * t.i_s;
   const double dx = c0 * lx - s0 * ly, dy = s0 * lx + c0 * ly;
-  Mat3 f = Mat3::Identity();
-  f(0, 2) = -dy;  // Eq. 16: x depends on the start heading through -dy ...
-  f(1, 2) = dx;   // ... and y through +dx
-  Mat3 rot = Mat3::Identity();
-  rot(0, 0) = c0;
-  rot(0, 1) = -s0;
-  rot(1, 0) = s0;
-  rot(1, 1) = c0;
-  Eigen::Map<Mat3> p(cov.data());
-  const Mat3 next = f * p * f.transpose() + rot * q * rot.transpose();
-  // Keep the result exactly symmetric so round-off cannot accumulate into asymmetry.
-  p = 0.5 * (next + next.transpose());
+  // cov <- F P F^T + R Q R^T written out on the six distinct entries (both terms are symmetric
+  // by construction, so the result stays exactly symmetric). F is the identity except
+  // F(0,2) = -dy, F(1,2) = dx (Eq. 16: the start heading moves x by -dy and y by +dx); R is the
+  // rotation by theta0 about the z axis.
+  const double p00 = cov[0], p01 = cov[1], p02 = cov[2], p11 = cov[4], p12 = cov[5], p22 = cov[8];
+  const double fa = -dy, fc = dx;
+  const double q00 = q(0, 0), q01 = q(0, 1), q02 = q(0, 2), q11 = q(1, 1), q12 = q(1, 2);
+  const double cc = c0 * c0, ss = s0 * s0, cs = c0 * s0;
+  const double n00 = p00 + fa * (2.0 * p02 + fa * p22) + cc * q00 - 2.0 * cs * q01 + ss * q11;
+  const double n11 = p11 + fc * (2.0 * p12 + fc * p22) + ss * q00 + 2.0 * cs * q01 + cc * q11;
+  const double n01 = p01 + fa * p12 + fc * p02 + fa * fc * p22 + cs * (q00 - q11) + (cc - ss) * q01;
+  const double n02 = p02 + fa * p22 + c0 * q02 - s0 * q12;
+  const double n12 = p12 + fc * p22 + s0 * q02 + c0 * q12;
+  const double n22 = p22 + q(2, 2);
+  cov = {n00, n01, n02, n01, n11, n12, n02, n12, n22};
 }
 
 }  // namespace odo

@@ -133,6 +133,35 @@ TEST(ErrorModel, SeriesAndClosedFormsMeetAtTheSwitch) {
   }
 }
 
+TEST(ErrorModel, ShortAndFullSeriesMeetAtTheSwitch) {
+  // |phi| = 0.05 switches from the six-term series (every ordinary tick) to the full series; the
+  // omitted terms are below 1e-22 of the leading one there, so both sides agree to rounding.
+  for (double sign : {1.0, -1.0}) {
+    const ArcTerms lo = arc_terms(sign * std::nextafter(0.05, 0.0));
+    const ArcTerms hi = arc_terms(sign * 0.05);
+    const double* a = &lo.i_c;
+    const double* b = &hi.i_c;
+    for (std::size_t i = 0; i < sizeof(ArcTerms) / sizeof(double); ++i) {
+      EXPECT_NEAR(a[i], b[i], 4e-15 * std::fabs(b[i])) << "term " << i << " sign " << sign;
+    }
+  }
+}
+
+TEST(ErrorModel, SineCosineEntryEqualsHeadingEntry) {
+  // The loop passes the integrator's cached sin/cos of the start heading instead of the angle;
+  // from any starting covariance both entries must give the same result (to rounding).
+  for (double theta0 : {0.0, 0.3, 2.0, -2.9, 7.5}) {
+    Cov3 a{1e-4, 2e-5, -3e-5, 2e-5, 5e-4, 1e-5, -3e-5, 1e-5, 2e-4};
+    Cov3 b = a;
+    propagate_arc(a, theta0, 0.011, 0.0102, kB, kParams);
+    propagate_arc(b, std::sin(theta0), std::cos(theta0), 0.011, 0.0102, kB, kParams);
+    expect_cov_near(b, a, 1e-14, "sin/cos entry");
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) EXPECT_EQ(b[3 * i + j], b[3 * j + i]) << "not symmetric";
+    }
+  }
+}
+
 TEST(ErrorModel, ZeroTurnLimits) {
   // phi = 0: I_c = 1, I_s = 0, I_cc = 1, I_ss = 0, I_cs = 0, J_x = int (1-u) = 1/2, J_y = 0,
   // J_xx = int (1-u)^2 = 1/3, J_yy = J_xy = 0, J_cx = 1/2, J_cy = J_sx = J_sy = 0.

@@ -52,6 +52,11 @@ Cov3 arc_input_covariance(double d_left, double d_right, double b,
 void propagate_arc(Cov3& cov, double theta0, double d_left, double d_right, double b,
                    const ErrorModelParams& k) noexcept;
 
+// propagate_arc: the same with the start heading given by its sine and cosine (the integrator
+// keeps them, so a tick needs no trigonometric call).
+void propagate_arc(Cov3& cov, double sin_theta0, double cos_theta0, double d_left, double d_right,
+                   double b, const ErrorModelParams& k) noexcept;
+
 // PoseCovariance: the running covariance of the integrated pose; starts at zero.
 class PoseCovariance {
  public:
@@ -62,6 +67,11 @@ class PoseCovariance {
   // d_right the wheel travels of the tick [m], b the wheelbase [m].
   void step(double theta0, double d_left, double d_right, double b) noexcept {
     propagate_arc(cov_, theta0, d_left, d_right, b, k_);
+  }
+  // step_sc: the same with the start heading as sin and cos (no trigonometric call).
+  void step_sc(double sin_theta0, double cos_theta0, double d_left, double d_right,
+               double b) noexcept {
+    propagate_arc(cov_, sin_theta0, cos_theta0, d_left, d_right, b, k_);
   }
   void set_params(const ErrorModelParams& k) noexcept { k_ = k; }
   const ErrorModelParams& params() const noexcept { return k_; }

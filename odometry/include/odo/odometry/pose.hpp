@@ -58,9 +58,11 @@ class Odometry {
 
   const Kinematics& kinematics() const noexcept { return k_; }
   const Pose2& pose() const noexcept { return integ_.pose(); }
-  double linear_velocity() const noexcept { return v_; }     // [m/s] of the centre point
-  double angular_velocity() const noexcept { return w_; }    // [rad/s]
-  double distance() const noexcept { return distance_; }     // path length of the centre [m]
+  double sin_theta() const noexcept { return integ_.sin_theta(); }  // sin of pose().theta
+  double cos_theta() const noexcept { return integ_.cos_theta(); }  // cos of pose().theta
+  double linear_velocity() const noexcept { return v_; }            // [m/s] of the centre point
+  double angular_velocity() const noexcept { return w_; }           // [rad/s]
+  double distance() const noexcept { return distance_; }            // path length of the centre [m]
   double last_d_left() const noexcept { return d_left_; }    // wheel travel of the last tick [m]
   double last_d_right() const noexcept { return d_right_; }  // [m]
 
