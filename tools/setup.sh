@@ -11,6 +11,7 @@ set -euo pipefail
 build_pkgs=(g++ cmake make pkg-config python3 libeigen3-dev libgpiod-dev libtomlplusplus-dev
   libcli11-dev nlohmann-json3-dev)
 test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind
+  can-utils python3-can iproute2  # CAN kernel tests in the VM (candump, cansend, ip, tc)
   rt-tests stress-ng systemd  # cyclictest + load for tools/jitter.sh; systemd-analyze verify
   clang-14 libclang-rt-14-dev libfuzzer-14-dev)  # fuzz preset: clang-14 + libFuzzer (TESTING.md)
 # Cross builds (toolchains/, presets cross-aarch64 and cross-armhf) and the package checks

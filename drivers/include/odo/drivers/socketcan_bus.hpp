@@ -31,7 +31,21 @@ struct SocketCanOptions {
   bool receive_own = false;    // also receive frames this socket sent (tests)
   double reopen_period = 1.0;  // [s] between attempts to re-open a vanished interface
   int rx_buffer_bytes = 0;     // SO_RCVBUF, 0 = kernel default
+  int tx_buffer_bytes = 0;     // SO_SNDBUF, 0 = kernel default (small: EAGAIN sooner, tests)
 };
+
+// tx_result_for_errno: how a failed write() of a frame is reported (ENOBUFS/EAGAIN queue full,
+// ENETDOWN/ENXIO/ENODEV link down, anything else an error). Pure; unit-tested.
+CanTx tx_result_for_errno(int err) noexcept;
+// errno_means_vanished: true for the errno values after which the socket is re-opened by name
+// (ENODEV, ENXIO: the interface was removed or re-created with a new index).
+bool errno_means_vanished(int err) noexcept;
+// to_socketcan_id: the Linux can_id word of a frame (CAN_EFF_FLAG set for extended ids; the id
+// masked to 11 or 29 bits).
+std::uint32_t to_socketcan_id(const CanFrame& f) noexcept;
+// from_socketcan_id: fills f.id and f.extended from a Linux can_id word; false for remote (RTR)
+// and error frames, which the firmware does not use.
+bool from_socketcan_id(std::uint32_t can_id, CanFrame& f) noexcept;
 
 // SocketCanCounters: cumulative since open; read from the thread that sends/receives.
 struct SocketCanCounters {
@@ -55,12 +69,20 @@ class SocketCanBus final : public CanBus {
 
   const SocketCanCounters& counters() const noexcept { return counters_; }
   const std::string& interface() const noexcept { return opts_.interface; }
+  // is_open: false while the interface has vanished and is waiting to be re-opened.
+  bool is_open() const noexcept { return fd_ >= 0; }
 
  private:
   explicit SocketCanBus(SocketCanOptions o);
-  Status reopen() noexcept;
+  // open_socket: a new bound raw socket for opts_ into fd_; returns 0 or the errno, and in
+  // `stage` the call that failed. No allocation (it also runs on the loop thread to re-open).
+  int open_socket(const char*& stage) noexcept;
+  // try_reopen: at most once per reopen_period, replaces a closed/vanished socket; true if open.
+  bool try_reopen() noexcept;
+  void close_socket() noexcept;
 
   SocketCanOptions opts_;
+  std::vector<std::uint32_t> kfilters_;  // struct can_filter pairs (can_id, can_mask), built once
   int fd_ = -1;
   std::int64_t next_reopen_ns_ = 0;
   SocketCanCounters counters_;

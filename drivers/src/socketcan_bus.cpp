@@ -1,0 +1,207 @@
+#include "odo/drivers/socketcan_bus.hpp"
+
+#include <fcntl.h>
+#include <linux/can.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace odo::drivers {
+namespace {
+
+static_assert(sizeof(can_filter) == 2 * sizeof(std::uint32_t), "can_filter is two canid_t");
+
+std::int64_t monotonic_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+}  // namespace
+
+CanTx tx_result_for_errno(int err) noexcept {
+  switch (err) {
+    case ENOBUFS:
+    case EAGAIN:
+      return CanTx::kQueueFull;
+    case ENETDOWN:
+    case ENXIO:
+    case ENODEV:
+      return CanTx::kLinkDown;
+    default:
+      return CanTx::kError;
+  }
+}
+
+bool errno_means_vanished(int err) noexcept {
+  return err == ENODEV || err == ENXIO;
+}
+
+std::uint32_t to_socketcan_id(const CanFrame& f) noexcept {
+  return f.extended ? ((f.id & CAN_EFF_MASK) | CAN_EFF_FLAG) : (f.id & CAN_SFF_MASK);
+}
+
+bool from_socketcan_id(std::uint32_t can_id, CanFrame& f) noexcept {
+  if ((can_id & (CAN_RTR_FLAG | CAN_ERR_FLAG)) != 0) return false;
+  f.extended = (can_id & CAN_EFF_FLAG) != 0;
+  f.id = f.extended ? (can_id & CAN_EFF_MASK) : (can_id & CAN_SFF_MASK);
+  return true;
+}
+
+SocketCanBus::SocketCanBus(SocketCanOptions o) : opts_(std::move(o)) {
+  kfilters_.reserve(2 * opts_.filters.size());
+  for (const CanFilter& cf : opts_.filters) {
+    const std::uint32_t id_bits = cf.extended ? CAN_EFF_MASK : CAN_SFF_MASK;
+    kfilters_.push_back((cf.id & id_bits) | (cf.extended ? CAN_EFF_FLAG : 0u));
+    // The mask always compares the EFF flag (standard and extended ids are never confused)
+    // and never lets RTR frames through.
+    kfilters_.push_back((cf.mask & id_bits) | CAN_EFF_FLAG | CAN_RTR_FLAG);
+  }
+}
+
+SocketCanBus::~SocketCanBus() {
+  close_socket();
+}
+
+void SocketCanBus::close_socket() noexcept {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+}
+
+int SocketCanBus::open_socket(const char*& stage) noexcept {
+  close_socket();
+  stage = "socket(PF_CAN, SOCK_RAW, CAN_RAW)";
+  const int fd = ::socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+  if (fd < 0) return errno;
+  auto fail = [&](const char* what) {
+    const int e = errno;
+    stage = what;
+    ::close(fd);
+    return e;
+  };
+  ifreq ifr{};
+  if (opts_.interface.empty() || opts_.interface.size() >= IFNAMSIZ) {
+    ::close(fd);
+    stage = "interface name (1..15 characters)";
+    return EINVAL;
+  }
+  std::memcpy(ifr.ifr_name, opts_.interface.c_str(), opts_.interface.size() + 1);
+  if (::ioctl(fd, SIOCGIFINDEX, &ifr) < 0) return fail("SIOCGIFINDEX");
+  // Kernel filters: zero filters = the socket receives nothing.
+  const socklen_t flen = static_cast<socklen_t>(kfilters_.size() * sizeof(std::uint32_t));
+  if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, kfilters_.empty() ? nullptr : kfilters_.data(),
+                   flen) < 0)
+    return fail("setsockopt(CAN_RAW_FILTER)");
+  const int own = opts_.receive_own ? 1 : 0;
+  if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_RECV_OWN_MSGS, &own, sizeof own) < 0)
+    return fail("setsockopt(CAN_RAW_RECV_OWN_MSGS)");
+  if (opts_.rx_buffer_bytes > 0 &&
+      ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &opts_.rx_buffer_bytes, sizeof(int)) < 0)
+    return fail("setsockopt(SO_RCVBUF)");
+  if (opts_.tx_buffer_bytes > 0 &&
+      ::setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &opts_.tx_buffer_bytes, sizeof(int)) < 0)
+    return fail("setsockopt(SO_SNDBUF)");
+  sockaddr_can addr{};
+  addr.can_family = AF_CAN;
+  addr.can_ifindex = ifr.ifr_ifindex;
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) < 0) return fail("bind");
+  fd_ = fd;
+  return 0;
+}
+
+Result<std::unique_ptr<SocketCanBus>> SocketCanBus::open(const SocketCanOptions& o) {
+  if (!(o.reopen_period > 0.0) || o.reopen_period > 3600.0)
+    return make_error(Errc::kInvalidArgument, "socketcan: reopen_period must be in (0, 3600] s");
+  std::unique_ptr<SocketCanBus> bus(new SocketCanBus(o));
+  const char* stage = "";
+  const int err = bus->open_socket(stage);
+  if (err != 0) {
+    const Errc code = (err == ENODEV || err == ENXIO)                   ? Errc::kNotFound
+                      : (err == EAFNOSUPPORT || err == EPROTONOSUPPORT) ? Errc::kUnsupported
+                                                                        : Errc::kIo;
+    return make_error(code,
+                      "socketcan " + o.interface + ": " + stage + " failed: " + std::strerror(err) +
+                          (code == Errc::kUnsupported ? " (kernel without CAN support?)" : ""));
+  }
+  return bus;
+}
+
+bool SocketCanBus::try_reopen() noexcept {
+  if (fd_ >= 0) return true;
+  const std::int64_t now = monotonic_ns();
+  if (now < next_reopen_ns_) return false;
+  next_reopen_ns_ = now + static_cast<std::int64_t>(opts_.reopen_period * 1e9);
+  const char* stage = "";
+  if (open_socket(stage) != 0) return false;
+  ++counters_.reopens;
+  return true;
+}
+
+CanTx SocketCanBus::send(const CanFrame& f) noexcept {
+  if (fd_ < 0 && !try_reopen()) {
+    ++counters_.tx_link_down;
+    return CanTx::kLinkDown;
+  }
+  can_frame cf{};
+  cf.can_id = to_socketcan_id(f);
+  cf.can_dlc = f.len > 8 ? 8 : f.len;
+  std::memcpy(cf.data, f.data.data(), cf.can_dlc);
+  const ssize_t n = ::send(fd_, &cf, sizeof cf, MSG_DONTWAIT);
+  if (n == static_cast<ssize_t>(sizeof cf)) {
+    ++counters_.sent;
+    return CanTx::kSent;
+  }
+  const int err = n < 0 ? errno : EIO;
+  const CanTx r = tx_result_for_errno(err);
+  switch (r) {
+    case CanTx::kQueueFull:
+      ++counters_.tx_queue_full;
+      break;
+    case CanTx::kLinkDown:
+      ++counters_.tx_link_down;
+      if (errno_means_vanished(err)) {
+        // The interface vanished (or came back with a new index): re-open it by name after
+        // one retry period.
+        close_socket();
+        next_reopen_ns_ = monotonic_ns() + static_cast<std::int64_t>(opts_.reopen_period * 1e9);
+      }
+      break;
+    default:
+      ++counters_.tx_errors;
+      break;
+  }
+  return r;
+}
+
+bool SocketCanBus::receive(CanFrame& out) noexcept {
+  if (fd_ < 0 && !try_reopen()) return false;
+  for (;;) {
+    can_frame cf{};
+    const ssize_t n = ::recv(fd_, &cf, sizeof cf, MSG_DONTWAIT);
+    if (n < 0) {
+      // EAGAIN: nothing waiting. ENETDOWN is reported once after the link went down;
+      // ENODEV after the interface vanished: re-open later.
+      if (errno_means_vanished(errno)) {
+        close_socket();
+        next_reopen_ns_ = monotonic_ns() + static_cast<std::int64_t>(opts_.reopen_period * 1e9);
+      }
+      return false;
+    }
+    if (n != static_cast<ssize_t>(sizeof cf)) continue;  // not a classic frame (CAN FD): skip
+    if (!from_socketcan_id(cf.can_id, out)) continue;
+    out.len = cf.can_dlc > 8 ? 8 : cf.can_dlc;
+    out.data = {};
+    std::memcpy(out.data.data(), cf.data, out.len);
+    out.stamp = monotonic_ns();
+    ++counters_.received;
+    return true;
+  }
+}
+
+}  // namespace odo::drivers
