@@ -36,6 +36,12 @@ constexpr NumericKey kNumeric[] = {
     {"sim", "speed", "0.009", "5.1", "[0.01, 5] m/s"},
     {"sim", "turn_rate", "0.04", "10.1", "[0.05, 10] rad/s"},
     {"sim", "pause", "-1", "61", "[0, 60] s"},
+    {"can_encoder", "timeout", "0.004", "10.5", "[0.005, 10] s"},
+    {"can_encoder", "max_speed", "0.009", "100.5", "[0.01, 100] m/s"},
+    {"can_encoder", "request_rate", "-0.5", "1000.5", "[0, 1000] Hz"},
+    {"can_encoder", "sim_period", "0.0009", "1.5", "[0.001, 1] s"},
+    {"can_encoder", "sim_stop_left_after", "-1.5", "2e6", "[-1, 1e+06] s"},
+    {"can_encoder", "sim_stop_right_after", "-1.5", "2e6", "[-1, 1e+06] s"},
 };
 
 std::string doc(const NumericKey& k, const char* value) {
@@ -100,7 +106,7 @@ TEST(ConfigErrors, ChoicesNameTheAllowedWords) {
 
 TEST(ConfigErrors, UnknownKeysAndTablesEverywhere) {
   for (const char* table : {"loop", "robot", "encoder", "sim", "realtime", "calibration",
-                            "hctl1100", "gpio", "error_model"}) {
+                            "hctl1100", "gpio", "can_encoder", "error_model"}) {
     expect_error(std::string("[") + table + "]\n\nbogus = 1\n",
                  std::string("bad.toml:3: ") + table + ".bogus is not a known setting (misspelt?)");
   }
