@@ -90,17 +90,17 @@ void CanEncoderSource::accept(int i, std::int64_t value, TimeNs stamp,
   Wheel& w = wheel_[static_cast<std::size_t>(i)];
   const int bits = counter_bits();
   const bool reverse = i == 0 ? cfg_.reverse_left : cfg_.reverse_right;
-  const std::int64_t raw = wrap_bits(reverse ? -value : value, bits);
+  const std::int64_t raw = reverse ? wrap_sub(0, value, bits) : wrap_bits(value, bits);
   if (!w.primed) {
     // The first frame is the reference: the wheel reads 0 here, as it did before.
     w.offset = raw;
     w.primed = true;
   } else {
-    const std::int64_t step = wrap_bits(raw - w.last_raw, bits);
+    const std::int64_t step = wrap_sub(raw, w.last_raw, bits);
     const double dt = to_seconds(stamp - w.last_stamp);
     if (implausible_step(step, cfg_.max_counts_per_s, (dt > 0.0 ? dt : 0.0) + kLatencySlack, 1.0)) {
       // Report, do not integrate: shift the offset so the reported value stays put.
-      w.offset = wrap_bits(w.offset + step, bits);
+      w.offset = wrap_add(w.offset, step, bits);
       ++counters_.implausible_jumps;
       flags |= kEncoderImplausibleJump;
     }
@@ -177,8 +177,8 @@ EncoderSample CanEncoderSource::read(TimeNs now) noexcept {
     if (stale) s.flags |= i == 0 ? kEncoderStaleLeft : kEncoderStaleRight;
   }
   const int bits = counter_bits();
-  s.left = wheel_[0].primed ? wrap_bits(wheel_[0].last_raw - wheel_[0].offset, bits) : 0;
-  s.right = wheel_[1].primed ? wrap_bits(wheel_[1].last_raw - wheel_[1].offset, bits) : 0;
+  s.left = wheel_[0].primed ? wrap_sub(wheel_[0].last_raw, wheel_[0].offset, bits) : 0;
+  s.right = wheel_[1].primed ? wrap_sub(wheel_[1].last_raw, wheel_[1].offset, bits) : 0;
   s.counters = counters_;
   return s;
 }

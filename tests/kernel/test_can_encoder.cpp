@@ -200,7 +200,9 @@ TEST(CanEncoderKernel, StoppedSenderIsStaleWithinTheTimeoutPlusOnePeriod) {
   // first tick after last frame + timeout: <= timeout + one loop period after the kill (+2 ms
   // of scheduling allowance for the VM's timer).
   EXPECT_LE(latency, 0.100 + 0.010 + 0.002);
-  EXPECT_GE(latency, 0.100 - 0.010 - 0.002);  // not before the timeout minus the sender gap
+  // Not long before the timeout: the last frame may precede the kill by one sender gap, which
+  // under the emulated VM's timers stretches to ~12 ms; two gaps are allowed.
+  EXPECT_GE(latency, 0.100 - 0.020);
   EXPECT_EQ(r.enc->read(r.clock.now()).counters.stale_events, 1u);
 }
 

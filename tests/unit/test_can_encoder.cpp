@@ -243,6 +243,32 @@ TEST_F(CanEncoder, Int32WrapIsMotionNotAJump) {
   EXPECT_EQ(s.left, 80);
 }
 
+TEST_F(CanEncoder, SixtyFourBitCountsWrapWithoutOverflow) {
+  // Regression (fuzz_canenc, first seconds): with 64-bit counts the step last - first was
+  // computed in signed 64-bit arithmetic and overflowed (UBSan). Left: INT64_MAX - 9 then
+  // INT64_MIN + 10: modulo 2^64 the step is +20 counts. Right, reversed: INT64_MIN (its
+  // negation is itself modulo 2^64) then INT64_MIN + 5, negated: a step of -5.
+  cfg.left = CanCountLayout{0x100, false, 0, 64, true, false};
+  cfg.right = CanCountLayout{0x101, false, 0, 64, true, false};
+  cfg.reverse_right = true;
+  CanEncoderSource enc = make();
+  EXPECT_EQ(enc.counter_bits(), 64);
+  auto le64 = [](std::uint32_t id, std::uint64_t v, TimeNs t) {
+    CanFrame f = frame(id, {0, 0, 0, 0, 0, 0, 0, 0}, t);
+    for (std::size_t i = 0; i < 8; ++i) f.data[i] = static_cast<std::uint8_t>(v >> (8 * i));
+    return f;
+  };
+  port.inject(le64(0x100, 0x7FFFFFFFFFFFFFF6ull, 10 * kMs));
+  port.inject(le64(0x101, 0x8000000000000000ull, 10 * kMs));
+  enc.read(10 * kMs);
+  port.inject(le64(0x100, 0x800000000000000Aull, 20 * kMs));
+  port.inject(le64(0x101, 0x8000000000000005ull, 20 * kMs));
+  const EncoderSample s = enc.read(20 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 20);
+  EXPECT_EQ(s.right, -5);
+}
+
 TEST_F(CanEncoder, ReverseNegatesTheCount) {
   cfg.reverse_right = true;
   CanEncoderSource enc = make();
