@@ -161,48 +161,58 @@ TEST(CanEncoderKernel, StoppedSenderIsStaleWithinTheTimeoutPlusOnePeriod) {
   c.timeout = 100 * kMs;
   Rig r;
   ASSERT_TRUE(r.open(v.name, c));
+  // The loop runs SCHED_FIFO as the firmware's does (RESET_ON_FORK: the senders do not).
+  sched_param sp{};
+  sp.sched_priority = 80;
+  const bool fifo = sched_setscheduler(0, SCHED_FIFO | SCHED_RESET_ON_FORK, &sp) == 0;
   // Two independent senders, one frame every 10 ms each, constant counts (a wheel at rest).
   Background left("cangen vcce2 -I 00A -L 8 -D 0100000000000000 -g 10");
   Background right("cangen vcce2 -I 02A -L 8 -D 0200000000000000 -g 10");
   ASSERT_GT(left.pid, 0);
   ASSERT_GT(right.pid, 0);
-  // The loop: 100 Hz on absolute deadlines for 1 s: after the first frames never stale.
+  // The loop: 100 Hz on absolute deadlines for 1 s; once both wheels are fresh, never stale.
   const TimeNs period = 10 * kMs;
   TimeNs t = r.clock.now();
-  int fresh = 0, stale = 0;
+  int fresh = 0;
   for (int i = 0; i < 100; ++i) {
     t += period;
     r.clock.sleep_until(t);
     const EncoderSample s = r.enc->read(r.clock.now());
-    (s.flags == 0 ? fresh : stale)++;
     if (fresh > 0) EXPECT_EQ(s.flags, 0u) << "tick " << i;
+    if (s.flags == 0) ++fresh;
   }
-  EXPECT_GE(fresh, 90);
-  // Stop the left sender; measure until the loop sees stale-left.
+  EXPECT_GE(fresh, 50);  // the senders start within half a second, even under emulation
+  // Stop the left sender; tick on until the loop sees stale-left.
   left.stop();
   const TimeNs stopped = r.clock.now();
-  TimeNs seen = -1;
+  TimeNs seen = -1, late = 0;
   for (int i = 0; i < 100 && seen < 0; ++i) {
     t += period;
     r.clock.sleep_until(t);
     const TimeNs now = r.clock.now();
     const EncoderSample s = r.enc->read(now);
     EXPECT_EQ(s.flags & kEncoderStaleRight, 0u);
-    if (s.flags & kEncoderStaleLeft) seen = now;
+    if (s.flags & kEncoderStaleLeft) {
+      seen = now;
+      late = now - t;  // how late this tick woke (emulator, host load)
+    }
   }
+  sp.sched_priority = 0;
+  sched_setscheduler(0, SCHED_OTHER, &sp);
   ASSERT_GT(seen, 0) << "never flagged stale";
-  const double latency = to_seconds(seen - stopped);
+  const double from_kill = to_seconds(seen - stopped);
+  const double from_last = to_seconds(seen - r.enc->last_frame(0));
   std::printf(
-      "stale detection: %.1f ms after the sender was killed (timeout 100 ms, period 10 ms)\n",
-      latency * 1e3);
-  RecordProperty("stale_latency_ms", std::to_string(latency * 1e3));
-  // The last frame came at most one sender gap before the kill, so stale is flagged at the
-  // first tick after last frame + timeout: <= timeout + one loop period after the kill (+2 ms
-  // of scheduling allowance for the VM's timer).
-  EXPECT_LE(latency, 0.100 + 0.010 + 0.002);
-  // Not long before the timeout: the last frame may precede the kill by one sender gap, which
-  // under the emulated VM's timers stretches to ~12 ms; two gaps are allowed.
-  EXPECT_GE(latency, 0.100 - 0.020);
+      "stale detection (%s loop): %.1f ms after the left wheel's last frame, %.1f ms "
+      "after the sender was killed (timeout 100 ms, period 10 ms, tick woke %.2f ms "
+      "late)\n",
+      fifo ? "SCHED_FIFO" : "SCHED_OTHER", from_last * 1e3, from_kill * 1e3,
+      to_seconds(late) * 1e3);
+  RecordProperty("stale_after_last_frame_ms", std::to_string(from_last * 1e3));
+  // Flagged at the first tick after last frame + timeout: within (timeout, timeout + one
+  // period] of the last frame, plus however late that tick woke.
+  EXPECT_GT(from_last, 0.100);
+  EXPECT_LE(from_last, 0.100 + 0.010 + to_seconds(late));
   EXPECT_EQ(r.enc->read(r.clock.now()).counters.stale_events, 1u);
 }
 
@@ -283,8 +293,14 @@ TEST(CanEncoderKernel, ReceiveFloodDecoderKeepsUpLoopNeverBlocks) {
       static_cast<double>(rx_frames) / a.seconds, fifo ? "SCHED_FIFO 80" : "SCHED_OTHER",
       static_cast<double>(sa.decoded) / a.seconds, static_cast<unsigned long long>(sa.foreign),
       to_seconds(a.worst_read) * 1e6, a.late_ticks, a.stale_ticks, a.jump_ticks);
-  EXPECT_EQ(sa.foreign, 0u);    // the kernel filter dropped every foreign id
-  EXPECT_EQ(a.stale_ticks, 0);  // fresh counts on every tick despite the flood
+  EXPECT_EQ(sa.foreign, 0u);  // the kernel filter dropped every foreign id
+  // Fresh counts on every tick despite the flood. When the whole VM stalls (the host's qemu
+  // thread not scheduled: the SCHED_FIFO loop itself then wakes more than a period late), the
+  // senders stall too; a stale tick is accepted only alongside such stalls.
+  if (a.late_ticks == 0)
+    EXPECT_EQ(a.stale_ticks, 0);
+  else
+    EXPECT_LE(a.stale_ticks, a.late_ticks);
   EXPECT_EQ(a.jump_ticks, 0);
   // A read is at most 64 non-blocking recv calls; under TCG emulation the kernel's softirq
   // work for the flood lands inside it too. It never takes a whole period.

@@ -98,6 +98,11 @@ class CanEncoderSource final : public EncoderSource {
   int counter_bits() const noexcept override { return cfg_.left.width_bits; }
 
   const CanEncoderStats& stats() const noexcept { return stats_; }
+  // last_frame: receive stamp of the newest accepted frame of wheel 0 (left) or 1 (right) [ns];
+  // 0 before the first.
+  TimeNs last_frame(int wheel) const noexcept {
+    return wheel_[wheel == 0 ? 0 : 1].primed ? wheel_[wheel == 0 ? 0 : 1].last_stamp : 0;
+  }
 
  private:
   CanEncoderSource(CanBus& bus, const CanEncoderConfig& cfg) : bus_(&bus), cfg_(cfg) {}
