@@ -7,6 +7,7 @@
 
 #include "odo/drivers/can_encoder.hpp"
 #include "odo/sim/sim_can_bus.hpp"
+#include "odo/sim/sim_odrive.hpp"
 
 namespace odo::drivers {
 namespace {
@@ -372,6 +373,60 @@ TEST_F(CanEncoder, CreateRejectsMismatchedWidthsAndOverlaps) {
   cfg.right = odrive_count_layout(1);
   cfg.max_frames_per_read = 0;
   EXPECT_FALSE(CanEncoderSource::create(port, cfg).ok());
+}
+
+TEST(SimOdrive, PublishesCanSimpleEncoderCountFrames) {
+  sim::SimCanPort port(8, 8);
+  sim::SimOdrive od(port, sim::SimOdriveOptions{2, 5, 8192});
+  // Left: -3 counts: shadow 0xFFFFFFFD, count in CPR (-3 mod 8192) = 8189 = 0x1FFD.
+  // Right: 2^32 + 7 counts: the shadow count keeps the low 32 bits = 7; in CPR 7.
+  od.publish(42, -3, (std::int64_t{1} << 32) + 7);
+  CanFrame f;
+  ASSERT_TRUE(port.receive(f));
+  EXPECT_EQ(f.id, (2u << 5) | 0x00Au);  // 0x04A
+  EXPECT_EQ(f.len, 8);
+  EXPECT_EQ(f.stamp, 42);
+  const std::array<std::uint8_t, 8> left{0xFD, 0xFF, 0xFF, 0xFF, 0xFD, 0x1F, 0x00, 0x00};
+  EXPECT_EQ(f.data, left);
+  ASSERT_TRUE(port.receive(f));
+  EXPECT_EQ(f.id, (5u << 5) | 0x00Au);  // 0x0AA
+  const std::array<std::uint8_t, 8> right{7, 0, 0, 0, 7, 0, 0, 0};
+  EXPECT_EQ(f.data, right);
+  EXPECT_FALSE(port.receive(f));
+  EXPECT_EQ(od.frames(), 2u);
+}
+
+TEST(SimOdrive, FaultHooksReachTheDriverAsStaleAndJump) {
+  sim::SimCanPort port(8, 64);
+  sim::SimOdrive od(port, sim::SimOdriveOptions{0, 1, 8192});
+  CanEncoderConfig c;
+  c.left = odrive_count_layout(0);
+  c.right = odrive_count_layout(1);
+  c.timeout = 50 * kMs;
+  c.max_counts_per_s = 10'000;
+  CanEncoderSource enc = CanEncoderSource::create(port, c).value();
+  // Both axes at rest at 0, published every 10 ms.
+  TimeNs t = 0;
+  for (; t <= 30 * kMs; t += 10 * kMs) {
+    od.publish(t, 0, 0);
+    EXPECT_EQ(enc.read(t).flags, 0u);
+  }
+  // The right axis stops sending after 30 ms; the left leaps 1000 counts at 40 ms (limit
+  // 10 000 * (0.010 + 0.005) + 1 = 151 counts).
+  od.set_sending(1, false);
+  od.add_jump(0, 1000);
+  od.publish(t, 0, 0);
+  EncoderSample s = enc.read(t);  // t = 40 ms
+  EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kEncoderImplausibleJump));
+  EXPECT_EQ(s.left, 0);
+  // The right wheel's last frame was at 30 ms: stale once the read is later than 80 ms.
+  for (t += 10 * kMs; t <= 90 * kMs; t += 10 * kMs) {
+    od.publish(t, 0, 0);
+    s = enc.read(t);
+    EXPECT_EQ(s.flags, t > 80 * kMs ? kEncoderStaleRight : 0u) << t;
+  }
+  EXPECT_EQ(s.counters.stale_events, 1u);
+  EXPECT_EQ(s.counters.implausible_jumps, 1u);
 }
 
 }  // namespace
