@@ -53,6 +53,21 @@ struct Background {
   ~Background() { stop(); }
 };
 
+// FifoScope: the calling thread runs SCHED_FIFO 80 as the firmware's loop does (README,
+// [realtime]) while it lives; RESET_ON_FORK: processes started meanwhile run normally.
+struct FifoScope {
+  bool on = false;
+  FifoScope() {
+    sched_param sp{};
+    sp.sched_priority = 80;
+    on = sched_setscheduler(0, SCHED_FIFO | SCHED_RESET_ON_FORK, &sp) == 0;
+  }
+  ~FifoScope() {
+    sched_param sp{};
+    if (on) sched_setscheduler(0, SCHED_OTHER, &sp);
+  }
+};
+
 // Rig: a SocketCanBus with exact kernel filters for the two wheels (as the firmware's
 // make_can_socketcan_backend installs them) and the encoder on it.
 struct Rig {
@@ -161,10 +176,7 @@ TEST(CanEncoderKernel, StoppedSenderIsStaleWithinTheTimeoutPlusOnePeriod) {
   c.timeout = 100 * kMs;
   Rig r;
   ASSERT_TRUE(r.open(v.name, c));
-  // The loop runs SCHED_FIFO as the firmware's does (RESET_ON_FORK: the senders do not).
-  sched_param sp{};
-  sp.sched_priority = 80;
-  const bool fifo = sched_setscheduler(0, SCHED_FIFO | SCHED_RESET_ON_FORK, &sp) == 0;
+  const FifoScope fifo;  // the senders started below run at normal priority
   // Two independent senders, one frame every 10 ms each, constant counts (a wheel at rest).
   Background left("cangen vcce2 -I 00A -L 8 -D 0100000000000000 -g 10");
   Background right("cangen vcce2 -I 02A -L 8 -D 0200000000000000 -g 10");
@@ -197,8 +209,6 @@ TEST(CanEncoderKernel, StoppedSenderIsStaleWithinTheTimeoutPlusOnePeriod) {
       late = now - t;  // how late this tick woke (emulator, host load)
     }
   }
-  sp.sched_priority = 0;
-  sched_setscheduler(0, SCHED_OTHER, &sp);
   ASSERT_GT(seen, 0) << "never flagged stale";
   const double from_kill = to_seconds(seen - stopped);
   const double from_last = to_seconds(seen - r.enc->last_frame(0));
@@ -206,7 +216,7 @@ TEST(CanEncoderKernel, StoppedSenderIsStaleWithinTheTimeoutPlusOnePeriod) {
       "stale detection (%s loop): %.1f ms after the left wheel's last frame, %.1f ms "
       "after the sender was killed (timeout 100 ms, period 10 ms, tick woke %.2f ms "
       "late)\n",
-      fifo ? "SCHED_FIFO" : "SCHED_OTHER", from_last * 1e3, from_kill * 1e3,
+      fifo.on ? "SCHED_FIFO" : "SCHED_OTHER", from_last * 1e3, from_kill * 1e3,
       to_seconds(late) * 1e3);
   RecordProperty("stale_after_last_frame_ms", std::to_string(from_last * 1e3));
   // Flagged at the first tick after last frame + timeout: within (timeout, timeout + one
@@ -257,12 +267,9 @@ TEST(CanEncoderKernel, ReceiveFloodDecoderKeepsUpLoopNeverBlocks) {
   ASSERT_TRUE(v.ok);
   Rig r;
   ASSERT_TRUE(r.open(v.name, odrive_config()));
-  // The firmware's loop runs SCHED_FIFO (README, [realtime]); so does this one, else the three
-  // busy senders on the VM's single CPU would preempt it and measure the scheduler. RESET_ON_FORK:
-  // the senders started below run at normal priority.
-  sched_param sp{};
-  sp.sched_priority = 80;
-  const bool fifo = sched_setscheduler(0, SCHED_FIFO | SCHED_RESET_ON_FORK, &sp) == 0;
+  // The loop runs SCHED_FIFO, else the busy senders on the VM's single CPU would preempt it
+  // and the test would measure the scheduler.
+  const FifoScope fifo;
   // Phase A, 2 s: foreign traffic from two senders with a 0.2 ms gap each, about 10 000
   // frames/s in all (more than a saturated 1 Mbit/s bus carries, ~7 600) (random 29-bit ids, and
   // the 11-bit id 0x7FF with random data; random 11-bit ids would hit our own ids with random
@@ -290,7 +297,7 @@ TEST(CanEncoderKernel, ReceiveFloodDecoderKeepsUpLoopNeverBlocks) {
       "flood A (%.0f frames/s on the interface, loop %s): %.0f of our frames/s "
       "decoded, foreign frames in user space %llu, worst read %.1f us, late ticks %d, "
       "stale ticks %d, jump ticks %d\n",
-      static_cast<double>(rx_frames) / a.seconds, fifo ? "SCHED_FIFO 80" : "SCHED_OTHER",
+      static_cast<double>(rx_frames) / a.seconds, fifo.on ? "SCHED_FIFO 80" : "SCHED_OTHER",
       static_cast<double>(sa.decoded) / a.seconds, static_cast<unsigned long long>(sa.foreign),
       to_seconds(a.worst_read) * 1e6, a.late_ticks, a.stale_ticks, a.jump_ticks);
   EXPECT_EQ(sa.foreign, 0u);  // the kernel filter dropped every foreign id
@@ -323,8 +330,6 @@ TEST(CanEncoderKernel, ReceiveFloodDecoderKeepsUpLoopNeverBlocks) {
   EXPECT_GT(sb.capped_reads, sa.capped_reads);  // the flood exceeded the cap
   EXPECT_LT(b.worst_read, 10 * kMs);
   EXPECT_EQ(b.jump_ticks, 0);
-  sp.sched_priority = 0;
-  sched_setscheduler(0, SCHED_OTHER, &sp);
 }
 
 }  // namespace
