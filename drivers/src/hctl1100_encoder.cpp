@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <string>
 
+#include "odo/drivers/count_plausibility.hpp"
+
 namespace odo::drivers {
 namespace {
 
@@ -13,7 +15,7 @@ constexpr std::uint8_t kRegLsb = 0x14;
 
 // wrap24: the low 24 bits of v, sign-extended (two's complement).
 constexpr std::int64_t wrap24(std::int64_t v) noexcept {
-  return static_cast<std::int64_t>(static_cast<std::uint64_t>(v) << 40) >> 40;
+  return wrap_bits(v, 24);
 }
 
 }  // namespace
@@ -84,8 +86,7 @@ EncoderSample Hctl1100Encoder::read(TimeNs now) noexcept {
       const std::int64_t step = wrap24(raw - w.last_raw);
       // The largest step the wheel can make since the last accepted reading, plus the motion
       // allowed inside one reading.
-      const double limit = cfg_.max_counts_per_s * dt + cfg_.agree_window + 1.0;
-      if (std::fabs(static_cast<double>(step)) > limit) {
+      if (implausible_step(step, cfg_.max_counts_per_s, dt, cfg_.agree_window + 1.0)) {
         // Report, do not integrate: shift the offset so the reported value stays put.
         w.offset += step;
         ++counters_.implausible_jumps;

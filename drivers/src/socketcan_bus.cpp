@@ -44,12 +44,14 @@ bool errno_means_vanished(int err) noexcept {
 }
 
 std::uint32_t to_socketcan_id(const CanFrame& f) noexcept {
-  return f.extended ? ((f.id & CAN_EFF_MASK) | CAN_EFF_FLAG) : (f.id & CAN_SFF_MASK);
+  const std::uint32_t rtr = f.rtr ? CAN_RTR_FLAG : 0u;  // a remote request (no data)
+  return rtr | (f.extended ? ((f.id & CAN_EFF_MASK) | CAN_EFF_FLAG) : (f.id & CAN_SFF_MASK));
 }
 
 bool from_socketcan_id(std::uint32_t can_id, CanFrame& f) noexcept {
   if ((can_id & (CAN_RTR_FLAG | CAN_ERR_FLAG)) != 0) return false;
   f.extended = (can_id & CAN_EFF_FLAG) != 0;
+  f.rtr = false;  // remote requests never get here (filtered above and in the kernel)
   f.id = f.extended ? (can_id & CAN_EFF_MASK) : (can_id & CAN_SFF_MASK);
   return true;
 }

@@ -112,6 +112,45 @@ void read_gpio(TableReader t, GpioSection& s) {
   t.finish();
 }
 
+void read_can_encoder(TableReader t, CanEncoderSection& s) {
+  s.bus = t.choice("bus", s.bus, {"socketcan", "sim"});
+  s.interface = t.string("interface", s.interface);
+  s.protocol = t.choice("protocol", s.protocol, {"odrive", "generic"});
+  s.node_left = static_cast<int>(t.integer("node_left", s.node_left, 0, 63));
+  s.node_right = static_cast<int>(t.integer("node_right", s.node_right, 0, 63));
+  s.reverse_left = t.boolean("reverse_left", s.reverse_left);
+  s.reverse_right = t.boolean("reverse_right", s.reverse_right);
+  s.timeout = t.number("timeout", s.timeout, 0.005, 10.0, "s");
+  s.max_speed = t.number("max_speed", s.max_speed, 0.01, 100.0, "m/s");
+  s.request_rate = t.number("request_rate", s.request_rate, 0.0, 1000.0, "Hz");
+  s.max_frames_per_read =
+      static_cast<int>(t.integer("max_frames_per_read", s.max_frames_per_read, 1, 4096));
+  s.extended = t.boolean("extended", s.extended);
+  const std::int64_t max_id = s.extended ? 0x1FFFFFFF : 0x7FF;
+  s.left_id = t.integer("left_id", s.left_id, 0, max_id);
+  s.right_id = t.integer("right_id", s.right_id, 0, max_id);
+  s.width = static_cast<int>(t.integer("width", s.width, 16, 64));
+  if (s.width % 8 != 0)
+    t.reject("width",
+             "= " + std::to_string(s.width) + " must be a whole number of bytes (16, 24, ..., 64)");
+  const int bytes = s.width / 8;
+  s.left_offset = static_cast<int>(t.integer("left_offset", s.left_offset, 0, 8 - bytes));
+  s.right_offset = static_cast<int>(t.integer("right_offset", s.right_offset, 0, 8 - bytes));
+  s.is_signed = t.boolean("signed", s.is_signed);
+  s.byte_order = t.choice("byte_order", s.byte_order, {"little", "big"});
+  if (s.protocol == "generic" && s.left_id == s.right_id && s.left_offset == s.right_offset)
+    t.reject("right_offset", "= " + std::to_string(s.right_offset) +
+                                 ": both wheels would read the same bytes of frame " +
+                                 std::to_string(s.left_id));
+  if (s.protocol == "odrive" && s.node_left == s.node_right)
+    t.reject("node_right", "= " + std::to_string(s.node_right) +
+                               " is the left wheel's node id too (they must differ)");
+  s.sim_period = t.number("sim_period", s.sim_period, 0.001, 1.0, "s");
+  s.sim_stop_left_after = t.number("sim_stop_left_after", s.sim_stop_left_after, -1.0, 1e6, "s");
+  s.sim_stop_right_after = t.number("sim_stop_right_after", s.sim_stop_right_after, -1.0, 1e6, "s");
+  t.finish();
+}
+
 void read_error_model(TableReader t, ErrorModelParams& k) {
   k.k_left = t.number("k_left", k.k_left, 0.0, kErrorModelKMax, "m^(1/2)");
   k.k_right = t.number("k_right", k.k_right, 0.0, kErrorModelKMax, "m^(1/2)");
@@ -200,6 +239,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_calibration(root.sub("calibration"), c.calibration);
   read_hctl1100(root.sub("hctl1100"), c.hctl1100);
   read_gpio(root.sub("gpio"), c.gpio);
+  read_can_encoder(root.sub("can_encoder"), c.can_encoder);
   read_error_model(root.sub("error_model"), c.error_model);
   read_can(root.sub("can"), c.can, c.loop.rate_hz);
   root.finish();

@@ -1,14 +1,18 @@
 #include "encoder_backends.hpp"
 
+#include <cstdio>
 #include <numbers>
 #include <optional>
 #include <sstream>
 
+#include "odo/drivers/can_encoder.hpp"
 #include "odo/drivers/gpio_quadrature.hpp"
 #include "odo/drivers/gpiod_parallel_bus.hpp"
 #include "odo/drivers/hctl1100_encoder.hpp"
+#include "odo/drivers/socketcan_bus.hpp"
 #include "odo/sim/hctl1100_model.hpp"
 #include "odo/sim/robot.hpp"
+#include "odo/sim/sim_odrive.hpp"
 
 namespace odo::fw {
 namespace {
@@ -105,7 +109,155 @@ class HctlSimBackend final : public EncoderBackend, public sim::BusCycleHook {
   std::string desc_;
 };
 
+class CanSocketBackend final : public EncoderBackend {
+ public:
+  CanSocketBackend(std::unique_ptr<drivers::SocketCanBus> bus, std::string d)
+      : bus_(std::move(bus)), desc_(std::move(d)) {}
+  void set_encoder(drivers::CanEncoderSource enc) { enc_.emplace(std::move(enc)); }
+  drivers::SocketCanBus& bus() noexcept { return *bus_; }
+  EncoderSource& encoder() noexcept override { return *enc_; }
+  const std::string& describe() const noexcept override { return desc_; }
+
+ private:
+  std::unique_ptr<drivers::SocketCanBus> bus_;  // the encoder points at it
+  std::optional<drivers::CanEncoderSource> enc_;
+  std::string desc_;
+};
+
+// CanSimBackend: before each read, the simulated ODrive axes publish every cyclic message due
+// since the last read (the robot moved to each message's time), then the driver reads the port.
+class CanSimBackend final : public EncoderBackend, public EncoderSource {
+ public:
+  CanSimBackend(const CanEncoderSection& s, sim::SimRobot& robot, TimeNs epoch)
+      : port_(64, 1024),
+        odrive_(port_, sim::SimOdriveOptions{static_cast<std::uint32_t>(s.node_left),
+                                             static_cast<std::uint32_t>(s.node_right), 8192}),
+        robot_(robot),
+        epoch_(epoch),
+        period_(from_seconds(s.sim_period)),
+        stop_left_(s.sim_stop_left_after < 0 ? -1 : from_seconds(s.sim_stop_left_after)),
+        stop_right_(s.sim_stop_right_after < 0 ? -1 : from_seconds(s.sim_stop_right_after)) {}
+  void set_encoder(drivers::CanEncoderSource enc, std::string d) {
+    enc_.emplace(std::move(enc));
+    desc_ = std::move(d);
+  }
+  sim::SimCanPort& port() noexcept { return port_; }
+  EncoderSample read(TimeNs now) noexcept override {
+    const TimeNs t = now - epoch_;
+    for (; next_ <= t; next_ += period_) {
+      if (next_ > robot_.time()) robot_.advance_to(next_);
+      odrive_.set_sending(0, stop_left_ < 0 || next_ < stop_left_);
+      odrive_.set_sending(1, stop_right_ < 0 || next_ < stop_right_);
+      odrive_.publish(next_ + epoch_, robot_.counts_left(), robot_.counts_right());
+    }
+    if (t > robot_.time()) robot_.advance_to(t);  // the truth at the loop's time
+    return enc_->read(now);
+  }
+  int counter_bits() const noexcept override { return enc_->counter_bits(); }
+  EncoderSource& encoder() noexcept override { return *this; }
+  const std::string& describe() const noexcept override { return desc_; }
+
+ private:
+  sim::SimCanPort port_;
+  sim::SimOdrive odrive_;
+  sim::SimRobot& robot_;
+  TimeNs epoch_;
+  TimeNs period_;
+  TimeNs stop_left_;
+  TimeNs stop_right_;
+  TimeNs next_ = 0;
+  std::optional<drivers::CanEncoderSource> enc_;
+  std::string desc_;
+};
+
+std::string layout_text(const drivers::CanCountLayout& l) {
+  char b[96];
+  std::snprintf(b, sizeof b, "id 0x%X%s bytes %d..%d", l.id, l.extended ? " (29-bit)" : "",
+                l.byte_offset, l.byte_offset + l.width_bits / 8 - 1);
+  return b;
+}
+
+std::string can_text(const CanEncoderSection& s, const drivers::CanEncoderConfig& c) {
+  std::ostringstream d;
+  if (s.protocol == "odrive")
+    d << "ODrive CAN Simple encoder counts (nodes " << s.node_left << "/" << s.node_right << ", ";
+  else
+    d << "generic CAN counts (";
+  d << "left " << layout_text(c.left) << ", right " << layout_text(c.right) << ", "
+    << c.left.width_bits << "-bit " << (c.left.is_signed ? "signed" : "unsigned") << " "
+    << (c.left.big_endian ? "big" : "little") << " endian), stale after " << s.timeout * 1e3
+    << " ms, jump limit " << c.max_counts_per_s << " counts/s"
+    << (s.request_rate > 0 ? ", requests at " + std::to_string(s.request_rate) + " Hz" : "");
+  return d.str();
+}
+
 }  // namespace
+
+drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const KinematicParams& p) {
+  drivers::CanEncoderConfig c;
+  if (s.protocol == "odrive") {
+    c.left = drivers::odrive_count_layout(static_cast<std::uint32_t>(s.node_left));
+    c.right = drivers::odrive_count_layout(static_cast<std::uint32_t>(s.node_right));
+  } else {
+    for (int i = 0; i < 2; ++i) {
+      drivers::CanCountLayout& l = i == 0 ? c.left : c.right;
+      l.id = static_cast<std::uint32_t>(i == 0 ? s.left_id : s.right_id);
+      l.extended = s.extended;
+      l.byte_offset = i == 0 ? s.left_offset : s.right_offset;
+      l.width_bits = s.width;
+      l.is_signed = s.is_signed;
+      l.big_endian = s.byte_order == "big";
+    }
+  }
+  c.reverse_left = s.reverse_left;
+  c.reverse_right = s.reverse_right;
+  c.timeout = from_seconds(s.timeout);
+  // Counts per metre of wheel travel: Ce * n / (pi * Dn).
+  c.max_counts_per_s =
+      s.max_speed * p.counts_per_rev * p.gear_ratio / (std::numbers::pi * p.wheel_diameter);
+  c.max_frames_per_read = s.max_frames_per_read;
+  c.request_period = s.request_rate > 0 ? from_seconds(1.0 / s.request_rate) : 0;
+  return c;
+}
+
+Result<std::unique_ptr<EncoderBackend>> make_can_socketcan_backend(const Config& cfg,
+                                                                   const Kinematics& k) {
+  const CanEncoderSection& s = cfg.can_encoder;
+  const drivers::CanEncoderConfig c = can_encoder_config(s, k.params());
+  drivers::SocketCanOptions o;
+  o.interface = s.interface;
+  for (const drivers::CanCountLayout* l : {&c.left, &c.right}) {
+    // Exact-id filters: every other frame is dropped by the kernel.
+    o.filters.push_back({l->id, l->extended ? 0x1FFFFFFFu : 0x7FFu, l->extended});
+  }
+  auto bus = drivers::SocketCanBus::open(o);
+  if (!bus) return in_file(cfg, "can_encoder", std::move(bus).error());
+  auto b = std::make_unique<CanSocketBackend>(std::move(bus).value(),
+                                              can_text(s, c) + " on SocketCAN " + s.interface);
+  auto enc = drivers::CanEncoderSource::create(b->bus(), c);
+  if (!enc) return in_file(cfg, "can_encoder", std::move(enc).error());
+  b->set_encoder(std::move(enc).value());
+  return std::unique_ptr<EncoderBackend>(std::move(b));
+}
+
+Result<std::unique_ptr<EncoderBackend>> make_can_sim_backend(const Config& cfg, const Kinematics& k,
+                                                             sim::SimRobot& robot, TimeNs epoch) {
+  const CanEncoderSection& s = cfg.can_encoder;
+  if (s.protocol != "odrive")
+    return make_error(Errc::kInvalidArgument,
+                      cfg.source +
+                          ": [can_encoder] bus = \"sim\" simulates ODrive controllers: "
+                          "set protocol = \"odrive\"");
+  const drivers::CanEncoderConfig c = can_encoder_config(s, k.params());
+  auto b = std::make_unique<CanSimBackend>(s, robot, epoch);
+  auto enc = drivers::CanEncoderSource::create(b->port(), c);
+  if (!enc) return in_file(cfg, "can_encoder", std::move(enc).error());
+  std::ostringstream d;
+  d << can_text(s, c) << ", from 2 simulated ODrive axes every " << s.sim_period * 1e3
+    << " ms following the simulated robot";
+  b->set_encoder(std::move(enc).value(), d.str());
+  return std::unique_ptr<EncoderBackend>(std::move(b));
+}
 
 double max_counts_per_s(const Hctl1100Section& s, const KinematicParams& p) {
   // Counts per metre of wheel travel: Ce * n / (pi * Dn).

@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "odo/drivers/can_encoder.hpp"
 #include "odo/firmware/config.hpp"
 #include "odo/hal/clock.hpp"
 #include "odo/hal/encoder.hpp"
@@ -42,5 +43,20 @@ Result<std::unique_ptr<EncoderBackend>> make_hctl_sim_backend(const Config& cfg,
                                                               const Kinematics& k,
                                                               sim::SimRobot& robot, Clock& clock,
                                                               TimeNs epoch);
+
+// can_encoder_config: the driver configuration of [can_encoder] for this robot (layouts from
+// the protocol, jump limit from max_speed, request period from request_rate).
+drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const KinematicParams& p);
+
+// make_can_socketcan_backend: [can_encoder] with bus = "socketcan": a raw socket on
+// `interface` with kernel filters for the two wheel ids.
+Result<std::unique_ptr<EncoderBackend>> make_can_socketcan_backend(const Config& cfg,
+                                                                   const Kinematics& k);
+
+// make_can_sim_backend: [can_encoder] with bus = "sim": two simulated ODrive axes publish the
+// counts of `robot` (robot time = loop time minus `epoch`) every sim_period into a simulated
+// bus port, read by the real driver; sim_stop_*_after stop an axis (fault).
+Result<std::unique_ptr<EncoderBackend>> make_can_sim_backend(const Config& cfg, const Kinematics& k,
+                                                             sim::SimRobot& robot, TimeNs epoch);
 
 }  // namespace odo::fw

@@ -104,13 +104,16 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
   auto impl = std::make_unique<Impl>();
   const std::string& be = cfg.encoder.backend;
   const bool hctl_sim = be == "hctl1100" && cfg.hctl1100.bus == "sim";
-  if (be == "gpio" || (be == "hctl1100" && !hctl_sim)) {
+  const bool can_sim = be == "can" && cfg.can_encoder.bus == "sim";
+  if (be == "gpio" || (be == "hctl1100" && !hctl_sim) || (be == "can" && !can_sim)) {
     if (virtual_time)
       return make_error(Errc::kInvalidArgument,
                         "--virtual-time needs a simulated encoder "
                         "backend (encoder.backend = \"" +
                             be + "\")");
-    auto b = be == "gpio" ? make_gpio_backend(cfg) : make_hctl_gpio_backend(cfg, k);
+    auto b = be == "gpio"       ? make_gpio_backend(cfg)
+             : be == "hctl1100" ? make_hctl_gpio_backend(cfg, k)
+                                : make_can_socketcan_backend(cfg, k);
     if (!b) return std::move(b).error();
     impl->backend = std::move(b).value();
     impl->clock = std::make_unique<drivers::MonotonicClock>();
@@ -118,7 +121,7 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     impl->description = impl->backend->describe() + ", real time (CLOCK_MONOTONIC)";
     return Rig(std::move(impl));
   }
-  if (be != "sim" && !hctl_sim) {
+  if (be != "sim" && !hctl_sim && !can_sim) {
     return make_error(Errc::kUnsupported, cfg.source + ": encoder.backend = \"" +
                                               cfg.encoder.backend +
                                               "\" is not available in this build yet");
@@ -157,12 +160,19 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     impl->backend = std::move(b).value();
     impl->encoder = &impl->backend->encoder();
   }
+  if (can_sim) {
+    const TimeNs epoch = virtual_time ? 0 : impl->clock->now();
+    auto b = make_can_sim_backend(cfg, k, *impl->robot, epoch);
+    if (!b) return std::move(b).error();
+    impl->backend = std::move(b).value();
+    impl->encoder = &impl->backend->encoder();
+  }
   impl->truth = std::make_unique<TruthObserver>(*impl->robot);
   std::ostringstream d;
   d << "simulated robot '" << cfg.sim.robot << "' (true wheelbase " << g.wheelbase * 1e3
     << " mm, D_R/D_L " << g.wheel_diameter_right / g.wheel_diameter_left << "), scenario '"
     << cfg.sim.scenario << "' (" << impl->scenario_duration << " s), " << cfg.sim.counter_bits
-    << "-bit counters, " << (hctl_sim ? impl->backend->describe() + ", " : std::string())
+    << "-bit counters, " << (hctl_sim || can_sim ? impl->backend->describe() + ", " : std::string())
     << (virtual_time ? "virtual time" : "real time (CLOCK_MONOTONIC)");
   impl->description = d.str();
   return Rig(std::move(impl));

@@ -24,6 +24,10 @@ void TableReader::fail(const toml::node* n, std::string_view key, const std::str
   *error_ = o.str();
 }
 
+void TableReader::reject(std::string_view key, const std::string& what) {
+  fail(table_ != nullptr ? table_->get(key) : nullptr, key, what);
+}
+
 const toml::node* TableReader::get(std::string_view key) {
   used_.emplace(key);
   if (table_ == nullptr) return nullptr;

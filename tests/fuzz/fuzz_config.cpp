@@ -30,6 +30,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   require(c->sim.counter_bits >= 16 && c->sim.counter_bits <= 64, "sim.counter_bits out of range");
   const std::string& b = c->encoder.backend;
   require(b == "sim" || b == "hctl1100" || b == "gpio" || b == "can", "unknown backend", b);
+  // [can_encoder]: an accepted generic layout fits a classic frame and its id length.
+  const auto& e = c->can_encoder;
+  const std::int64_t max_id = e.extended ? 0x1FFFFFFF : 0x7FF;
+  require(e.width >= 16 && e.width <= 64 && e.width % 8 == 0, "can_encoder.width invalid");
+  require(e.left_offset >= 0 && e.left_offset + e.width / 8 <= 8 && e.right_offset >= 0 &&
+              e.right_offset + e.width / 8 <= 8,
+          "can_encoder offset does not fit 8 bytes");
+  require(e.left_id >= 0 && e.left_id <= max_id && e.right_id >= 0 && e.right_id <= max_id,
+          "can_encoder id does not fit its length");
+  require(
+      in(e.timeout, 0.005, 10.0) && in(e.request_rate, 0.0, 1000.0) && in(e.max_speed, 0.01, 100.0),
+      "can_encoder timing out of range");
   require(c->source == "fuzz.toml", "source not kept");
   auto k = odo::Kinematics::create(c->robot);
   require(k.ok(), "accepted robot section gives invalid kinematics:",

@@ -351,5 +351,36 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   EXPECT_EQ(loop->stats().wakeup_latency.count, kTicks - kTicks % fw::OdometryLoop::kSummaryTicks);
 }
 
+TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
+  // [encoder] backend = "can" on the simulated ODrive pair: frames packed, queued on the
+  // simulated port, drained and decoded every tick, and the stale path once the left axis stops
+  // sending at 20 s; none of it may allocate.
+  fw::Config cfg = fw::default_config();
+  cfg.loop.rate_hz = 1000.0;
+  cfg.encoder.backend = "can";
+  cfg.can_encoder.bus = "sim";
+  cfg.can_encoder.sim_stop_left_after = 20.0;
+  auto kin = Kinematics::create(cfg.robot);
+  ASSERT_TRUE(kin.ok());
+  auto rig = fw::Rig::create(cfg, *kin, /*virtual_time=*/true);
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  fw::LoopConfig lc;
+  lc.rate_hz = cfg.loop.rate_hz;
+  auto loop = fw::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
+  loop->start();
+  constexpr std::uint64_t kTicks = 40'000;  // 40 s at 1 kHz
+  {
+    AllocWindow w;
+    for (std::uint64_t i = 0; i < kTicks; ++i) loop->tick();
+    w.disarm();
+    EXPECT_EQ(g_allocs.load(), 0u) << "heap allocations during " << kTicks << " ticks";
+    EXPECT_EQ(g_frees.load(), 0u) << "heap deallocations during " << kTicks << " ticks";
+  }
+  fw::LoopSnapshot snap;
+  ASSERT_TRUE(loop->snapshots().latest(snap));
+  EXPECT_EQ(snap.encoder_flags, static_cast<std::uint32_t>(kEncoderStaleLeft));
+  EXPECT_EQ(snap.encoder_counters.stale_events, 1u);
+}
+
 }  // namespace
 }  // namespace odo::test

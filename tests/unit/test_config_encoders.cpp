@@ -84,6 +84,63 @@ reverse_left = true
   EXPECT_FALSE(g.reverse_right);
 }
 
+TEST(ConfigEncoders, CanEncoderDefaults) {
+  auto c = parse_config("[encoder]\nbackend = \"can\"\n", "c.toml");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  const CanEncoderSection& e = c->can_encoder;
+  EXPECT_EQ(e.bus, "socketcan");
+  EXPECT_EQ(e.interface, "can0");
+  EXPECT_EQ(e.protocol, "odrive");
+  EXPECT_EQ(e.node_left, 0);
+  EXPECT_EQ(e.node_right, 1);
+  EXPECT_DOUBLE_EQ(e.timeout, 0.1);
+  EXPECT_DOUBLE_EQ(e.request_rate, 0.0);  // requests off: ODrive sends cyclically
+  EXPECT_EQ(e.max_frames_per_read, 64);
+}
+
+TEST(ConfigEncoders, ReadsCanEncoderGenericLayout) {
+  auto c = parse_config(R"(
+[encoder]
+backend = "can"
+[can_encoder]
+bus = "socketcan"
+interface = "vcan0"
+protocol = "generic"
+extended = true
+left_id = 0x18FF0010
+right_id = 0x18FF0010
+left_offset = 0
+right_offset = 4
+width = 32
+signed = false
+byte_order = "big"
+timeout = 0.25
+max_speed = 1.5
+request_rate = 50
+max_frames_per_read = 128
+reverse_left = true
+)",
+                        "c.toml");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  const CanEncoderSection& e = c->can_encoder;
+  EXPECT_EQ(e.interface, "vcan0");
+  EXPECT_EQ(e.protocol, "generic");
+  EXPECT_TRUE(e.extended);
+  EXPECT_EQ(e.left_id, 0x18FF0010);
+  EXPECT_EQ(e.right_id, 0x18FF0010);
+  EXPECT_EQ(e.left_offset, 0);
+  EXPECT_EQ(e.right_offset, 4);
+  EXPECT_EQ(e.width, 32);
+  EXPECT_FALSE(e.is_signed);
+  EXPECT_EQ(e.byte_order, "big");
+  EXPECT_DOUBLE_EQ(e.timeout, 0.25);
+  EXPECT_DOUBLE_EQ(e.max_speed, 1.5);
+  EXPECT_DOUBLE_EQ(e.request_rate, 50.0);
+  EXPECT_EQ(e.max_frames_per_read, 128);
+  EXPECT_TRUE(e.reverse_left);
+  EXPECT_FALSE(e.reverse_right);
+}
+
 struct Bad {
   const char* text;
   const char* expect;
@@ -106,7 +163,39 @@ INSTANTIATE_TEST_SUITE_P(
         Bad{"[gpio]\nleft_index = -2\n", "bad.toml:2: gpio.left_index = -2 is outside"},
         Bad{"[gpio]\n\nbatch = 0\n", "bad.toml:3: gpio.batch"},
         Bad{"[gpio]\nreorder_window = 1\n", "bad.toml:2: gpio.reorder_window"},
-        Bad{"[gpio]\nleft_c = 1\n", "bad.toml:2: gpio.left_c is not a known setting"}));
+        Bad{"[gpio]\nleft_c = 1\n", "bad.toml:2: gpio.left_c is not a known setting"},
+        Bad{"[can_encoder]\nbus = \"usb\"\n",
+            "bad.toml:2: can_encoder.bus = \"usb\" is not one of: socketcan, sim"},
+        Bad{"[can_encoder]\nprotocol = \"canopen\"\n",
+            "bad.toml:2: can_encoder.protocol = \"canopen\" is not one of: odrive, generic"},
+        Bad{"[can_encoder]\nnode_left = 64\n",
+            "bad.toml:2: can_encoder.node_left = 64 is outside the allowed range [0, 63]"},
+        Bad{"[can_encoder]\nnode_right = 0\n",
+            "bad.toml:2: can_encoder.node_right = 0 is the left wheel's node id too"},
+        // 11-bit ids end at 0x7FF = 2047; 29-bit ones at 0x1FFFFFFF = 536870911.
+        Bad{"[can_encoder]\nleft_id = 2048\n",
+            "bad.toml:2: can_encoder.left_id = 2048 is outside the allowed range [0, 2047]"},
+        Bad{"[can_encoder]\nextended = true\nright_id = 0x20000000\n",
+            "bad.toml:3: can_encoder.right_id = 536870912 is outside the allowed range [0, "
+            "536870911]"},
+        Bad{"[can_encoder]\nwidth = 8\n",
+            "bad.toml:2: can_encoder.width = 8 is outside the allowed range [16, 64]"},
+        Bad{"[can_encoder]\nwidth = 20\n",
+            "bad.toml:2: can_encoder.width = 20 must be a whole number of bytes"},
+        // 32 bits are 4 bytes: the last offset that fits 8 data bytes is 4.
+        Bad{"[can_encoder]\nleft_offset = 5\n",
+            "bad.toml:2: can_encoder.left_offset = 5 is outside the allowed range [0, 4]"},
+        Bad{"[can_encoder]\nwidth = 64\nright_offset = 1\n",
+            "bad.toml:3: can_encoder.right_offset = 1 is outside the allowed range [0, 0]"},
+        Bad{"[can_encoder]\nprotocol = \"generic\"\nleft_id = 5\nright_id = 5\n",
+            "can_encoder.right_offset = 0: both wheels would read the same bytes of frame 5"},
+        Bad{"[can_encoder]\nbyte_order = \"middle\"\n",
+            "bad.toml:2: can_encoder.byte_order = \"middle\" is not one of: little, big"},
+        Bad{"[can_encoder]\nsigned = 1\n", "bad.toml:2: can_encoder.signed must be true or false"},
+        Bad{"[can_encoder]\nmax_frames_per_read = 0\n",
+            "bad.toml:2: can_encoder.max_frames_per_read = 0 is outside the allowed range [1, "
+            "4096]"},
+        Bad{"[can_encoder]\nnode = 1\n", "bad.toml:2: can_encoder.node is not a known setting"}));
 
 }  // namespace
 }  // namespace odo::fw

@@ -42,6 +42,12 @@ constexpr NumericKey kNumeric[] = {
     {"can", "status_hz", "-0.1", "2000.5", "[0, 2000] Hz"},
     {"can", "timing_hz", "-0.1", "2000.5", "[0, 2000] Hz"},
     {"can", "reopen_period", "0.009", "60.1", "[0.01, 60] s"},
+    {"can_encoder", "timeout", "0.004", "10.5", "[0.005, 10] s"},
+    {"can_encoder", "max_speed", "0.009", "100.5", "[0.01, 100] m/s"},
+    {"can_encoder", "request_rate", "-0.5", "1000.5", "[0, 1000] Hz"},
+    {"can_encoder", "sim_period", "0.0009", "1.5", "[0.001, 1] s"},
+    {"can_encoder", "sim_stop_left_after", "-1.5", "2e6", "[-1, 1e+06] s"},
+    {"can_encoder", "sim_stop_right_after", "-1.5", "2e6", "[-1, 1e+06] s"},
 };
 
 std::string doc(const NumericKey& k, const char* value) {
@@ -139,7 +145,7 @@ TEST(ConfigErrors, CanSection) {
 
 TEST(ConfigErrors, UnknownKeysAndTablesEverywhere) {
   for (const char* table : {"loop", "robot", "encoder", "sim", "realtime", "calibration",
-                            "hctl1100", "gpio", "error_model", "can"}) {
+                            "hctl1100", "gpio", "can_encoder", "error_model", "can"}) {
     expect_error(std::string("[") + table + "]\n\nbogus = 1\n",
                  std::string("bad.toml:3: ") + table + ".bogus is not a known setting (misspelt?)");
   }

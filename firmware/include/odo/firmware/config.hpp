@@ -67,6 +67,36 @@ struct GpioSection {
   double idle_check = 0.05;      // [s] 0.01..10
 };
 
+// [can_encoder]: wheel encoder counts that motor controllers publish on CAN. bus = "socketcan":
+// a SocketCAN interface; bus = "sim": a simulated ODrive pair following the simulated robot
+// (same driver on a simulated bus port).
+struct CanEncoderSection {
+  std::string bus = "socketcan";    // socketcan | sim
+  std::string interface = "can0";   // SocketCAN interface
+  std::string protocol = "odrive";  // odrive (CAN Simple Get_Encoder_Count) | generic
+  int node_left = 0;                // odrive: axis node ids 0..63
+  int node_right = 1;
+  bool reverse_left = false;
+  bool reverse_right = false;
+  double timeout = 0.1;          // [s] a wheel without a frame for this long is stale
+  double max_speed = 3.0;        // [m/s] physical maximum wheel surface speed (jump check)
+  double request_rate = 0.0;     // [Hz] remote requests per wheel, 0 = off (cyclic senders)
+  int max_frames_per_read = 64;  // frames taken per loop tick, 1..4096
+  // generic layout (protocol = "generic"); both wheels share width, order, signedness.
+  std::int64_t left_id = 0x100;  // arbitration id, 0..0x7FF (0..0x1FFFFFFF extended)
+  std::int64_t right_id = 0x101;
+  bool extended = false;  // 29-bit ids
+  int left_offset = 0;    // [bytes] 0..7
+  int right_offset = 0;
+  int width = 32;                     // [bits] 16, 24, ..., 64
+  bool is_signed = true;              // key "signed"
+  std::string byte_order = "little";  // little | big
+  // bus = "sim" only
+  double sim_period = 0.01;           // [s] cyclic message period of the simulated controllers
+  double sim_stop_left_after = -1.0;  // [s] the left axis stops sending after this; < 0 never
+  double sim_stop_right_after = -1.0;
+};
+
 struct EncoderSection {
   std::string backend = "sim";  // sim | hctl1100 | gpio | can
 };
@@ -111,6 +141,7 @@ struct Config {
   CalibrationSection calibration;
   Hctl1100Section hctl1100;
   GpioSection gpio;
+  CanEncoderSection can_encoder;
   ErrorModelParams error_model;  // [error_model]: Chong-Kleeman k_L, k_R [m^(1/2)]
   CanSection can;
 };

@@ -27,6 +27,8 @@ class TableReader {
   // choice: a string that must be one of `allowed`.
   std::string choice(std::string_view key, std::string def,
                      std::initializer_list<std::string_view> allowed);
+  // reject: reports a problem found across settings at the line of `key` (or of the table).
+  void reject(std::string_view key, const std::string& what);
   // sub: a nested table (may be absent).
   TableReader sub(std::string_view key);
   // reject: reports `what` for a key already read (cross-field checks), naming its line.

@@ -13,6 +13,7 @@ namespace odo {
 struct CanFrame {
   std::uint32_t id = 0;
   bool extended = false;
+  bool rtr = false;      // remote transmission request: carries no data, len = requested DLC
   std::uint8_t len = 0;  // data length 0..8 [bytes]
   std::array<std::uint8_t, 8> data{};
   TimeNs stamp = 0;  // receive time on the loop's clock [ns]; 0 for frames to send

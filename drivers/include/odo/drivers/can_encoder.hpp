@@ -1,0 +1,128 @@
+// CanEncoderSource: wheel encoder counts that motor controllers publish on CAN, as an
+// EncoderSource. Runs on any CanBus: SocketCanBus on a target (with kernel receive filters for
+// the two wheel ids), SimCanPort in tests and in the simulated rig.
+//
+// Frames: the ODrive "CAN Simple" Get_Encoder_Count reply (id node_id << 5 | 0x00A, 11-bit,
+// DLC 8: int32 shadow count at byte 0, int32 count-in-CPR at byte 4, little endian; the
+// shadow count is used: it is cumulative and wraps as an int32, the count-in-CPR wraps every
+// motor revolution and would alias above half a revolution per tick), or a generic layout
+// (id, 11/29-bit, byte offset, width 16..64 bits in whole bytes, signed or unsigned, little or
+// big endian). Both wheels may share one id at different offsets.
+//
+// read(now):
+// - takes at most max_frames_per_read frames from the bus without blocking; frames beyond stay
+//   queued (in the kernel socket buffer) for the next read, and since the counts are cumulative
+//   only the newest frame of each wheel matters: a backlog delays, never loses, motion;
+// - counts are reported relative to the first frame of each wheel (so the loop's reference
+//   reading is never a jump); before the first frame a wheel reads 0 and is stale;
+// - a wheel whose newest frame is older than `timeout` is flagged kEncoderStaleLeft/Right and
+//   keeps its last count; stale_events counts each fresh -> stale transition (the start-up
+//   state before the first frame is not an event). On recovery the count difference since the
+//   last frame is real motion (the counts are cumulative) unless it is implausible;
+// - a step between two frames of a wheel beyond max_counts_per_s * (time between the frames)
+//   + 1 count is flagged kEncoderImplausibleJump, counted and not integrated (re-based);
+// - optionally sends a remote request (RTR) for each wheel's id at request_period, for
+//   controllers that answer only on request; a dropped request is counted, never waited for.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "odo/hal/can_bus.hpp"
+#include "odo/hal/encoder.hpp"
+#include "odo/hal/result.hpp"
+#include "odo/hal/time.hpp"
+
+namespace odo::drivers {
+
+// CanCountLayout: where one wheel's count sits in which frame.
+struct CanCountLayout {
+  std::uint32_t id = 0;     // arbitration id, 11-bit (extended false) or 29-bit
+  bool extended = false;    // 29-bit identifier
+  int byte_offset = 0;      // first byte of the count in the data field, 0..7
+  int width_bits = 32;      // 16, 24, ..., 64 (whole bytes)
+  bool is_signed = true;    // two's complement; false: unsigned
+  bool big_endian = false;  // byte order of the count
+};
+
+// odrive_count_layout: the shadow count of ODrive CAN Simple Get_Encoder_Count (cmd 0x00A) of
+// node `node_id` (0..63).
+CanCountLayout odrive_count_layout(std::uint32_t node_id) noexcept;
+
+enum class CanDecode : std::uint8_t {
+  kOk,
+  kOtherId,     // id or id length differs: not this wheel's frame
+  kRemote,      // a remote request with this id: carries no count
+  kShortFrame,  // DLC too short for offset + width
+};
+
+// decode_count: the count of `layout` in frame `f` [counts, as the sender's counter holds it:
+// signed values sign-extended, unsigned zero-extended (64-bit unsigned: reinterpreted)]; no
+// allocation, no exceptions. `out` is written only for kOk.
+CanDecode decode_count(const CanFrame& f, const CanCountLayout& layout, std::int64_t& out) noexcept;
+
+// check_layout: configure-time validation of a layout; the message names the field.
+Status check_layout(const CanCountLayout& layout);
+
+struct CanEncoderConfig {
+  CanCountLayout left;
+  CanCountLayout right;
+  bool reverse_left = false;  // negate the count (mirrored motor mounting)
+  bool reverse_right = false;
+  TimeNs timeout = 100'000'000;   // [ns] newest frame older than this: stale
+  double max_counts_per_s = 1e6;  // physical maximum count rate of a wheel [counts/s]
+  int max_frames_per_read = 64;   // frames taken from the bus per read, 1..4096
+  TimeNs request_period = 0;      // [ns] between remote requests, 0 = never (cyclic senders)
+};
+
+// Per-source diagnostics beyond EncoderCounters.
+struct CanEncoderStats {
+  std::uint64_t frames = 0;            // frames taken from the bus
+  std::uint64_t decoded = 0;           // counts decoded (a frame may carry both wheels)
+  std::uint64_t foreign = 0;           // frames of other ids (the kernel filter lets none pass)
+  std::uint64_t short_frames = 0;      // our id with a DLC too short: ignored
+  std::uint64_t remote = 0;            // remote requests with our id: ignored
+  std::uint64_t capped_reads = 0;      // reads that stopped at max_frames_per_read
+  std::uint64_t requests_sent = 0;     // remote requests sent
+  std::uint64_t requests_dropped = 0;  // remote requests the bus refused
+};
+
+class CanEncoderSource final : public EncoderSource {
+ public:
+  // create: validates the configuration (layouts, equal widths, ranges); `bus` must outlive it.
+  static Result<CanEncoderSource> create(CanBus& bus, const CanEncoderConfig& cfg);
+
+  // read: drains frames and reports both wheels; see the header comment.
+  EncoderSample read(TimeNs now) noexcept override;
+  // counter_bits: the width of the configured count field.
+  int counter_bits() const noexcept override { return cfg_.left.width_bits; }
+
+  const CanEncoderStats& stats() const noexcept { return stats_; }
+  // last_frame: receive stamp of the newest accepted frame of wheel 0 (left) or 1 (right) [ns];
+  // 0 before the first.
+  TimeNs last_frame(int wheel) const noexcept {
+    return wheel_[wheel == 0 ? 0 : 1].primed ? wheel_[wheel == 0 ? 0 : 1].last_stamp : 0;
+  }
+
+ private:
+  CanEncoderSource(CanBus& bus, const CanEncoderConfig& cfg) : bus_(&bus), cfg_(cfg) {}
+  void accept(int wheel, std::int64_t raw, TimeNs stamp, std::uint32_t& flags) noexcept;
+  void send_requests(TimeNs now) noexcept;
+
+  struct Wheel {
+    std::int64_t offset = 0;    // subtracted from the sender's count (first frame, re-basing)
+    std::int64_t last_raw = 0;  // last accepted count (after reverse)
+    TimeNs last_stamp = 0;      // receive time of the newest frame [ns]
+    bool primed = false;        // a frame has arrived
+    bool stale = true;          // flagged stale at the last read
+  };
+
+  CanBus* bus_;
+  CanEncoderConfig cfg_;
+  std::array<Wheel, 2> wheel_{};
+  EncoderCounters counters_;
+  CanEncoderStats stats_;
+  TimeNs next_request_ = 0;
+};
+
+}  // namespace odo::drivers

@@ -1,0 +1,186 @@
+#include "odo/drivers/can_encoder.hpp"
+
+#include <string>
+
+#include "odo/drivers/count_plausibility.hpp"
+
+namespace odo::drivers {
+namespace {
+
+constexpr std::uint32_t kOdriveGetEncoderCount = 0x00A;
+constexpr std::uint32_t kMaxStdId = 0x7FF;
+constexpr std::uint32_t kMaxExtId = 0x1FFFFFFF;
+// Receive stamps are taken when a frame is read, not when the sender latched its count: two
+// frames may arrive closer together than they were sent. The jump limit allows this much
+// latency jitter on top of the time between the frames [s].
+constexpr double kLatencySlack = 0.005;
+
+}  // namespace
+
+CanCountLayout odrive_count_layout(std::uint32_t node_id) noexcept {
+  CanCountLayout l;
+  l.id = (node_id << 5) | kOdriveGetEncoderCount;
+  l.extended = false;
+  l.byte_offset = 0;  // shadow count; the count-in-CPR follows at byte 4
+  l.width_bits = 32;
+  l.is_signed = true;
+  l.big_endian = false;
+  return l;
+}
+
+CanDecode decode_count(const CanFrame& f, const CanCountLayout& layout,
+                       std::int64_t& out) noexcept {
+  if (f.id != layout.id || f.extended != layout.extended) return CanDecode::kOtherId;
+  if (f.rtr) return CanDecode::kRemote;
+  const int bytes = layout.width_bits / 8;
+  if (layout.byte_offset < 0 || bytes < 1 || bytes > 8 || layout.byte_offset + bytes > 8 ||
+      f.len > 8 || layout.byte_offset + bytes > f.len)
+    return CanDecode::kShortFrame;
+  std::uint64_t v = 0;
+  for (int i = 0; i < bytes; ++i) {
+    // Little endian: byte i carries bits 8i..8i+7; big endian: the first byte is the highest.
+    const int src =
+        layout.big_endian ? layout.byte_offset + i : layout.byte_offset + (bytes - 1 - i);
+    v = (v << 8) | f.data[static_cast<std::size_t>(src)];
+  }
+  const int bits = bytes * 8;
+  if (layout.is_signed) {
+    out = wrap_bits(static_cast<std::int64_t>(v), bits);
+  } else {
+    out = static_cast<std::int64_t>(v);  // zero-extended; 64-bit values reinterpreted
+  }
+  return CanDecode::kOk;
+}
+
+Status check_layout(const CanCountLayout& l) {
+  auto bad = [](const std::string& m) { return make_error(Errc::kInvalidArgument, m); };
+  if (!l.extended && l.id > kMaxStdId)
+    return bad("id " + std::to_string(l.id) + " does not fit 11 bits (0..2047; set extended)");
+  if (l.extended && l.id > kMaxExtId)
+    return bad("id " + std::to_string(l.id) + " does not fit 29 bits (0..536870911)");
+  if (l.width_bits < 16 || l.width_bits > 64 || l.width_bits % 8 != 0)
+    return bad("width " + std::to_string(l.width_bits) +
+               " must be 16, 24, 32, 40, 48, 56 or 64 bits (whole bytes; the loop needs >= 16)");
+  if (l.byte_offset < 0 || l.byte_offset + l.width_bits / 8 > 8)
+    return bad("byte offset " + std::to_string(l.byte_offset) + " + " +
+               std::to_string(l.width_bits / 8) + " bytes does not fit the 8 data bytes");
+  return Ok{};
+}
+
+Result<CanEncoderSource> CanEncoderSource::create(CanBus& bus, const CanEncoderConfig& cfg) {
+  auto bad = [](const std::string& m) { return make_error(Errc::kInvalidArgument, m); };
+  if (Status s = check_layout(cfg.left); !s) return bad("left wheel: " + s.error().message);
+  if (Status s = check_layout(cfg.right); !s) return bad("right wheel: " + s.error().message);
+  if (cfg.left.width_bits != cfg.right.width_bits)
+    return bad("both wheels' counts must have the same width");
+  if (cfg.left.id == cfg.right.id && cfg.left.extended == cfg.right.extended &&
+      cfg.left.byte_offset == cfg.right.byte_offset)
+    return bad("both wheels read the same bytes of the same frame");
+  if (cfg.timeout <= 0) return bad("timeout must be > 0 s");
+  if (!(cfg.max_counts_per_s > 0.0 && cfg.max_counts_per_s <= 1e9))
+    return bad("max_counts_per_s must be in (0, 1e9] counts/s");
+  if (cfg.max_frames_per_read < 1 || cfg.max_frames_per_read > 4096)
+    return bad("max_frames_per_read must be in [1, 4096]");
+  if (cfg.request_period < 0) return bad("request_period must be >= 0 s");
+  return CanEncoderSource(bus, cfg);
+}
+
+void CanEncoderSource::accept(int i, std::int64_t value, TimeNs stamp,
+                              std::uint32_t& flags) noexcept {
+  Wheel& w = wheel_[static_cast<std::size_t>(i)];
+  const int bits = counter_bits();
+  const bool reverse = i == 0 ? cfg_.reverse_left : cfg_.reverse_right;
+  const std::int64_t raw = reverse ? wrap_sub(0, value, bits) : wrap_bits(value, bits);
+  if (!w.primed) {
+    // The first frame is the reference: the wheel reads 0 here, as it did before.
+    w.offset = raw;
+    w.primed = true;
+  } else {
+    const std::int64_t step = wrap_sub(raw, w.last_raw, bits);
+    const double dt = to_seconds(stamp - w.last_stamp);
+    if (implausible_step(step, cfg_.max_counts_per_s, (dt > 0.0 ? dt : 0.0) + kLatencySlack, 1.0)) {
+      // Report, do not integrate: shift the offset so the reported value stays put.
+      w.offset = wrap_add(w.offset, step, bits);
+      ++counters_.implausible_jumps;
+      flags |= kEncoderImplausibleJump;
+    }
+  }
+  w.last_raw = raw;
+  w.last_stamp = stamp;
+}
+
+void CanEncoderSource::send_requests(TimeNs now) noexcept {
+  if (cfg_.request_period <= 0 || now < next_request_) return;
+  // Skip missed periods: one request per wheel per period at most, never a burst.
+  next_request_ = now + cfg_.request_period;
+  const std::array<const CanCountLayout*, 2> ls{&cfg_.left, &cfg_.right};
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (i == 1 && ls[1]->id == ls[0]->id && ls[1]->extended == ls[0]->extended) break;
+    CanFrame r;
+    r.id = ls[i]->id;
+    r.extended = ls[i]->extended;
+    r.rtr = true;
+    r.len = 8;
+    if (bus_->send(r) == CanTx::kSent)
+      ++stats_.requests_sent;
+    else
+      ++stats_.requests_dropped;
+  }
+}
+
+EncoderSample CanEncoderSource::read(TimeNs now) noexcept {
+  EncoderSample s;
+  s.stamp = now;
+  send_requests(now);
+  // Only the newest count of each wheel in this batch matters (cumulative counts).
+  std::array<std::int64_t, 2> newest{};
+  std::array<TimeNs, 2> newest_stamp{};
+  std::array<bool, 2> got{false, false};
+  const std::array<const CanCountLayout*, 2> ls{&cfg_.left, &cfg_.right};
+  CanFrame f;
+  int n = 0;
+  for (; n < cfg_.max_frames_per_read && bus_->receive(f); ++n) {
+    ++stats_.frames;
+    bool ours = false;
+    for (std::size_t i = 0; i < 2; ++i) {
+      std::int64_t v = 0;
+      switch (decode_count(f, *ls[i], v)) {
+        case CanDecode::kOk:
+          newest[i] = v;
+          newest_stamp[i] = f.stamp != 0 ? f.stamp : now;
+          got[i] = true;
+          ++stats_.decoded;
+          ours = true;
+          break;
+        case CanDecode::kRemote:
+          if (!ours) ++stats_.remote;
+          ours = true;
+          break;
+        case CanDecode::kShortFrame:
+          if (!ours) ++stats_.short_frames;
+          ours = true;
+          break;
+        case CanDecode::kOtherId:
+          break;
+      }
+    }
+    if (!ours) ++stats_.foreign;
+  }
+  if (n == cfg_.max_frames_per_read) ++stats_.capped_reads;
+  for (int i = 0; i < 2; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (got[k]) accept(i, newest[k], newest_stamp[k], s.flags);
+    Wheel& w = wheel_[k];
+    const bool stale = !w.primed || now - w.last_stamp > cfg_.timeout;
+    if (stale && !w.stale && w.primed) ++counters_.stale_events;
+    w.stale = stale;
+    if (stale) s.flags |= i == 0 ? kEncoderStaleLeft : kEncoderStaleRight;
+  }
+  const int bits = counter_bits();
+  s.left = wheel_[0].primed ? wrap_sub(wheel_[0].last_raw, wheel_[0].offset, bits) : 0;
+  s.right = wheel_[1].primed ? wrap_sub(wheel_[1].last_raw, wheel_[1].offset, bits) : 0;
+  s.counters = counters_;
+  return s;
+}
+
+}  // namespace odo::drivers

@@ -1,0 +1,433 @@
+// CAN encoder counts (issue 5, backend 3): the pure frame decoder with hand-built frames, and
+// CanEncoderSource against sim_hal's SimCanPort for every fault path (stale, recovery,
+// implausible jump, floods beyond the per-read cap, short frames, remote requests).
+#include <gtest/gtest.h>
+
+#include <cstdint>
+
+#include "odo/drivers/can_encoder.hpp"
+#include "odo/sim/sim_can_bus.hpp"
+#include "odo/sim/sim_odrive.hpp"
+
+namespace odo::drivers {
+namespace {
+
+constexpr TimeNs kMs = 1'000'000;
+
+CanFrame frame(std::uint32_t id, std::initializer_list<std::uint8_t> bytes, TimeNs stamp = 0,
+               bool extended = false) {
+  CanFrame f;
+  f.id = id;
+  f.extended = extended;
+  f.len = static_cast<std::uint8_t>(bytes.size());
+  std::size_t i = 0;
+  for (std::uint8_t b : bytes) f.data[i++] = b;
+  f.stamp = stamp;
+  return f;
+}
+
+// odrive: a Get_Encoder_Count reply of `node` with shadow count `shadow` (little endian int32
+// at byte 0) and count-in-CPR 0x55 at byte 4 (never read).
+CanFrame odrive(std::uint32_t node, std::int32_t shadow, TimeNs stamp) {
+  const auto u = static_cast<std::uint32_t>(shadow);
+  return frame(
+      (node << 5) | 0x00A,
+      {static_cast<std::uint8_t>(u), static_cast<std::uint8_t>(u >> 8),
+       static_cast<std::uint8_t>(u >> 16), static_cast<std::uint8_t>(u >> 24), 0x55, 0, 0, 0},
+      stamp);
+}
+
+TEST(CanDecode, OdriveLayoutIsShadowCountOfCommand0x00A) {
+  const CanCountLayout l = odrive_count_layout(3);
+  // node 3: 3 << 5 = 0x60, | 0x00A = 0x06A.
+  EXPECT_EQ(l.id, 0x06Au);
+  EXPECT_FALSE(l.extended);
+  EXPECT_EQ(l.byte_offset, 0);
+  EXPECT_EQ(l.width_bits, 32);
+  EXPECT_TRUE(l.is_signed);
+  EXPECT_FALSE(l.big_endian);
+  std::int64_t v = 0;
+  // bytes 0x10 0x32 0x54 0x76 little endian = 0x76543210 = 1985229328.
+  ASSERT_EQ(decode_count(frame(0x06A, {0x10, 0x32, 0x54, 0x76, 0xFF, 0xFF, 0xFF, 0xFF}), l, v),
+            CanDecode::kOk);
+  EXPECT_EQ(v, 1985229328);
+  // 0xFFFFFFFE as int32 = -2.
+  ASSERT_EQ(decode_count(frame(0x06A, {0xFE, 0xFF, 0xFF, 0xFF, 0, 0, 0, 0}), l, v), CanDecode::kOk);
+  EXPECT_EQ(v, -2);
+}
+
+TEST(CanDecode, ByteOrderSignednessWidthOffset) {
+  const CanFrame f = frame(0x123, {0x00, 0x80, 0x01, 0xFF, 0xFE, 0x12, 0x34, 0x56});
+  CanCountLayout l;
+  l.id = 0x123;
+  std::int64_t v = 0;
+  // 16 bits at offset 1, little endian: bytes 0x80 0x01 -> 0x0180 = 384 (signed or not).
+  l.byte_offset = 1;
+  l.width_bits = 16;
+  ASSERT_EQ(decode_count(f, l, v), CanDecode::kOk);
+  EXPECT_EQ(v, 384);
+  // Same bytes big endian: 0x8001 = 32769 unsigned, 32769 - 65536 = -32767 signed.
+  l.big_endian = true;
+  l.is_signed = false;
+  ASSERT_EQ(decode_count(f, l, v), CanDecode::kOk);
+  EXPECT_EQ(v, 32769);
+  l.is_signed = true;
+  ASSERT_EQ(decode_count(f, l, v), CanDecode::kOk);
+  EXPECT_EQ(v, -32767);
+  // 24 bits at offset 3, big endian: 0xFF 0xFE 0x12 = 0xFFFE12 = 16776722 unsigned;
+  // signed: 16776722 - 2^24 = 16776722 - 16777216 = -494.
+  l.byte_offset = 3;
+  l.width_bits = 24;
+  ASSERT_EQ(decode_count(f, l, v), CanDecode::kOk);
+  EXPECT_EQ(v, -494);
+  l.is_signed = false;
+  ASSERT_EQ(decode_count(f, l, v), CanDecode::kOk);
+  EXPECT_EQ(v, 16776722);
+  // 64 bits little endian: 0x56341 2FEFF018000 -> bytes reversed = 0x563412FEFF018000.
+  l.byte_offset = 0;
+  l.width_bits = 64;
+  l.big_endian = false;
+  l.is_signed = true;
+  ASSERT_EQ(decode_count(f, l, v), CanDecode::kOk);
+  EXPECT_EQ(static_cast<std::uint64_t>(v), 0x563412FEFF018000ull);
+  // 48 bits at offset 2, little endian: bytes 01 FF FE 12 34 56 -> 0x563412FEFF01, positive.
+  l.byte_offset = 2;
+  l.width_bits = 48;
+  ASSERT_EQ(decode_count(f, l, v), CanDecode::kOk);
+  EXPECT_EQ(v, 0x563412FEFF01ll);
+}
+
+TEST(CanDecode, WrongIdRemoteAndShortFramesAreNotCounts) {
+  const CanCountLayout l = odrive_count_layout(1);  // id 0x02A
+  std::int64_t v = 77;
+  EXPECT_EQ(decode_count(frame(0x02B, {1, 2, 3, 4, 5, 6, 7, 8}), l, v), CanDecode::kOtherId);
+  // The same number as a 29-bit id is another identifier.
+  EXPECT_EQ(decode_count(frame(0x02A, {1, 2, 3, 4}, 0, true), l, v), CanDecode::kOtherId);
+  CanFrame rtr = frame(0x02A, {});
+  rtr.rtr = true;
+  rtr.len = 8;
+  EXPECT_EQ(decode_count(rtr, l, v), CanDecode::kRemote);
+  // DLC 3 < offset 0 + 4 bytes.
+  EXPECT_EQ(decode_count(frame(0x02A, {1, 2, 3}), l, v), CanDecode::kShortFrame);
+  // A DLC above 8 is never trusted.
+  CanFrame bad = frame(0x02A, {1, 2, 3, 4});
+  bad.len = 15;
+  EXPECT_EQ(decode_count(bad, l, v), CanDecode::kShortFrame);
+  EXPECT_EQ(v, 77);  // untouched
+  // DLC 4 is enough for the shadow count (the count-in-CPR is not needed).
+  ASSERT_EQ(decode_count(frame(0x02A, {5, 0, 0, 0}), l, v), CanDecode::kOk);
+  EXPECT_EQ(v, 5);
+}
+
+TEST(CanDecode, LayoutChecksNameTheProblem) {
+  CanCountLayout l;
+  l.id = 0x800;  // 2048 > 0x7FF
+  EXPECT_NE(check_layout(l).error().message.find("does not fit 11 bits"), std::string::npos);
+  l.extended = true;
+  EXPECT_TRUE(check_layout(l).ok());
+  l.id = 0x20000000;  // 2^29
+  EXPECT_NE(check_layout(l).error().message.find("does not fit 29 bits"), std::string::npos);
+  l.id = 1;
+  l.width_bits = 8;
+  EXPECT_NE(check_layout(l).error().message.find("width 8"), std::string::npos);
+  l.width_bits = 20;
+  EXPECT_FALSE(check_layout(l).ok());
+  l.width_bits = 32;
+  l.byte_offset = 5;  // 5 + 4 = 9 > 8
+  EXPECT_NE(check_layout(l).error().message.find("byte offset 5 + 4 bytes"), std::string::npos);
+  l.byte_offset = 4;
+  EXPECT_TRUE(check_layout(l).ok());
+}
+
+struct CanEncoder : ::testing::Test {
+  sim::SimCanPort port{8, 512};
+  CanEncoderConfig cfg = [] {
+    CanEncoderConfig c;
+    c.left = odrive_count_layout(0);   // id 0x00A
+    c.right = odrive_count_layout(1);  // id 0x02A
+    c.timeout = 50 * kMs;
+    c.max_counts_per_s = 10'000;
+    return c;
+  }();
+  CanEncoderSource make() {
+    auto s = CanEncoderSource::create(port, cfg);
+    EXPECT_TRUE(s.ok());
+    return std::move(s).value();
+  }
+};
+
+TEST_F(CanEncoder, BeforeTheFirstFrameStaleAndZeroThenRelativeToIt) {
+  CanEncoderSource enc = make();
+  EXPECT_EQ(enc.counter_bits(), 32);
+  EncoderSample s = enc.read(10 * kMs);
+  EXPECT_EQ(s.flags, kEncoderStaleLeft | kEncoderStaleRight);
+  EXPECT_EQ(s.left, 0);
+  EXPECT_EQ(s.right, 0);
+  EXPECT_EQ(s.counters.stale_events, 0u);  // the start-up state is not an event
+  port.inject(odrive(0, 1000, 15 * kMs));
+  port.inject(odrive(1, -5000, 15 * kMs));
+  s = enc.read(20 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 0);  // the first frame is the reference
+  EXPECT_EQ(s.right, 0);
+  EXPECT_EQ(s.stamp, 20 * kMs);
+  // 10 ms later: +50 and -30 counts (well under 10 000 counts/s * 10 ms = 100).
+  port.inject(odrive(0, 1050, 25 * kMs));
+  port.inject(odrive(1, -5030, 25 * kMs));
+  s = enc.read(30 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 50);
+  EXPECT_EQ(s.right, -30);
+}
+
+TEST_F(CanEncoder, StoppedWheelIsStaleAfterTheTimeoutOnceAndRecoversWithRealMotion) {
+  CanEncoderSource enc = make();
+  port.inject(odrive(0, 0, 0 * kMs + 1));
+  port.inject(odrive(1, 0, 0 * kMs + 1));
+  EXPECT_EQ(enc.read(1 * kMs).flags, 0u);
+  // Only the right wheel keeps sending, every 10 ms; the left's last frame is at 1 ns.
+  std::uint32_t flags = 0;
+  for (TimeNs t = 10 * kMs; t <= 100 * kMs; t += 10 * kMs) {
+    port.inject(odrive(1, static_cast<std::int32_t>(t / kMs), t));
+    flags = enc.read(t).flags;
+    // Stale once now - 1 ns > 50 ms, i.e. from t = 60 ms on (50 ms is 1 ns short of it).
+    EXPECT_EQ(flags, t >= 60 * kMs ? kEncoderStaleLeft : 0u) << t;
+  }
+  EncoderSample s = enc.read(100 * kMs);
+  EXPECT_EQ(s.counters.stale_events, 1u);  // one transition, however long it lasts
+  EXPECT_EQ(s.left, 0);                    // the last count is kept
+  // The left wheel comes back at 200 ms having moved 900 counts: 199 ms at up to 10 000
+  // counts/s allows 1990 (+ slack), so this is real motion and is integrated.
+  port.inject(odrive(0, 900, 200 * kMs));
+  s = enc.read(200 * kMs);
+  EXPECT_EQ(s.flags & kEncoderStaleLeft, 0u);
+  EXPECT_EQ(s.flags & kEncoderImplausibleJump, 0u);
+  EXPECT_EQ(s.left, 900);
+  // Stops again: a second event.
+  s = enc.read(260 * kMs);
+  EXPECT_NE(s.flags & kEncoderStaleLeft, 0u);
+  EXPECT_EQ(s.counters.stale_events, 3u);  // + the right wheel, silent since 100 ms
+}
+
+TEST_F(CanEncoder, ImplausibleJumpIsReportedNotIntegrated) {
+  CanEncoderSource enc = make();
+  port.inject(odrive(0, 100, 10 * kMs));
+  port.inject(odrive(1, 100, 10 * kMs));
+  enc.read(10 * kMs);
+  // 10 ms later the left count leaps by 500: the limit is 10 000 * (0.010 + 0.005 latency
+  // slack) + 1 = 151 counts.
+  port.inject(odrive(0, 600, 20 * kMs));
+  port.inject(odrive(1, 240, 20 * kMs));  // right: +140 < 151, plausible
+  EncoderSample s = enc.read(20 * kMs);
+  EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kEncoderImplausibleJump));
+  EXPECT_EQ(s.left, 0);  // not integrated
+  EXPECT_EQ(s.right, 140);
+  EXPECT_EQ(s.counters.implausible_jumps, 1u);
+  // Motion after the jump counts from the new base: 600 -> 640 is +40.
+  port.inject(odrive(0, 640, 30 * kMs));
+  s = enc.read(30 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 40);
+}
+
+TEST_F(CanEncoder, Int32WrapIsMotionNotAJump) {
+  CanEncoderSource enc = make();
+  // 2147483600 -> -2147483616: as int32 steps, -2147483616 - 2147483600 = -4294967216,
+  // + 2^32 = +80 counts.
+  port.inject(odrive(0, 2147483600, 10 * kMs));
+  port.inject(odrive(1, 0, 10 * kMs));
+  enc.read(10 * kMs);
+  port.inject(odrive(0, -2147483616, 20 * kMs));
+  port.inject(odrive(1, 0, 20 * kMs));
+  const EncoderSample s = enc.read(20 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 80);
+}
+
+TEST_F(CanEncoder, SixtyFourBitCountsWrapWithoutOverflow) {
+  // Regression (fuzz_canenc, first seconds): with 64-bit counts the step last - first was
+  // computed in signed 64-bit arithmetic and overflowed (UBSan). Left: INT64_MAX - 9 then
+  // INT64_MIN + 10: modulo 2^64 the step is +20 counts. Right, reversed: INT64_MIN (its
+  // negation is itself modulo 2^64) then INT64_MIN + 5, negated: a step of -5.
+  cfg.left = CanCountLayout{0x100, false, 0, 64, true, false};
+  cfg.right = CanCountLayout{0x101, false, 0, 64, true, false};
+  cfg.reverse_right = true;
+  CanEncoderSource enc = make();
+  EXPECT_EQ(enc.counter_bits(), 64);
+  auto le64 = [](std::uint32_t id, std::uint64_t v, TimeNs t) {
+    CanFrame f = frame(id, {0, 0, 0, 0, 0, 0, 0, 0}, t);
+    for (std::size_t i = 0; i < 8; ++i) f.data[i] = static_cast<std::uint8_t>(v >> (8 * i));
+    return f;
+  };
+  port.inject(le64(0x100, 0x7FFFFFFFFFFFFFF6ull, 10 * kMs));
+  port.inject(le64(0x101, 0x8000000000000000ull, 10 * kMs));
+  enc.read(10 * kMs);
+  port.inject(le64(0x100, 0x800000000000000Aull, 20 * kMs));
+  port.inject(le64(0x101, 0x8000000000000005ull, 20 * kMs));
+  const EncoderSample s = enc.read(20 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 20);
+  EXPECT_EQ(s.right, -5);
+}
+
+TEST_F(CanEncoder, ReverseNegatesTheCount) {
+  cfg.reverse_right = true;
+  CanEncoderSource enc = make();
+  port.inject(odrive(0, 10, 10 * kMs));
+  port.inject(odrive(1, 10, 10 * kMs));
+  enc.read(10 * kMs);
+  port.inject(odrive(0, 30, 20 * kMs));
+  port.inject(odrive(1, 30, 20 * kMs));
+  const EncoderSample s = enc.read(20 * kMs);
+  EXPECT_EQ(s.left, 20);
+  EXPECT_EQ(s.right, -20);
+}
+
+TEST_F(CanEncoder, FloodBeyondTheCapIsReadOverTheNextTicksAndOnlyTheNewestCountMatters) {
+  cfg.max_frames_per_read = 64;
+  CanEncoderSource enc = make();
+  // 300 frames: foreign ids interleaved with our counts 1..100 of each wheel, all at 5 ms.
+  int ours = 0;
+  for (int k = 1; k <= 100; ++k) {
+    port.inject(frame(0x100 + static_cast<std::uint32_t>(k), {1, 2, 3, 4, 5, 6, 7, 8}, 5 * kMs));
+    port.inject(odrive(0, k, 5 * kMs));
+    port.inject(odrive(1, 2 * k, 5 * kMs));
+    ours += 2;
+  }
+  ASSERT_EQ(ours, 200);
+  // 300 frames at 64 per read: reads 1-4 take 64 each (256), read 5 the remaining 44.
+  EncoderSample s;
+  for (int r = 1; r <= 5; ++r) s = enc.read(5 * kMs + r * kMs);
+  EXPECT_EQ(enc.stats().frames, 300u);
+  EXPECT_EQ(enc.stats().foreign, 100u);
+  EXPECT_EQ(enc.stats().decoded, 200u);
+  EXPECT_EQ(enc.stats().capped_reads, 4u);
+  // Frame 3(k-1)+1 is foreign k, 3(k-1)+2 left k (count k), 3k right k (count 2k). Read 1
+  // takes frames 1..64 (up to foreign 22): its newest counts, left 21 and right 42, are the
+  // reference. The newest at the end are left 100 and right 200: 100 - 21 = 79 and
+  // 200 - 42 = 158. All frames carry the stamp 5 ms, so the limit per read is
+  // 10 000 * (0 + 0.005 s slack) + 1 = 51 counts; the largest step per read is the right
+  // wheel's 84 -> 128 = 44 (read 3 ends at frame 192 = right 64): no jump is flagged.
+  EXPECT_EQ(s.left, 79);
+  EXPECT_EQ(s.right, 158);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.counters.implausible_jumps, 0u);
+}
+
+TEST_F(CanEncoder, ShortFramesAndRemoteRequestsWithOurIdAreIgnored) {
+  CanEncoderSource enc = make();
+  port.inject(odrive(0, 7, 1 * kMs));
+  port.inject(odrive(1, 7, 1 * kMs));
+  enc.read(1 * kMs);
+  port.inject(frame(0x00A, {9, 9}, 2 * kMs));  // DLC 2
+  CanFrame rtr = frame(0x02A, {}, 2 * kMs);
+  rtr.rtr = true;
+  rtr.len = 8;
+  port.inject(rtr);
+  const EncoderSample s = enc.read(3 * kMs);
+  EXPECT_EQ(s.left, 0);
+  EXPECT_EQ(s.right, 0);
+  EXPECT_EQ(enc.stats().short_frames, 1u);
+  EXPECT_EQ(enc.stats().remote, 1u);
+}
+
+TEST_F(CanEncoder, BothWheelsInOneFrame) {
+  // A two-axis controller: one frame, id 0x18FF0010 (29-bit), left int32 big endian at
+  // byte 0, right at byte 4.
+  cfg.left = CanCountLayout{0x18FF0010, true, 0, 32, true, true};
+  cfg.right = CanCountLayout{0x18FF0010, true, 4, 32, true, true};
+  CanEncoderSource enc = make();
+  port.inject(frame(0x18FF0010, {0, 0, 0, 0, 0, 0, 0, 0}, 1 * kMs, true));
+  enc.read(1 * kMs);
+  // left 0x00000040 = 64, right 0xFFFFFFC0 = -64.
+  port.inject(frame(0x18FF0010, {0, 0, 0, 0x40, 0xFF, 0xFF, 0xFF, 0xC0}, 11 * kMs, true));
+  const EncoderSample s = enc.read(11 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 64);
+  EXPECT_EQ(s.right, -64);
+}
+
+TEST_F(CanEncoder, RemoteRequestsAtTheConfiguredPeriodNeverBlock) {
+  cfg.request_period = 20 * kMs;
+  CanEncoderSource enc = make();  // the port's transmit queue holds 8 frames
+  // Reads every 10 ms from 0 to 90 ms: requests at 0, 20, 40, 60, 80 ms, two frames each.
+  for (TimeNs t = 0; t < 100 * kMs; t += 10 * kMs) enc.read(t);
+  // 10 requests for 8 places: 8 sent, 2 refused (queue full) and counted, none waited for.
+  EXPECT_EQ(enc.stats().requests_sent, 8u);
+  EXPECT_EQ(enc.stats().requests_dropped, 2u);
+  CanFrame f;
+  ASSERT_TRUE(port.drain_tx(f));
+  EXPECT_TRUE(f.rtr);
+  EXPECT_EQ(f.id, 0x00Au);
+  EXPECT_EQ(f.len, 8);
+  ASSERT_TRUE(port.drain_tx(f));
+  EXPECT_EQ(f.id, 0x02Au);
+}
+
+TEST_F(CanEncoder, CreateRejectsMismatchedWidthsAndOverlaps) {
+  cfg.right.width_bits = 16;
+  EXPECT_FALSE(CanEncoderSource::create(port, cfg).ok());
+  cfg.right = cfg.left;
+  EXPECT_NE(CanEncoderSource::create(port, cfg).error().message.find("same bytes"),
+            std::string::npos);
+  cfg.right = odrive_count_layout(1);
+  cfg.max_frames_per_read = 0;
+  EXPECT_FALSE(CanEncoderSource::create(port, cfg).ok());
+}
+
+TEST(SimOdrive, PublishesCanSimpleEncoderCountFrames) {
+  sim::SimCanPort port(8, 8);
+  sim::SimOdrive od(port, sim::SimOdriveOptions{2, 5, 8192});
+  // Left: -3 counts: shadow 0xFFFFFFFD, count in CPR (-3 mod 8192) = 8189 = 0x1FFD.
+  // Right: 2^32 + 7 counts: the shadow count keeps the low 32 bits = 7; in CPR 7.
+  od.publish(42, -3, (std::int64_t{1} << 32) + 7);
+  CanFrame f;
+  ASSERT_TRUE(port.receive(f));
+  EXPECT_EQ(f.id, (2u << 5) | 0x00Au);  // 0x04A
+  EXPECT_EQ(f.len, 8);
+  EXPECT_EQ(f.stamp, 42);
+  const std::array<std::uint8_t, 8> left{0xFD, 0xFF, 0xFF, 0xFF, 0xFD, 0x1F, 0x00, 0x00};
+  EXPECT_EQ(f.data, left);
+  ASSERT_TRUE(port.receive(f));
+  EXPECT_EQ(f.id, (5u << 5) | 0x00Au);  // 0x0AA
+  const std::array<std::uint8_t, 8> right{7, 0, 0, 0, 7, 0, 0, 0};
+  EXPECT_EQ(f.data, right);
+  EXPECT_FALSE(port.receive(f));
+  EXPECT_EQ(od.frames(), 2u);
+}
+
+TEST(SimOdrive, FaultHooksReachTheDriverAsStaleAndJump) {
+  sim::SimCanPort port(8, 64);
+  sim::SimOdrive od(port, sim::SimOdriveOptions{0, 1, 8192});
+  CanEncoderConfig c;
+  c.left = odrive_count_layout(0);
+  c.right = odrive_count_layout(1);
+  c.timeout = 50 * kMs;
+  c.max_counts_per_s = 10'000;
+  CanEncoderSource enc = CanEncoderSource::create(port, c).value();
+  // Both axes at rest at 0, published every 10 ms.
+  TimeNs t = 0;
+  for (; t <= 30 * kMs; t += 10 * kMs) {
+    od.publish(t, 0, 0);
+    EXPECT_EQ(enc.read(t).flags, 0u);
+  }
+  // The right axis stops sending after 30 ms; the left leaps 1000 counts at 40 ms (limit
+  // 10 000 * (0.010 + 0.005) + 1 = 151 counts).
+  od.set_sending(1, false);
+  od.add_jump(0, 1000);
+  od.publish(t, 0, 0);
+  EncoderSample s = enc.read(t);  // t = 40 ms
+  EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kEncoderImplausibleJump));
+  EXPECT_EQ(s.left, 0);
+  // The right wheel's last frame was at 30 ms: stale once the read is later than 80 ms.
+  for (t += 10 * kMs; t <= 90 * kMs; t += 10 * kMs) {
+    od.publish(t, 0, 0);
+    s = enc.read(t);
+    EXPECT_EQ(s.flags, t > 80 * kMs ? kEncoderStaleRight : 0u) << t;
+  }
+  EXPECT_EQ(s.counters.stale_events, 1u);
+  EXPECT_EQ(s.counters.implausible_jumps, 1u);
+}
+
+}  // namespace
+}  // namespace odo::drivers
