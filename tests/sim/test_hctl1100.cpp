@@ -30,8 +30,18 @@ struct World final : sim::BusCycleHook {
   void on_bus_cycle() noexcept override { advance(cycle); }
   void advance(TimeNs dt) {
     t += dt;
-    left.follow(true_counts(0));
-    right.follow(true_counts(1));
+    track(0, left);
+    track(1, right);
+  }
+  // track: the chip counts the disc's motion, except while its wire is cut: then it sees no
+  // edges, its counter holds and the motion meanwhile is lost for good.
+  void track(int i, Hctl1100Model& m) {
+    if (cut[i]) {
+      lost[i] = true_counts(i) - seen[i];
+      return;
+    }
+    seen[i] = true_counts(i) - lost[i];
+    m.follow(seen[i]);
   }
   // true_counts: where the disc of wheel i is at the current time [counts].
   std::int64_t true_counts(int i) const {
@@ -42,6 +52,9 @@ struct World final : sim::BusCycleHook {
   double rate[2];
   TimeNs cycle;
   TimeNs t = 0;
+  bool cut[2] = {false, false};   // encoder wire of wheel i cut
+  std::int64_t seen[2] = {0, 0};  // counts the chip has seen
+  std::int64_t lost[2] = {0, 0};  // counts the disc moved while the wire was cut
 };
 
 Hctl1100Config config_for(double max_rate) {
@@ -182,6 +195,46 @@ TEST(Hctl1100Driver, ImplausibleJumpIsReportedNotIntegrated) {
   EXPECT_EQ(d.flags, 0u);
   EXPECT_EQ(wrap_delta(c.left, d.left, 24), 10);
   EXPECT_EQ(d.counters.implausible_jumps, 1u);
+}
+
+TEST(Hctl1100Driver, CutEncoderWireReadsAsAStandingWheelAndIsNotFlagged) {
+  // Fault matrix row "encoder wire cut": the chip sees no more edges, so its counter holds:
+  // exactly what a standing wheel looks like. The driver has no stale timeout (only the CAN
+  // backend has one): no flag, no counter, and the motion during the cut is lost.
+  World w(Hctl1100Model::Latch::kNone, 1000, 1000, 1'000);
+  auto enc = Hctl1100Encoder::create(w.bus, config_for(2000));
+  ASSERT_TRUE(enc.ok());
+  const EncoderSample first = enc->read(w.t);
+  EncoderSample prev = first;
+  auto next = [&] {
+    w.advance(10'000'000);  // 10 ms: 10 counts at 1000 counts/s
+    const EncoderSample s = enc->read(w.t);
+    EXPECT_EQ(s.flags, 0u);
+    EXPECT_NEAR(static_cast<double>(wrap_delta(prev.right, s.right, 24)), 10.0, 1.0);
+    return s;
+  };
+  for (int i = 0; i < 50; ++i) prev = next();
+  w.cut[0] = true;
+  const std::int64_t held = prev.left;
+  for (int i = 0; i < 100; ++i) {  // 1 s with the left wire cut
+    prev = next();
+    EXPECT_EQ(prev.left, held) << "read " << i;
+  }
+  EXPECT_GE(w.lost[0], 990);  // the disc turned on
+  w.cut[0] = false;           // reconnected: counting resumes from the held value
+  for (int i = 0; i < 50; ++i) {
+    const std::int64_t before = prev.left;
+    prev = next();
+    EXPECT_NEAR(static_cast<double>(wrap_delta(before, prev.left, 24)), 10.0, 1.0);
+  }
+  EXPECT_EQ(prev.counters.implausible_jumps, 0u);
+  EXPECT_EQ(prev.counters.read_errors, 0u);
+  EXPECT_EQ(prev.counters.stale_events, 0u);
+  // Left is behind right by the motion during the cut (within one count: the chips are read
+  // a few bus cycles apart).
+  const auto behind =
+      wrap_delta(first.right, prev.right, 24) - wrap_delta(first.left, prev.left, 24);
+  EXPECT_NEAR(static_cast<double>(behind), static_cast<double>(w.lost[0]), 1.0);
 }
 
 TEST(Hctl1100Driver, BusFaultIsAReadErrorAndLosesNothing) {

@@ -351,6 +351,62 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   EXPECT_EQ(loop->stats().wakeup_latency.count, kTicks - kTicks % fw::OdometryLoop::kSummaryTicks);
 }
 
+TEST(ZeroAlloc, CanReceiveFloodWithoutAllocating) {
+  // Fault matrix row "CAN flood on the receive side": the daemon's CAN link on the simulated
+  // bus with set-pose on; every tick 100 frames arrive (foreign ids and, every 10th tick, a
+  // set-pose command for this node), far more than the broadcaster reads per tick.
+  fw::Config cfg = fw::default_config();
+  cfg.loop.rate_hz = 1000.0;
+  cfg.sim.scenario = "idle";
+  ASSERT_TRUE(cfg.can.set_pose);
+  auto kin = Kinematics::create(cfg.robot);
+  ASSERT_TRUE(kin.ok());
+  auto rig = fw::Rig::create(cfg, *kin, /*virtual_time=*/true);
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  fw::LoopConfig lc;
+  lc.rate_hz = cfg.loop.rate_hz;
+  auto loop = fw::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
+  auto can = fw::CanLink::create(cfg.can, cfg.loop.rate_hz, *loop, "");
+  ASSERT_TRUE(can.ok()) << can.error().message;
+  sim::SimCanPort* port = (*can)->sim_port();
+  ASSERT_NE(port, nullptr);
+  loop->start();
+  CanFrame ours;
+  fw::can::encode_set_pose(
+      fw::can::frame_id(fw::can::kDefaultBaseId, cfg.can.node_id, fw::can::Msg::kSetPose),
+      fw::can::SetPoseCmd{false, 1.0, 2.0, 0.5}, ours);
+  CanFrame foreign;
+  foreign.len = 8;
+  constexpr std::uint64_t kTicks = 20'000;
+  std::uint64_t ours_taken = 0;
+  {
+    AllocWindow w;
+    for (std::uint64_t i = 0; i < kTicks; ++i) {
+      for (std::uint32_t k = 0; k < 100; ++k) {
+        if (k == 0 && i % 10 == 0) {
+          if (port->inject(ours)) ++ours_taken;
+        } else {
+          foreign.id = (k * 37 + static_cast<std::uint32_t>(i)) % 0x400;  // below the base id
+          port->inject(foreign);
+        }
+      }
+      loop->tick();
+    }
+    w.disarm();
+    EXPECT_EQ(g_allocs.load(), 0u) << "heap allocations during " << kTicks << " flooded ticks";
+    EXPECT_EQ(g_frees.load(), 0u) << "heap deallocations during " << kTicks << " flooded ticks";
+  }
+  EXPECT_EQ(loop->stats().ticks, kTicks);
+  EXPECT_EQ(loop->stats().missed_deadlines, 0u);
+  EXPECT_GT(port->counters().rx_dropped, 0u);  // it really was a flood
+  EXPECT_GT(ours_taken, 0u);
+  // Commands still apply: the ones read so far (the backlog holds the rest).
+  EXPECT_GT((*can)->counters().set_pose_applied, 0u);
+  EXPECT_LE((*can)->counters().set_pose_applied, ours_taken);
+  EXPECT_NEAR(loop->snapshot().pose.x, 1.0, 1e-9);
+  EXPECT_NEAR(loop->snapshot().pose.y, 2.0, 1e-9);
+}
+
 TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
   // [encoder] backend = "can" on the simulated ODrive pair: frames packed, queued on the
   // simulated port, drained and decoded every tick, and the stale path once the left axis stops

@@ -81,6 +81,39 @@ TEST(QuadTracker, BothLinesAtOnceIsInvalidNotMotion) {
   EXPECT_EQ(t.count(), 1);
 }
 
+TEST(QuadTracker, BurstOfInvalidTransitionsCountsEachAndMovesNothing) {
+  // Fault matrix row "invalid quadrature transition burst": 1000 illegal transitions in a row
+  // (both lines at once, and repeated edges of one line), starting from every state.
+  constexpr std::uint8_t kFwd[4] = {2, 0, 3, 1};  // next state forward: 0->2->3->1->0
+  QuadTracker t;
+  t.reset(0);
+  for (int i = 0; i < 7; ++i) {  // some motion first: 7 forward steps
+    const QuadState s = t.state();
+    ASSERT_EQ(t.apply(static_cast<std::uint8_t>(s ^ kFwd[s]), kFwd[s]), QuadStep::kForward);
+  }
+  const std::int64_t count = t.count();
+  constexpr int kBurst = 1000;
+  for (int i = 0; i < kBurst; ++i) {
+    const QuadState s = t.state();
+    if (i % 3 == 2) {  // an edge of A to the level A already has: its opposite edge was lost
+      EXPECT_EQ(t.apply(kA, s), QuadStep::kInvalid) << i;
+      EXPECT_EQ(t.state(), s);
+    } else {  // both lines flip at once
+      EXPECT_EQ(t.apply(kA | kB, static_cast<std::uint8_t>(s ^ 3u)), QuadStep::kInvalid) << i;
+      EXPECT_EQ(t.state(), s ^ 3u);  // the new levels are adopted
+    }
+  }
+  EXPECT_EQ(t.count(), count);  // no motion from the burst
+  EXPECT_EQ(t.invalid(), static_cast<std::uint64_t>(kBurst));
+  // Legal steps after the burst count exactly again.
+  for (int i = 0; i < 100; ++i) {
+    const QuadState s = t.state();
+    ASSERT_EQ(t.apply(static_cast<std::uint8_t>(s ^ kFwd[s]), kFwd[s]), QuadStep::kForward);
+  }
+  EXPECT_EQ(t.count(), count + 100);
+  EXPECT_EQ(t.invalid(), static_cast<std::uint64_t>(kBurst));
+}
+
 TEST(QuadTracker, RepeatedEdgeMeansALostEvent) {
   QuadTracker t;
   t.reset(0);

@@ -1,0 +1,153 @@
+// Fault matrix row "SIGHUP during a store write": another process (odomctl calib set) is in the
+// middle of writing a record to the file store when odometryd gets SIGHUP and re-reads the
+// store. The re-read must give the record before the save or the one it writes, whole and
+// applied (state ok), never nominal values, a corrupt state or a mix of two records.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include "calib_kill_loop.hpp"
+#include "odo/drivers/nv_storage.hpp"
+#include "odo/firmware/calibration_io.hpp"
+#include "odo/firmware/config.hpp"
+
+namespace odo::calib {
+namespace {
+
+std::atomic<bool> g_reload{false};
+
+// As odometryd's handler: SIGHUP only sets the flag the reload thread polls.
+extern "C" void on_reload_signal(int) {
+  g_reload.store(true);
+}
+
+// PausingFileStorage: a file store whose write stops after `split` bytes, sends SIGHUP to the
+// parent (the daemon) and waits `pause` before writing the rest: a slow medium with the signal
+// arriving mid-write.
+class PausingFileStorage final : public NvStorage {
+ public:
+  PausingFileStorage(const std::string& path, std::size_t split, std::chrono::milliseconds pause)
+      : file_(path), split_(split), pause_(pause) {}
+  NvGeometry geometry() const noexcept override { return file_.geometry(); }
+  Status read(std::size_t off, std::span<std::uint8_t> out) override {
+    return file_.read(off, out);
+  }
+  Status write(std::size_t off, std::span<const std::uint8_t> data) override {
+    const std::size_t first = std::min(split_, data.size());
+    if (auto s = file_.write(off, data.first(first)); !s) return s;
+    kill(getppid(), SIGHUP);
+    std::this_thread::sleep_for(pause_);
+    if (first == data.size()) return Ok{};
+    return file_.write(off + first, data.subspan(first));
+  }
+  Status erase(std::size_t off, std::size_t len) override { return file_.erase(off, len); }
+
+ private:
+  drv::FileNvStorage file_;
+  std::size_t split_;
+  std::chrono::milliseconds pause_;
+};
+
+// check_applied: `a` is record `seq` applied to `nominal` (record_for(seq): c_l, c_r, wheelbase).
+void check_applied(const fw::AppliedCalibration& a, const KinematicParams& nominal,
+                   std::uint64_t seq) {
+  const CalibrationRecord r = record_for(seq);
+  EXPECT_EQ(a.state, 1) << a.report;
+  EXPECT_EQ(a.sequence, seq) << a.report;
+  EXPECT_EQ(a.params.c_l, r.c_l);
+  EXPECT_EQ(a.params.c_r, r.c_r);
+  EXPECT_EQ(a.params.wheelbase, *r.wheelbase);
+  EXPECT_EQ(a.params.wheel_diameter, nominal.wheel_diameter);
+}
+
+TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
+  const char* base = std::getenv("TMPDIR");
+  const std::filesystem::path dir =
+      std::filesystem::path(base ? base : "/tmp") / ("odo_reload_race_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "calibration.bin").string();
+  const KinematicParams nominal = fw::default_config().robot;
+
+  const std::size_t record_bytes = kRecordV1Bytes;  // one write() of a byte medium's slot
+  std::uint64_t seq = 1;
+  {
+    drv::FileNvStorage m(path);
+    auto store = CalibrationStore::create(m);
+    ASSERT_TRUE(store);
+    ASSERT_TRUE(store->save(record_for(seq)));
+  }
+  struct sigaction sa {};
+  struct sigaction old {};
+  sa.sa_handler = on_reload_signal;
+  sigemptyset(&sa.sa_mask);
+  ASSERT_EQ(sigaction(SIGHUP, &sa, &old), 0);
+
+  // One save per writer process, as `odomctl calib set`; the signal comes after every byte of
+  // the record in turn, up to its last but one.
+  int rounds = 0, torn_seen = 0, mid_write = 0;
+  for (std::size_t split = 1; split < record_bytes; ++split) {
+    g_reload.store(false);
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      PausingFileStorage m(path, split, std::chrono::milliseconds(40));
+      auto store = CalibrationStore::create(m);
+      if (!store) _exit(3);
+      auto l = store->load();
+      if (!l || !l->record) _exit(4);
+      _exit(store->save(record_for(l->record->sequence + 1)) ? 0 : 5);
+    }
+    // The daemon's side: wait for the signal, then re-read as CalibrationReloader::reload does.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (!g_reload.exchange(false) && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    const fw::AppliedCalibration during = fw::read_and_apply(nominal, path, "file");
+    // The writer had written part of the record and had not finished when we read.
+    int status = 0;
+    const pid_t w = waitpid(pid, &status, WNOHANG);
+    ASSERT_GE(w, 0);
+    if (w == 0) ++mid_write;
+    // The store as it stood: the slot being written half old, half new (not valid, not blank)?
+    drv::FileNvStorage probe(path);
+    auto ps = CalibrationStore::create(probe);
+    ASSERT_TRUE(ps);
+    auto l = ps->load();
+    ASSERT_TRUE(l);
+    const bool torn = l->record && l->record->sequence == seq &&
+                      !l->slots[static_cast<std::size_t>(1 - l->slot)].valid &&
+                      !l->slots[static_cast<std::size_t>(1 - l->slot)].blank;
+    if (torn) {
+      ++torn_seen;
+      check_applied(during, nominal, seq);  // the half-written record is never used
+    } else {
+      EXPECT_EQ(during.state, 1) << during.report;
+      EXPECT_TRUE(during.sequence == seq || during.sequence == seq + 1) << during.report;
+      check_applied(during, nominal, during.sequence);
+    }
+    if (w == 0) ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "writer status " << status;
+    ++seq;
+    // A SIGHUP after the save: the new record.
+    check_applied(fw::read_and_apply(nominal, path, "file"), nominal, seq);
+    ++rounds;
+  }
+  sigaction(SIGHUP, &old, nullptr);
+  std::printf("reloads while the writer was mid-save: %d of %d; with the slot torn: %d\n",
+              mid_write, rounds, torn_seen);
+  EXPECT_EQ(rounds, static_cast<int>(record_bytes) - 1);
+  // Under heavy load a reload may come after the writer's 40 ms pause; most must not.
+  EXPECT_GE(mid_write, rounds / 2);
+  EXPECT_GT(torn_seen, 0);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace odo::calib
