@@ -118,10 +118,6 @@ TableReader TableReader::sub(std::string_view key) {
                      error_);
 }
 
-void TableReader::reject(std::string_view key, const std::string& what) {
-  fail(table_ != nullptr ? table_->get(key) : nullptr, key, what);
-}
-
 void TableReader::finish() {
   if (table_ == nullptr) return;
   for (const auto& [k, node] : *table_) {

@@ -31,8 +31,6 @@ class TableReader {
   void reject(std::string_view key, const std::string& what);
   // sub: a nested table (may be absent).
   TableReader sub(std::string_view key);
-  // reject: reports `what` for a key already read (cross-field checks), naming its line.
-  void reject(std::string_view key, const std::string& what);
   // finish: reports the first key of this table that no getter asked for.
   void finish();
   // ok: no error so far (the first error is kept, later ones dropped).
