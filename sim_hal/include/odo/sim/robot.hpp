@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "odo/hal/result.hpp"
@@ -97,12 +98,26 @@ class SimRobot {
   SimRobot(const RobotGeometry& g, Scenario s, const Pose2& start);
   void move(double dt, const Segment& seg) noexcept;
 
+  // resync_heading: sin/cos of the true heading from a real sin and cos (drops rounding drift).
+  void resync_heading() noexcept;
+
   RobotGeometry g_;
   Scenario scenario_;
   std::size_t seg_ = 0;
   TimeNs seg_start_ = 0;  // start time of segment seg_ [ns]
   TimeNs t_ = 0;
   Pose2 pose_;
+  double sin_theta_ = 0.0;  // sin(pose_.theta), rotated step by step between re-syncs
+  double cos_theta_ = 1.0;  // cos(pose_.theta)
+  std::uint32_t steps_since_sync_ = 0;
+  // Half-angle rotation of the last step, reused while the step's travels are bit-identical
+  // (constant wheel speeds and step length); NaN keys never match, so the first step computes.
+  double step_d_l_ = std::numeric_limits<double>::quiet_NaN();  // [m] key: left travel
+  double step_d_r_ = std::numeric_limits<double>::quiet_NaN();  // [m] key: right travel
+  double step_sin_h_ = 0.0;                                     // sin(h), h = half the turn
+  double step_cos_h_ = 1.0;                                     // cos(h)
+  double step_chord_ = 0.0;  // [m] chord of the step, ds * sin(h)/h
+  double step_dth_ = 0.0;    // [rad] heading change of the step, 2h
   double angle_l_ = 0.0;
   double angle_r_ = 0.0;
   double counts_per_wheel_rad_ = 0.0;
