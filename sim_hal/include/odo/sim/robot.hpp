@@ -82,9 +82,15 @@ class SimRobot {
   void advance_to(TimeNs t) noexcept;
 
   const Pose2& true_pose() const noexcept { return pose_; }
-  // counts_left/right: cumulative encoder counts, floor of the motor angle in counts.
-  std::int64_t counts_left() const noexcept;
-  std::int64_t counts_right() const noexcept;
+  // counts_left/right: cumulative encoder counts, floor of the motor angle in counts. The count
+  // changes only when the shaft crosses a quadrature state boundary; the encoder starts half a
+  // state away from one (kEncoderPhase), as a real disc rests somewhere inside a state.
+  std::int64_t counts_left() const noexcept {
+    return floor_to_int(angle_l_ * counts_per_wheel_rad_ + kEncoderPhase);
+  }
+  std::int64_t counts_right() const noexcept {
+    return floor_to_int(angle_r_ * counts_per_wheel_rad_ + kEncoderPhase);
+  }
   double wheel_angle_left() const noexcept { return angle_l_; }   // [rad] of the wheel
   double wheel_angle_right() const noexcept { return angle_r_; }  // [rad]
   TimeNs time() const noexcept { return t_; }
@@ -96,6 +102,12 @@ class SimRobot {
 
  private:
   SimRobot(const RobotGeometry& g, Scenario s, const Pose2& start);
+  // floor_to_int: floor(v) as an integer for |v| < 2^63 (std::floor is a library call at -O2
+  // on baseline x86-64; truncation plus a correction for negative fractions is inline).
+  static std::int64_t floor_to_int(double v) noexcept {
+    const auto i = static_cast<std::int64_t>(v);
+    return i - (static_cast<double>(i) > v ? 1 : 0);
+  }
   void move(double dt, const Segment& seg) noexcept;
 
   // resync_heading: sin/cos of the true heading from a real sin and cos (drops rounding drift).
@@ -105,6 +117,7 @@ class SimRobot {
   Scenario scenario_;
   std::size_t seg_ = 0;
   TimeNs seg_start_ = 0;  // start time of segment seg_ [ns]
+  TimeNs seg_end_ = 0;    // end time of segment seg_ [ns], computed once per segment
   TimeNs t_ = 0;
   Pose2 pose_;
   double sin_theta_ = 0.0;  // sin(pose_.theta), rotated step by step between re-syncs
