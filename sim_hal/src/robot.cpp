@@ -156,7 +156,7 @@ void SimRobot::move(double dt, const Segment& seg) noexcept {
   }
 }
 
-void SimRobot::advance_to(TimeNs t) noexcept {
+void SimRobot::advance_across(TimeNs t) noexcept {
   while (t_ < t) {
     if (seg_ >= scenario_.size()) {
       t_ = t;  // standing still after the last segment
@@ -168,7 +168,8 @@ void SimRobot::advance_to(TimeNs t) noexcept {
     if (t_ >= seg_end_) {
       ++seg_;
       seg_start_ = seg_end_;
-      if (seg_ < scenario_.size()) seg_end_ = seg_start_ + from_seconds(scenario_[seg_].duration);
+      seg_end_ = seg_ < scenario_.size() ? seg_start_ + from_seconds(scenario_[seg_].duration)
+                                         : kNoSegment;
       // Segment boundary: the rotated sin/cos restart from the exact heading.
       resync_heading();
     }

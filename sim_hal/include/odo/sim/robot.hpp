@@ -79,7 +79,15 @@ class SimRobot {
 
   // advance_to: move the robot along its scenario up to time t [ns since start]; after the last
   // segment it stands still. Never goes backwards.
-  void advance_to(TimeNs t) noexcept;
+  void advance_to(TimeNs t) noexcept {
+    // Inline common case (one encoder read per tick): a single step inside the current segment.
+    if (t > t_ && t < seg_end_) {
+      move(to_seconds(t - t_), scenario_[seg_]);
+      t_ = t;
+      return;
+    }
+    advance_across(t);
+  }
 
   const Pose2& true_pose() const noexcept { return pose_; }
   // counts_left/right: cumulative encoder counts, floor of the motor angle in counts. The count
@@ -109,6 +117,8 @@ class SimRobot {
     return i - (static_cast<double>(i) > v ? 1 : 0);
   }
   void move(double dt, const Segment& seg) noexcept;
+  // advance_across: advance_to for steps that reach a segment end or lie past the scenario.
+  void advance_across(TimeNs t) noexcept;
 
   // resync_heading: sin/cos of the true heading from a real sin and cos (drops rounding drift).
   void resync_heading() noexcept;
@@ -117,7 +127,9 @@ class SimRobot {
   Scenario scenario_;
   std::size_t seg_ = 0;
   TimeNs seg_start_ = 0;  // start time of segment seg_ [ns]
-  TimeNs seg_end_ = 0;    // end time of segment seg_ [ns], computed once per segment
+  // End time of segment seg_ [ns], computed once per segment; kNoSegment after the last one.
+  static constexpr TimeNs kNoSegment = std::numeric_limits<TimeNs>::min();
+  TimeNs seg_end_ = kNoSegment;
   TimeNs t_ = 0;
   Pose2 pose_;
   double sin_theta_ = 0.0;  // sin(pose_.theta), rotated step by step between re-syncs
