@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "odo/hal/result.hpp"
@@ -78,12 +79,26 @@ class SimRobot {
 
   // advance_to: move the robot along its scenario up to time t [ns since start]; after the last
   // segment it stands still. Never goes backwards.
-  void advance_to(TimeNs t) noexcept;
+  void advance_to(TimeNs t) noexcept {
+    // Inline common case (one encoder read per tick): a single step inside the current segment.
+    if (t > t_ && t < seg_end_) {
+      move(to_seconds(t - t_), scenario_[seg_]);
+      t_ = t;
+      return;
+    }
+    advance_across(t);
+  }
 
   const Pose2& true_pose() const noexcept { return pose_; }
-  // counts_left/right: cumulative encoder counts, floor of the motor angle in counts.
-  std::int64_t counts_left() const noexcept;
-  std::int64_t counts_right() const noexcept;
+  // counts_left/right: cumulative encoder counts, floor of the motor angle in counts. The count
+  // changes only when the shaft crosses a quadrature state boundary; the encoder starts half a
+  // state away from one (kEncoderPhase), as a real disc rests somewhere inside a state.
+  std::int64_t counts_left() const noexcept {
+    return floor_to_int(angle_l_ * counts_per_wheel_rad_ + kEncoderPhase);
+  }
+  std::int64_t counts_right() const noexcept {
+    return floor_to_int(angle_r_ * counts_per_wheel_rad_ + kEncoderPhase);
+  }
   double wheel_angle_left() const noexcept { return angle_l_; }   // [rad] of the wheel
   double wheel_angle_right() const noexcept { return angle_r_; }  // [rad]
   TimeNs time() const noexcept { return t_; }
@@ -95,14 +110,39 @@ class SimRobot {
 
  private:
   SimRobot(const RobotGeometry& g, Scenario s, const Pose2& start);
+  // floor_to_int: floor(v) as an integer for |v| < 2^63 (std::floor is a library call at -O2
+  // on baseline x86-64; truncation plus a correction for negative fractions is inline).
+  static std::int64_t floor_to_int(double v) noexcept {
+    const auto i = static_cast<std::int64_t>(v);
+    return i - (static_cast<double>(i) > v ? 1 : 0);
+  }
   void move(double dt, const Segment& seg) noexcept;
+  // advance_across: advance_to for steps that reach a segment end or lie past the scenario.
+  void advance_across(TimeNs t) noexcept;
+
+  // resync_heading: sin/cos of the true heading from a real sin and cos (drops rounding drift).
+  void resync_heading() noexcept;
 
   RobotGeometry g_;
   Scenario scenario_;
   std::size_t seg_ = 0;
   TimeNs seg_start_ = 0;  // start time of segment seg_ [ns]
+  // End time of segment seg_ [ns], computed once per segment; kNoSegment after the last one.
+  static constexpr TimeNs kNoSegment = std::numeric_limits<TimeNs>::min();
+  TimeNs seg_end_ = kNoSegment;
   TimeNs t_ = 0;
   Pose2 pose_;
+  double sin_theta_ = 0.0;  // sin(pose_.theta), rotated step by step between re-syncs
+  double cos_theta_ = 1.0;  // cos(pose_.theta)
+  std::uint32_t steps_since_sync_ = 0;
+  // Half-angle rotation of the last step, reused while the step's travels are bit-identical
+  // (constant wheel speeds and step length); NaN keys never match, so the first step computes.
+  double step_d_l_ = std::numeric_limits<double>::quiet_NaN();  // [m] key: left travel
+  double step_d_r_ = std::numeric_limits<double>::quiet_NaN();  // [m] key: right travel
+  double step_sin_h_ = 0.0;                                     // sin(h), h = half the turn
+  double step_cos_h_ = 1.0;                                     // cos(h)
+  double step_chord_ = 0.0;  // [m] chord of the step, ds * sin(h)/h
+  double step_dth_ = 0.0;    // [rad] heading change of the step, 2h
   double angle_l_ = 0.0;
   double angle_r_ = 0.0;
   double counts_per_wheel_rad_ = 0.0;
