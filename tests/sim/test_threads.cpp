@@ -30,10 +30,18 @@ TEST(Threads, SetPoseRequestsAreNeverTorn) {
   std::uint64_t changes = 0;  // snapshots showing a newly applied request
   double last_x = 0.0;
   int i = 0;
-  // Request until the loop has applied 500 different requests (bounded, so a loop that never
-  // applies them fails instead of hanging).
-  while (changes < 500 && i < 50'000'000) {
+  // Request until the loop has applied 500 different requests, bounded by time (not by a count
+  // of requests: on a loaded machine the loop thread may get no CPU for a while, and a count
+  // then runs out before the loop had its chance), so a loop that never applies them fails
+  // instead of hanging. The requester yields now and then so that the loop thread gets a core
+  // even when only one is free.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (changes < 500) {
     ++i;
+    if ((i & 63) == 0) {
+      if (std::chrono::steady_clock::now() > deadline) break;
+      std::this_thread::yield();
+    }
     const double v = i;
     run.loop->request_pose({v, -v, v / 1000.0});
     if (run.loop->snapshots().latest(s)) {
