@@ -1,6 +1,7 @@
 #include "odo/firmware/candump_log.hpp"
 
 #include <cctype>
+#include <string>
 
 namespace odo::fw {
 namespace {
@@ -35,6 +36,14 @@ Result<CandumpLine> parse_candump_line(std::string_view line) {
     return make_error(Errc::kParse, "time stamp must be seconds.microseconds (6 digits)");
   for (char c : stamp.substr(0, dot)) out.sec = out.sec * 10 + (c - '0');
   for (char c : stamp.substr(dot + 1)) out.usec = out.usec * 10 + (c - '0');
+  // Callers turn the stamp into 64-bit nanoseconds (TimeNs): beyond 9223372035 s (the year
+  // 2262) that overflows, so such a stamp is refused here (found by fuzz_candump).
+  if (out.sec > kCandumpMaxSeconds) {
+    return make_error(Errc::kParse, "time stamp " + std::to_string(out.sec) +
+                                        " s is beyond the range of a 64-bit nanosecond clock "
+                                        "(at most " +
+                                        std::to_string(kCandumpMaxSeconds) + " s, year 2262)");
+  }
   std::string_view rest = line.substr(close + 1);
   if (rest.empty() || rest.front() != ' ')
     return make_error(Errc::kParse, "expected a space after the time stamp");

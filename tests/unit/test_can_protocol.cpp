@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "odo/firmware/can_protocol.hpp"
+#include "odo/firmware/candump_log.hpp"
 
 namespace odo::fw::can {
 namespace {
@@ -238,6 +239,22 @@ TEST(CanDivisor, WholeDivisorsOnly) {
   EXPECT_EQ(divisor_for(100, 200), -1);
   EXPECT_EQ(divisor_for(100, -1), -1);
   EXPECT_EQ(divisor_for(1000, 0.5), 2000);
+}
+
+TEST(CandumpLog, TimeStampsBeyondTheNanosecondClockAreRefused) {
+  // 9223372035 s is the last whole second whose nanoseconds (plus 999999 us) fit an int64:
+  // 9223372035 * 1e9 + 999999000 = 9223372035999999000 < 2^63 - 1 = 9223372036854775807.
+  auto ok = fw::parse_candump_line("(9223372035.999999) vcan0 410#00");
+  ASSERT_TRUE(ok.ok()) << ok.error().message;
+  EXPECT_EQ(ok->sec, 9223372035);
+  // One second later the nanoseconds would overflow (found by fuzz_candump: 179535382837 s).
+  for (const char* line :
+       {"(9223372036.000000) vcan0 410#00", "(179535382837.303618) sim0 410#00"}) {
+    auto bad = fw::parse_candump_line(line);
+    ASSERT_FALSE(bad.ok()) << line;
+    EXPECT_NE(bad.error().message.find("beyond the range"), std::string::npos)
+        << bad.error().message;
+  }
 }
 
 }  // namespace

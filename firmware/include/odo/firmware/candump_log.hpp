@@ -20,7 +20,11 @@ struct CandumpLine {
   CanFrame frame;  // extended when the id has 8 hex digits (as candump prints it)
 };
 
+// Largest accepted time stamp [s]: sec * 1e9 + 999999000 still fits a signed 64-bit TimeNs.
+inline constexpr std::int64_t kCandumpMaxSeconds = 9'223'372'035;
+
 // parse_candump_line: one log line (no newline); the error says what is wrong (no file/line).
+// The time stamp's seconds are at most kCandumpMaxSeconds.
 // Accepts classic frames only: 3 hex digits (11-bit id) or 8 (29-bit id), then '#' and 0..8
 // bytes as hex pairs; remote (#R) and CAN FD (##) frames are rejected.
 Result<CandumpLine> parse_candump_line(std::string_view line);
