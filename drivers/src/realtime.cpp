@@ -118,6 +118,14 @@ RealtimeItem prefault(std::size_t bytes) {
     return it;
   }
   it.what = "stack pre-fault " + std::to_string(bytes) + " bytes";
+  // An unlimited stack rlimit does not make a huge request safe: the stack mapping still ends
+  // somewhere, so anything beyond kMaxPrefault is refused outright (the config allows 4 MiB).
+  constexpr std::size_t kMaxPrefault = std::size_t{256} << 20;
+  if (bytes > kMaxPrefault) {
+    it.outcome = RtOutcome::kFailed;
+    it.detail = "larger than the supported maximum of " + std::to_string(kMaxPrefault) + " bytes";
+    return it;
+  }
   rlimit l{};
   // Keep 64 KiB for what is already on the stack; more than the limit would be SIGSEGV.
   if (getrlimit(RLIMIT_STACK, &l) == 0 && l.rlim_cur != RLIM_INFINITY &&

@@ -53,14 +53,16 @@ rc=$?; [ $rc = 2 ]; check "bad cpu exit 2 (got $rc)" $?
 grep -q "bad.toml:2.*cpu" "$tmp/err"; check "bad cpu: line and field named" $?
 
 # systemd notify protocol against a real datagram socket, as systemd would set it up.
-python3 - "$ODOMETRYD" "$tmp/notify.sock" <<'PY'
-import os, socket, subprocess, sys
+python3 - "$ODOMETRYD" "$tmp/notify.sock" "${CROSS_EMULATOR:-}" <<'PY'
+import os, re, socket, subprocess, sys
 exe, path = sys.argv[1], sys.argv[2]
+# A cross build's binary runs under its emulator (qemu-user), as run() does above.
+emulator = [a for a in re.split(r"[ ;]", sys.argv[3]) if a]
 s = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
 s.bind(path)
 env = dict(os.environ, NOTIFY_SOCKET=path, WATCHDOG_USEC="200000")
 # Read while the daemon runs, as systemd does (the queue of a datagram socket is short).
-p = subprocess.Popen([exe, "--duration", "1.5", "--quiet"], env=env, stdout=subprocess.PIPE,
+p = subprocess.Popen(emulator + [exe, "--duration", "1.5", "--quiet"], env=env, stdout=subprocess.PIPE,
                      stderr=subprocess.PIPE, text=True)
 s.settimeout(0.2)
 msgs = []

@@ -15,7 +15,7 @@
 #include "odo/firmware/rig.hpp"
 #include "odo/sim/sim_can_bus.hpp"
 
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define ODO_COUNT_MALLOC 0
 #else
 #define ODO_COUNT_MALLOC 1
@@ -83,8 +83,9 @@ void* aligned(std::size_t n, std::align_val_t a) noexcept {
 }  // namespace
 
 #if ODO_COUNT_MALLOC
-// The malloc family, forwarded to glibc's own implementation. (Under AddressSanitizer its
-// interceptors own malloc; then only operator new/delete are counted.)
+// The malloc family, forwarded to glibc's own implementation. (Under AddressSanitizer or
+// ThreadSanitizer their interceptors own malloc, and replacing it under them crashes the
+// runtime at start-up; then only operator new/delete are counted.)
 extern "C" {
 void* malloc(std::size_t n) {
   note_alloc();

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -49,8 +50,9 @@ using Opener = std::unique_ptr<NvStorage> (*)(const std::string&);
   }
 }
 
-// kill_loop: seeds the store with record 1, then `rounds` times: fork a writer, let it run
-// 0.2 ms to max_sleep_us, SIGKILL it, load and check.
+// kill_loop: seeds the store, then `rounds` times: fork a writer, let it run 0.2 ms to the kill
+// window (max_sleep_us, or 100 of this machine's saves if that is longer), SIGKILL it, load and
+// check.
 inline void kill_loop(Opener open, const std::string& path, int rounds, std::uint64_t seed,
                       int max_sleep_us = 20000) {
   std::uint64_t last_seq = 1;
@@ -64,15 +66,29 @@ inline void kill_loop(Opener open, const std::string& path, int rounds, std::uin
     ASSERT_TRUE(store->save(record_for(first)));
     last_seq = first;
   }
+  // The kill window scales with what one writer round (open, load, save) costs here: under
+  // emulation (qemu-user in the cross builds) that is many times the native cost, and a fixed
+  // window would kill most writers before their first save, which tests nothing.
+  constexpr int kTimedSaves = 4;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < kTimedSaves; ++i) {
+    auto medium = open(path);
+    auto store = CalibrationStore::create(*medium);
+    ASSERT_TRUE(store->save(record_for(++last_seq)));
+  }
+  const double save_us =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count() /
+      kTimedSaves;
+  const int window_us = std::max(max_sleep_us, static_cast<int>(100.0 * save_us));
   std::mt19937_64 rng(seed);
   int advanced = 0, one_slot_bad = 0;
   for (int i = 0; i < rounds; ++i) {
     const pid_t pid = fork();
     ASSERT_GE(pid, 0);
     if (pid == 0) writer(open, path);
-    // 0.2 .. 20 ms: from the middle of start-up to hundreds of saves.
+    // 0.2 ms .. the window: from the middle of start-up to hundreds of saves.
     std::this_thread::sleep_for(
-        std::chrono::microseconds(200 + rng() % static_cast<std::uint64_t>(max_sleep_us - 199)));
+        std::chrono::microseconds(200 + rng() % static_cast<std::uint64_t>(window_us - 199)));
     ASSERT_EQ(kill(pid, SIGKILL), 0);
     int status = 0;
     ASSERT_EQ(waitpid(pid, &status, 0), pid);
@@ -90,9 +106,10 @@ inline void kill_loop(Opener open, const std::string& path, int rounds, std::uin
     last_seq = l->record->sequence;
   }
   std::printf(
-      "%d kills: store advanced in %d rounds to sequence %llu; %d loads found one slot "
-      "invalid\n",
-      rounds, advanced, static_cast<unsigned long long>(last_seq), one_slot_bad);
+      "%d kills (window %d us, one save %.0f us): store advanced in %d rounds to sequence "
+      "%llu; %d loads found one slot invalid\n",
+      rounds, window_us, save_us, advanced, static_cast<unsigned long long>(last_seq),
+      one_slot_bad);
   // The writer must really have been writing when it was killed.
   EXPECT_GT(advanced, rounds / 2);
 }

@@ -1,10 +1,12 @@
 // The real-time set-up and the systemd notifier against the real kernel of the test machine.
 #include <gtest/gtest.h>
+
 #include <pthread.h>
 #include <sched.h>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <unistd.h>
+#include <limits>
 
 #include <atomic>
 #include <chrono>
@@ -40,7 +42,9 @@ TEST(Realtime, MissingCpuFailsWithTheReasonAndStackIsTouched) {
       << items[2].detail;
   EXPECT_EQ(items[3].outcome, RtOutcome::kApplied);
   drivers::RealtimeRequest huge;
-  huge.prefault_stack = std::size_t{1} << 40;  // far beyond any stack limit: refused, no crash
+  // Far beyond any stack limit, on 32-bit targets too (armhf: size_t is 32 bits, so the former
+  // 1 << 40 was undefined and became 0, "off"): refused, no crash.
+  huge.prefault_stack = std::numeric_limits<std::size_t>::max() / 2;
   EXPECT_EQ(drivers::apply_realtime(huge)[3].outcome, RtOutcome::kFailed);
 }
 
