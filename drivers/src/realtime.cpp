@@ -59,6 +59,11 @@ RealtimeItem lock_memory(bool want) {
   it.outcome = RtOutcome::kFailed;
   it.detail = "not available in an AddressSanitizer build (its mlockall does nothing)";
   return it;
+#elif defined(__SANITIZE_THREAD__)
+  // ThreadSanitizer shares that interceptor (sanitizer_common): a no-op reporting success.
+  it.outcome = RtOutcome::kFailed;
+  it.detail = "not available in a ThreadSanitizer build (its mlockall does nothing)";
+  return it;
 #endif
   if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
     it.outcome = RtOutcome::kApplied;
