@@ -51,6 +51,13 @@ Result<CandumpLine> parse_candump_line(std::string_view line) {
   const std::size_t sp = rest.find(' ');
   if (sp == 0 || sp == std::string_view::npos || sp > 15)
     return make_error(Errc::kParse, "expected an interface name (1..15 characters) and a frame");
+  // A Linux interface name is printable ASCII without blanks or '/'; anything else (a NUL byte,
+  // found by fuzz_candump) would not survive being printed back.
+  for (char c : rest.substr(0, sp)) {
+    if (c <= ' ' || c > '~' || c == '/')
+      return make_error(Errc::kParse,
+                        "interface name must be printable ASCII without blanks or '/'");
+  }
   out.iface = std::string(rest.substr(0, sp));
   const std::string_view fr = rest.substr(sp + 1);
   const std::size_t hash = fr.find('#');

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
 
 #include "odo/firmware/can_protocol.hpp"
 #include "odo/firmware/candump_log.hpp"
@@ -239,6 +240,23 @@ TEST(CanDivisor, WholeDivisorsOnly) {
   EXPECT_EQ(divisor_for(100, 200), -1);
   EXPECT_EQ(divisor_for(100, -1), -1);
   EXPECT_EQ(divisor_for(1000, 0.5), 2000);
+}
+
+TEST(CandumpLog, InterfaceNamesMustBePrintable) {
+  // "(ts) <iface> <id>#<data>": a name with a NUL byte (found by fuzz_candump), a control
+  // character, a non-ASCII byte or a '/' cannot be a Linux interface name and would not survive
+  // being printed back; a name of 15 printable characters is the longest there is.
+  using namespace std::string_literals;
+  EXPECT_TRUE(fw::parse_candump_line("(1.000000) can-bus_0.1 410#00").ok());
+  EXPECT_TRUE(fw::parse_candump_line("(1.000000) abcdefghijklmno 410#00").ok());
+  for (const std::string& line : {"(1.000000) \0\0\0.sim0 410#00"s, "(1.000000) ca\tn0 410#00"s,
+                                  "(1.000000) can\xc3\xa9"
+                                  "0 410#00"s,
+                                  "(1.000000) a/b 410#00"s}) {
+    auto bad = fw::parse_candump_line(line);
+    ASSERT_FALSE(bad.ok()) << line;
+    EXPECT_NE(bad.error().message.find("interface name"), std::string::npos) << bad.error().message;
+  }
 }
 
 TEST(CandumpLog, TimeStampsBeyondTheNanosecondClockAreRefused) {
