@@ -1,17 +1,8 @@
 #!/usr/bin/env bash
 # odomctl calib show|set|import|export|reset on a file store, and odometryd reading the store
 # at start and on SIGHUP: exit codes, JSON, range checks that leave the store untouched.
-set -u
-run() { ${CROSS_EMULATOR:-} "$@"; }
-fail=0; pass=0
-check() {  # check NAME CONDITION-RESULT
-  if [ "$2" = 0 ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $1"; fi
-}
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
 S=(--store "$tmp/cal.bin")
-jget() { python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); v=j
-for k in sys.argv[2].split("."): v=v[k]
-print(v)' "$1" "$2"; }
 
 # Never written: uncalibrated, exit 0, factors 1, no geometry.
 run "$ODOMCTL" calib show "${S[@]}" --json >"$tmp/out" 2>"$tmp/err"

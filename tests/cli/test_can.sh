@@ -6,12 +6,7 @@
 # usage: test_can.sh SOURCE_DIR   (env ODOMETRYD, ODOMCTL, CROSS_EMULATOR)
 set -u
 src=$1
-run() { ${CROSS_EMULATOR:-} "$@"; }
-fail=0; pass=0
-check() {  # check NAME CONDITION-RESULT
-  if [ "$2" = 0 ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $1"; fi
-}
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
 dbc="$src/firmware/can/odometry.dbc"
 

@@ -2,12 +2,7 @@
 # Command-line behaviour of odometryd and odomctl: exit codes, stdout/stderr separation, JSON.
 set -u
 dir=$1
-run() { ${CROSS_EMULATOR:-} "$@"; }
-fail=0; pass=0
-check() {  # check NAME CONDITION-RESULT
-  if [ "$2" = 0 ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $1"; fi
-}
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
 
 # odomctl replay --json: exactly one JSON object on stdout.
 run "$ODOMCTL" replay --ticks "$dir/straight.csv" --wheel-diameter 0.1 --counts-per-rev 1000 \

@@ -3,12 +3,7 @@
 # driver over the register model runs the whole square; hardware backends that cannot open
 # their GPIO chip fail with exit 2 and a message naming the file, section and chip.
 set -u
-run() { ${CROSS_EMULATOR:-} "$@"; }
-fail=0; pass=0
-check() {  # check NAME CONDITION-RESULT
-  if [ "$2" = 0 ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $1"; fi
-}
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
 
 # Same square through the simulated backend and through HCTL-1100 models + driver: the poses
 # agree to a fraction of a millimetre (the chips are read a few bus cycles later).

@@ -1,12 +1,7 @@
 #!/usr/bin/env bash
 # odomctl errormodel validate|fit: exit codes, JSON on stdout, progress on stderr, SVG, bad input.
 set -u
-run() { ${CROSS_EMULATOR:-} "$@"; }
-fail=0; pass=0
-check() {  # check NAME CONDITION-RESULT
-  if [ "$2" = 0 ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $1"; fi
-}
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
 
 # validate --json: one object with the documented keys; progress on stderr; an SVG; a run CSV.
 run "$ODOMCTL" errormodel validate --runs 300 --path arc --k-left 0.0004 --k-right 0.00058 \

@@ -3,12 +3,8 @@
 # with `required = true`), --stats, and the systemd notify protocol end to end (READY=1,
 # WATCHDOG=1 while the loop runs, STOPPING=1) over a real AF_UNIX datagram socket.
 set -u
-run() { ${CROSS_EMULATOR:-} "$@"; }
-fail=0; pass=0
-check() {  # check NAME CONDITION-RESULT
-  if [ "$2" = 0 ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $1"; fi
-}
-tmp=$(mktemp -d); chmod 755 "$tmp"; trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
+chmod 755 "$tmp"  # the unprivileged runs below must reach it
 
 # Each part is reported at start; --stats prints the timing table at exit.
 run "$ODOMETRYD" --duration 0.3 --quiet --stats >"$tmp/out" 2>"$tmp/err"

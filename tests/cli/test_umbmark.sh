@@ -2,15 +2,7 @@
 # odomctl umbmark compute|scale|simulate: exit codes, JSON on stdout, messages naming the line or
 # field, the compute -> calib import -> odometryd chain and simulate --store -> odometryd.
 set -u
-run() { ${CROSS_EMULATOR:-} "$@"; }
-fail=0; pass=0
-check() {  # check NAME CONDITION-RESULT
-  if [ "$2" = 0 ]; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $1"; fi
-}
-tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-jget() { python3 -c 'import json,sys; j=json.load(open(sys.argv[1])); v=j
-for k in sys.argv[2].split("."): v=v[k]
-print(v)' "$1" "$2"; }
+. "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
 
 # A hand-made data set: alpha = 0.01 rad, beta = 0.002 rad on a 4 m square (Eq. 6.19/6.20):
 # c.g. cw (-96, -96) mm, ccw (-64, 64) mm; each cluster 5 runs at the c.g. and +-2 mm in x or y,
