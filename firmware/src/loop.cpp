@@ -47,8 +47,18 @@ void OdometryLoop::start() noexcept {
   // first deadline is one period later.
   start_ = clock_->now();
   deadline_ = start_ + period_;
-  snap_.encoder_flags = s.flags;
-  snap_.encoder_counters = s.counters;
+  // The reference reading's flags are the snapshot until the first tick.
+  LoopSnapshot& b = copy_newest();
+  b.encoder_flags = s.flags;
+  b.encoder_counters = s.counters;
+  published_.publish();
+}
+
+LoopSnapshot& OdometryLoop::copy_newest() noexcept {
+  LoopSnapshot& b = published_.back();
+  b = published_.newest();
+  b.stats = stats_;
+  return b;
 }
 
 void OdometryLoop::request_pose(const Pose2& p) noexcept {
@@ -101,18 +111,25 @@ void OdometryLoop::tick() noexcept {
   stats_.wakeup_latency_sum += latency;
   if (latency > stats_.wakeup_latency_max) stats_.wakeup_latency_max = latency;
 
-  snap_.tick = stats_.ticks;
-  snap_.stamp = s.stamp;
-  snap_.loop_time = woke - start_;
-  snap_.pose = odom_.pose();
-  snap_.v = odom_.linear_velocity();
-  snap_.w = odom_.angular_velocity();
-  snap_.distance = odom_.distance();
-  snap_.cov = cov_.cov();
-  snap_.has_cov = true;
-  snap_.encoder_flags = s.flags;
-  snap_.encoder_counters = s.counters;
-  for (std::size_t i = 0; i < n_observers_; ++i) observers_[i]->on_tick(snap_);
+  // Built where the status thread will read it: the back slot of the triple buffer. That slot
+  // holds a snapshot two or three ticks old, so every field that changes is written here or by
+  // the observers on every tick.
+  LoopSnapshot& snap = published_.back();
+  snap.tick = stats_.ticks;
+  snap.stamp = s.stamp;
+  snap.loop_time = woke - start_;
+  snap.pose = odom_.pose();
+  snap.v = odom_.linear_velocity();
+  snap.w = odom_.angular_velocity();
+  snap.distance = odom_.distance();
+  snap.cov = cov_.cov();
+  snap.has_cov = true;
+  snap.encoder_flags = s.flags;
+  snap.encoder_counters = s.counters;
+  // Observers see the statistics up to this tick's wake-up; the fields that change after them
+  // are patched in below, so the published snapshot carries the statistics of the whole tick.
+  snap.stats = stats_;
+  for (std::size_t i = 0; i < n_observers_; ++i) observers_[i]->on_tick(snap);
 
   const TimeNs done = clock_->now();
   const TimeNs compute = done - woke;
@@ -122,6 +139,8 @@ void OdometryLoop::tick() noexcept {
   if ((stats_.ticks & (kSummaryTicks - 1)) == 0) {
     stats_.wakeup_latency = wakeup_hist_.summary();
     stats_.compute_time = compute_hist_.summary();
+    snap.stats.wakeup_latency = stats_.wakeup_latency;
+    snap.stats.compute_time = stats_.compute_time;
   }
   heartbeat_.store(stats_.ticks, std::memory_order_relaxed);
 
@@ -133,8 +152,9 @@ void OdometryLoop::tick() noexcept {
     deadline_ += skipped * period_;
     stats_.missed_deadlines += static_cast<std::uint64_t>(skipped);
   }
-  snap_.stats = stats_;
-  published_.publish(snap_);
+  snap.stats.compute_max = stats_.compute_max;
+  snap.stats.missed_deadlines = stats_.missed_deadlines;
+  published_.publish();
 }
 
 void OdometryLoop::run(TimeNs duration, const std::atomic<bool>& stop) noexcept {
@@ -145,7 +165,8 @@ void OdometryLoop::run(TimeNs duration, const std::atomic<bool>& stop) noexcept 
   }
   stats_.wakeup_latency = wakeup_hist_.summary();
   stats_.compute_time = compute_hist_.summary();
-  snap_.stats = stats_;
+  copy_newest();
+  published_.publish();
 }
 
 }  // namespace odo::fw

@@ -149,16 +149,17 @@ TEST(Loop, PublishesSnapshotsWithStats) {
 
 TEST(Loop, SnapshotCarriesTimingHistogramSummaries) {
   // On the virtual clock a tick wakes exactly on time (latency 0) and a 2 ms read is the whole
-  // compute time. Loop time starts after the 2 ms start-up read: 3 s at 100 Hz = 300 ticks
-  // (at 12, 22, ..., 3002 ms). The snapshot's summaries were refreshed at tick 256 (every
-  // kSummaryTicks), the loop's own at the end of run().
+  // compute time. 300 ticks at 100 Hz (at 12, 22, ..., 3002 ms: loop time starts after the 2 ms
+  // start-up read). While ticking, the snapshot's summaries are refreshed every kSummaryTicks
+  // (last at tick 256); the end of run() publishes the summaries of all 300.
   const auto k = *Kinematics::create(nominal_labmate());
   sim::RobotGeometry g;
-  SimRun run(g, k, {{2.0, 1.0, 1.0}});
-  run.encoder.set_read_delay(&run.clock, 2'000'000);
-  run.drive();
+  SimRun ticked(g, k, {{2.0, 1.0, 1.0}});
+  ticked.encoder.set_read_delay(&ticked.clock, 2'000'000);
+  ticked.loop->start();
+  for (int i = 0; i < 300; ++i) ticked.loop->tick();
   fw::LoopSnapshot s;
-  ASSERT_TRUE(run.loop->snapshots().latest(s));
+  ASSERT_TRUE(ticked.loop->snapshots().latest(s));
   EXPECT_EQ(s.tick, 300u);
   EXPECT_EQ(s.stats.wakeup_latency.count, 256u);
   EXPECT_EQ(s.stats.wakeup_latency.max, 0);
@@ -169,8 +170,20 @@ TEST(Loop, SnapshotCarriesTimingHistogramSummaries) {
   EXPECT_EQ(s.stats.compute_time.p99, 2'000'000);  // bucket bound clamped to the maximum
   EXPECT_EQ(s.stats.compute_time.p999, 2'000'000);
   EXPECT_EQ(s.stats.compute_time.max, 2'000'000);
+  EXPECT_EQ(s.stats.compute_max, 2'000'000);
   EXPECT_EQ(s.stats.missed_deadlines, 0u);
+  EXPECT_EQ(ticked.loop->snapshot().stats.compute_time.count, 256u);
+
+  SimRun run(g, k, {{2.0, 1.0, 1.0}});
+  run.encoder.set_read_delay(&run.clock, 2'000'000);
+  run.drive();
+  ASSERT_TRUE(run.loop->snapshots().latest(s));
+  EXPECT_EQ(s.tick, 300u);
   EXPECT_EQ(run.loop->stats().compute_time.count, 300u);
+  EXPECT_EQ(s.stats.wakeup_latency.count, 300u);
+  EXPECT_EQ(s.stats.compute_time.count, 300u);
+  EXPECT_EQ(s.stats.compute_time.mean, 2'000'000);
+  EXPECT_EQ(run.loop->snapshot().stats.compute_time.count, 300u);
 }
 
 }  // namespace

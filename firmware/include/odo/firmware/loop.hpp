@@ -53,7 +53,10 @@ struct LoopSnapshot {
   std::uint8_t calibration_state = 0;  // 0 uncalibrated (nominal values), 1 calibrated, 2 corrupt
 };
 
-// TickObserver: called on the loop thread after every tick; must not block or allocate.
+// TickObserver: called on the loop thread after every tick; must not block or allocate. The
+// snapshot it gets is built in place in the triple buffer, in a slot that still holds an older
+// tick's values: an observer that sets a field sets it on every tick. Its stats are those up to
+// this tick's wake-up (compute time and missed deadlines: up to the previous tick).
 class TickObserver {
  public:
   virtual ~TickObserver() = default;
@@ -98,7 +101,8 @@ class OdometryLoop {
   const LatencyHistogram& compute_histogram() const noexcept { return compute_hist_; }
   // heartbeat: ticks so far, readable from any thread (the watchdog proves the loop is alive).
   std::uint64_t heartbeat() const noexcept { return heartbeat_.load(std::memory_order_relaxed); }
-  const LoopSnapshot& snapshot() const noexcept { return snap_; }
+  // snapshot: the newest snapshot, for the loop's own thread (or after run() returned).
+  const LoopSnapshot& snapshot() const noexcept { return published_.newest(); }
   TimeNs period() const noexcept { return period_; }
   // snapshots: the newest snapshot for another thread (status printer, supervisor).
   TripleBuffer<LoopSnapshot>& snapshots() noexcept { return published_; }
@@ -125,8 +129,12 @@ class OdometryLoop {
   LatencyHistogram wakeup_hist_;
   LatencyHistogram compute_hist_;
   std::atomic<std::uint64_t> heartbeat_{0};
-  LoopSnapshot snap_;
+  // Each tick builds its snapshot in the triple buffer's back slot and publishes it in place.
   TripleBuffer<LoopSnapshot> published_;
+
+  // copy_newest: the back slot filled with the newest snapshot and the current statistics, to be
+  // published (start-up and end of run only: it copies the whole snapshot).
+  LoopSnapshot& copy_newest() noexcept;
 
   // Set-pose hand-over from another thread: a sequence number guards the three doubles.
   std::atomic<std::uint32_t> pose_req_seq_{0};
