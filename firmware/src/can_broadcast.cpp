@@ -2,9 +2,12 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <initializer_list>
 
 #include "odo/drivers/socketcan_bus.hpp"
 #include "odo/sim/sim_can_bus.hpp"
@@ -155,9 +158,9 @@ void CanBroadcaster::drain_wire(std::int64_t loop_time) noexcept {
   }
 }
 
-void CanBroadcaster::poll_commands() noexcept {
-  CanFrame f;
-  for (std::size_t i = 0; i < o_.max_rx_per_tick && bus_->receive(f); ++i) {
+void CanBroadcaster::take_commands(CanFrame& f) noexcept {
+  for (std::size_t i = 0; i < o_.max_rx_per_tick; ++i) {
+    if (i > 0 && !bus_->receive(f)) break;
     int node = 0;
     can::Msg m{};
     if (!can::split_id(o_.base_id, f, node, m) || node != o_.node_id || m != can::Msg::kSetPose)
@@ -239,7 +242,21 @@ void CanBroadcaster::on_tick(LoopSnapshot& s) noexcept {
   // receiver that sees the ack also sees the new pose in the same or a later pose group.
   ack_ = static_cast<std::uint8_t>(ack_ + pending_ack_);
   pending_ack_ = 0;
-  if (o_.set_pose) poll_commands();
+  // The first receive is made here: on nearly every tick it finds nothing, and the command loop
+  // (take_commands) is not entered.
+  if (o_.set_pose && o_.max_rx_per_tick > 0) {
+    CanFrame f;
+    if (bus_->receive(f)) take_commands(f);
+  }
+  // Most ticks send nothing (19 of 20 at the default rates): one unsigned comparison tells, and
+  // five divisions are saved. A tick number that went back, or repeated, wraps around and fails
+  // it, so the result is always that of the modulo checks in send_due.
+  if (s.tick - quiet_after_ - 1 >= quiet_span_) send_due(s);
+  // Tested here, not in drain_wire: the call alone costs more than the test on quiet ticks.
+  if (wire_ != nullptr && wire_->tx_queued() != 0) drain_wire(s.loop_time);
+}
+
+void CanBroadcaster::send_due(const LoopSnapshot& s) noexcept {
   const std::uint64_t t = s.tick;
   const CanDivisors& d = o_.div;
   if (d.pose != 0 && t % d.pose == 0) send_pose_group(s);
@@ -247,7 +264,13 @@ void CanBroadcaster::on_tick(LoopSnapshot& s) noexcept {
   if (d.uncertainty != 0 && t % d.uncertainty == 0) send_uncertainty(s);
   if (d.status != 0 && t % d.status == 0) send_status(s, false);
   if (d.timing != 0 && t % d.timing == 0) send_timing(s);
-  drain_wire(s.loop_time);
+  // The next tick that is a multiple of an enabled divisor; none enabled: never.
+  std::uint64_t next = UINT64_MAX;
+  for (const std::uint32_t div : {d.pose, d.velocity, d.uncertainty, d.status, d.timing}) {
+    if (div != 0) next = std::min(next, (t / div + 1) * div);
+  }
+  quiet_after_ = t;
+  quiet_span_ = next - t - 1;
 }
 
 void CanBroadcaster::send_final(const LoopSnapshot& s) noexcept {

@@ -103,6 +103,39 @@ TEST(CanBroadcast, FramesAtTheirRatesAndPoseGroupsShareTheirSequence) {
   EXPECT_EQ(b.bc.counters().dropped(), 0u);
 }
 
+TEST(CanBroadcast, RatesFollowTheTickNumberWhenItRepeatsJumpsOrGoesBack) {
+  // A message is sent on the ticks that are a multiple of its divisor. The broadcaster skips the
+  // checks on ticks it knows to be quiet; fed tick numbers that repeat, jump ahead and go back,
+  // it must still send exactly what the modulo rule says, call by call.
+  sim::SimCanPort port(64, 16);
+  fw::CanFrameRing ring{1 << 10};
+  fw::CanBroadcastOptions o;
+  o.div = fw::CanDivisors{3, 4, 10, 0, 7};  // status off
+  fw::CanBroadcaster bc(o, port, nullptr, &port, &ring);
+  std::vector<std::uint64_t> ticks;
+  for (std::uint64_t t = 0; t <= 50; ++t) ticks.push_back(t);
+  for (std::uint64_t t : {50, 50, 21, 22, 23, 24, 1000, 1001, 1004, 1008, 5, 6, 0, 0, 70, 69})
+    ticks.push_back(t);
+  std::size_t frames = 0;
+  for (const std::uint64_t t : ticks) {
+    fw::LoopSnapshot s;
+    s.tick = t;
+    bc.on_tick(s);
+    std::vector<std::uint32_t> want;
+    if (t % 3 == 0) want.insert(want.end(), {id(Msg::kPoseX), id(Msg::kPoseYTheta)});
+    if (t % 4 == 0) want.push_back(id(Msg::kVelocity));
+    if (t % 10 == 0) want.push_back(id(Msg::kUncertainty));
+    if (t % 7 == 0) want.push_back(id(Msg::kTiming));
+    std::vector<std::uint32_t> got;
+    CanFrame f;
+    while (ring.pop(f)) got.push_back(f.id);
+    EXPECT_EQ(got, want) << "tick " << t;
+    frames += got.size();
+  }
+  EXPECT_EQ(bc.counters().sent, frames);
+  EXPECT_GT(frames, 60u);
+}
+
 TEST(CanBroadcast, LinkDownDropsCountsKeepsTheLoopAndResumes) {
   Bench b;
   const auto before = b.ticks(50);

@@ -122,7 +122,9 @@ class CanBroadcaster final : public TickObserver {
   std::uint8_t seq() const noexcept { return seq_; }
 
  private:
-  void poll_commands() noexcept;
+  // take_commands: handles the received frame `f`, then receives and handles more, up to
+  // max_rx_per_tick frames in all (`f` is scratch space).
+  void take_commands(CanFrame& f) noexcept;
   void send(const CanFrame& f, std::int64_t loop_time) noexcept;
   void send_pose_group(const LoopSnapshot& s) noexcept;
   void send_velocity(const LoopSnapshot& s) noexcept;
@@ -148,6 +150,13 @@ class CanBroadcaster final : public TickObserver {
   bool sent_any_pose_ = false;
   std::uint8_t ack_ = 0;           // set-pose commands applied (mod 256), in the status frame
   std::uint32_t pending_ack_ = 0;  // requested this tick, applied at the next one
+  // Ticks strictly between quiet_after_ and quiet_after_ + quiet_span_ + 1 are a multiple of no
+  // divisor: on them the rate checks are skipped (the span is 0 until the first check).
+  std::uint64_t quiet_after_ = 0;
+  std::uint64_t quiet_span_ = 0;
+
+  // send_due: sends what is due on tick t (t % divisor == 0) and notes the next such tick.
+  void send_due(const LoopSnapshot& s) noexcept;
 };
 
 // CanLink: the [can] section wired up: the bus (simulated port or SocketCAN), the broadcaster
