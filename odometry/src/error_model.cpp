@@ -104,23 +104,52 @@ constexpr double kG5[] = {0.20833333333333334,    -0.06805555555555555,    0.007
                           -1.772502855882662e-14, 1.4196246578111098e-16,  -9.568166108006477e-19,
                           5.502741021919477e-21};
 
-// Below |phi| = kShortSeriesLimit (every ordinary tick: 0.05 rad is 5 rad/s at 100 Hz) the first
-// kShortTerms coefficients suffice: the largest omitted term, c_6 z^6 of g3, is 2e-23 of c_0.
+// Shorter series for the small angles of ordinary ticks. Below |phi| = kShortSeriesLimit (0.05 rad
+// is 5 rad/s at 100 Hz) the first kShortTerms coefficients suffice: the largest omitted term,
+// c_6 z^6 of g3, is 2e-23 of c_0. Below kShortestSeriesLimit (15 rad/s at 1 kHz, 1.5 rad/s at
+// 100 Hz) kShortestTerms do: the largest omitted term, c_4 z^4 of g3, is below 8e-19 of c_0
+// (2^-60, under half an ulp), so the three tiers agree to the last bit or one ulp.
 constexpr double kShortSeriesLimit = 0.05;
 constexpr std::size_t kShortTerms = 6;
+constexpr double kShortestSeriesLimit = 0.015;
+constexpr std::size_t kShortestTerms = 4;
 
-// horner: the polynomial of the first M coefficients of c at z.
+// horner: the polynomial of the first M coefficients of c at z (M = 0: all of them).
 template <std::size_t M, std::size_t N>
 inline double horner(const double (&c)[N], double z) noexcept {
-  static_assert(M <= N);
-  double r = c[M - 1];
-  for (std::size_t i = M - 1; i-- > 0;) r = r * z + c[i];
+  constexpr std::size_t kM = M == 0 ? N : M;
+  static_assert(kM <= N);
+  double r = c[kM - 1];
+  for (std::size_t i = kM - 1; i-- > 0;) r = r * z + c[i];
   return r;
 }
 
-template <std::size_t N>
-inline double horner(const double (&c)[N], double z) noexcept {
-  return horner<N, N>(c, z);
+// The seven basic functions of the arc's swept angle.
+struct BasicFunctions {
+  double sinc, h, g1, g2, g3, g4, g5;
+};
+
+// series: the basic functions at z = phi^2 from the first M Taylor coefficients (0: all).
+template <std::size_t M>
+inline BasicFunctions series(double z) noexcept {
+  return {horner<M>(kSinc, z), horner<M>(kH, z),  horner<M>(kG1, z), horner<M>(kG2, z),
+          horner<M>(kG3, z),   horner<M>(kG4, z), horner<M>(kG5, z)};
+}
+
+// closed_form: the basic functions from sin and cos of phi (for |phi| >= kSeriesLimit).
+inline BasicFunctions closed_form(double phi) noexcept {
+  const double s = std::sin(phi), c = std::cos(phi);
+  const double inv = 1.0 / phi, inv2 = inv * inv;
+  const double i_ss = 0.5 * (phi - s * c) * inv;
+  BasicFunctions f;
+  f.sinc = s * inv;
+  f.h = (1.0 - c) * inv2;
+  f.g1 = i_ss * inv2;
+  f.g2 = (s - phi * c) * inv2 * inv;
+  f.g3 = (s * s - 2.0 * s * (1.0 - c) * inv + i_ss) * inv2;
+  f.g4 = (0.5 + c * c - 1.5 * s * c * inv) * inv2 * inv2;
+  f.g5 = (0.5 * s * s * inv - s * c + c * (1.0 - c) * inv) * inv2 * inv;
+  return f;
 }
 
 }  // namespace
@@ -139,48 +168,25 @@ Status check_error_model(const ErrorModelParams& k) {
 
 ArcTerms arc_terms(double phi) noexcept {
   const double z = phi * phi;
-  double sinc, h, g1, g2, g3, g4, g5;
-  if (std::fabs(phi) < kShortSeriesLimit) {
-    sinc = horner<kShortTerms>(kSinc, z);
-    h = horner<kShortTerms>(kH, z);
-    g1 = horner<kShortTerms>(kG1, z);
-    g2 = horner<kShortTerms>(kG2, z);
-    g3 = horner<kShortTerms>(kG3, z);
-    g4 = horner<kShortTerms>(kG4, z);
-    g5 = horner<kShortTerms>(kG5, z);
-  } else if (std::fabs(phi) < kSeriesLimit) {
-    sinc = horner(kSinc, z);
-    h = horner(kH, z);
-    g1 = horner(kG1, z);
-    g2 = horner(kG2, z);
-    g3 = horner(kG3, z);
-    g4 = horner(kG4, z);
-    g5 = horner(kG5, z);
-  } else {
-    const double s = std::sin(phi), c = std::cos(phi);
-    const double inv = 1.0 / phi, inv2 = inv * inv;
-    sinc = s * inv;
-    h = (1.0 - c) * inv2;
-    const double i_ss = 0.5 * (phi - s * c) * inv;
-    g1 = i_ss * inv2;
-    g2 = (s - phi * c) * inv2 * inv;
-    g3 = (s * s - 2.0 * s * (1.0 - c) * inv + i_ss) * inv2;
-    g4 = (0.5 + c * c - 1.5 * s * c * inv) * inv2 * inv2;
-    g5 = (0.5 * s * s * inv - s * c + c * (1.0 - c) * inv) * inv2 * inv;
-  }
+  const double abs_phi = std::fabs(phi);
+  const BasicFunctions f = abs_phi < kShortestSeriesLimit ? series<kShortestTerms>(z)
+                           : abs_phi < kShortSeriesLimit  ? series<kShortTerms>(z)
+                           : abs_phi < kSeriesLimit       ? series<0>(z)
+                                                          : closed_form(phi);
+  const double sinc = f.sinc, h = f.h;
   ArcTerms t;
   t.i_c = sinc;
   t.i_s = phi * h;
-  t.i_ss = z * g1;
+  t.i_ss = z * f.g1;
   t.i_cc = 1.0 - t.i_ss;
   t.i_cs = 0.5 * phi * sinc * sinc;
   t.j_x = sinc - h;
-  t.j_y = phi * g2;
-  t.j_xx = g3;
-  t.j_yy = z * g4;
-  t.j_xy = phi * g5;
+  t.j_y = phi * f.g2;
+  t.j_xx = f.g3;
+  t.j_yy = z * f.g4;
+  t.j_xy = phi * f.g5;
   t.j_cx = 0.5 * sinc * sinc;
-  t.j_cy = phi * g1;
+  t.j_cy = phi * f.g1;
   t.j_sy = 0.5 * t.i_s * t.i_s;
   t.j_sx = t.i_c * t.i_s - t.j_cy;
   return t;

@@ -133,16 +133,19 @@ TEST(ErrorModel, SeriesAndClosedFormsMeetAtTheSwitch) {
   }
 }
 
-TEST(ErrorModel, ShortAndFullSeriesMeetAtTheSwitch) {
-  // |phi| = 0.05 switches from the six-term series (every ordinary tick) to the full series; the
-  // omitted terms are below 1e-22 of the leading one there, so both sides agree to rounding.
-  for (double sign : {1.0, -1.0}) {
-    const ArcTerms lo = arc_terms(sign * std::nextafter(0.05, 0.0));
-    const ArcTerms hi = arc_terms(sign * 0.05);
-    const double* a = &lo.i_c;
-    const double* b = &hi.i_c;
-    for (std::size_t i = 0; i < sizeof(ArcTerms) / sizeof(double); ++i) {
-      EXPECT_NEAR(a[i], b[i], 4e-15 * std::fabs(b[i])) << "term " << i << " sign " << sign;
+TEST(ErrorModel, ShortAndFullSeriesMeetAtTheSwitches) {
+  // |phi| = 0.015 switches from the four-term series (ticks below 15 rad/s at 1 kHz) to the
+  // six-term one, |phi| = 0.05 from that to the full series. The omitted terms are below 2^-60
+  // (8e-19) of the leading one at either switch, so both sides agree to rounding.
+  for (double at : {0.015, 0.05}) {
+    for (double sign : {1.0, -1.0}) {
+      const ArcTerms lo = arc_terms(sign * std::nextafter(at, 0.0));
+      const ArcTerms hi = arc_terms(sign * at);
+      const double* a = &lo.i_c;
+      const double* b = &hi.i_c;
+      for (std::size_t i = 0; i < sizeof(ArcTerms) / sizeof(double); ++i) {
+        EXPECT_NEAR(a[i], b[i], 4e-15 * std::fabs(b[i])) << "term " << i << " at " << sign * at;
+      }
     }
   }
 }
