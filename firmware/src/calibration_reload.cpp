@@ -1,6 +1,7 @@
 #include "odo/firmware/calibration_reload.hpp"
 
 #include <chrono>
+#include <string>
 
 #include "odo/firmware/calibration_io.hpp"
 
@@ -49,8 +50,38 @@ void CalibrationReloader::stop() {
   if (thread_.joinable()) thread_.join();
 }
 
+AppliedCalibration read_settled(const std::function<AppliedCalibration()>& read, int attempts,
+                                const std::function<bool()>& pause, int* rereads) {
+  AppliedCalibration a = read();
+  int n = 0;
+  while (a.state == 2 && n + 1 < attempts && pause()) {
+    ++n;
+    a = read();
+  }
+  if (rereads != nullptr) *rereads = n;
+  return a;
+}
+
 void CalibrationReloader::reload() {
-  AppliedCalibration a = read_and_apply(nominal_, path_, backend_);
+  int rereads = 0;
+  AppliedCalibration a =
+      read_settled([this] { return read_and_apply(nominal_, path_, backend_); }, kReadAttempts,
+                   [this] {
+                     // Sleep in short steps so that stop() is not held up by a corrupt store.
+                     const auto until = std::chrono::steady_clock::now() +
+                                        std::chrono::duration<double>(kRereadPause);
+                     while (std::chrono::steady_clock::now() < until) {
+                       if (done_.load()) return false;
+                       std::this_thread::sleep_for(std::chrono::milliseconds(10));
+                     }
+                     return true;
+                   },
+                   &rereads);
+  if (rereads > 0) {
+    a.report += "; read " + std::to_string(rereads + 1) + " times (" +
+                (a.state == 2 ? "corrupt every time" : "corrupt at first: a save was in flight") +
+                ")";
+  }
   auto k = Kinematics::create(a.params);
   if (!k) {
     // apply_calibration only returns parameters Kinematics accepted; keep the running ones.

@@ -12,11 +12,16 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 #include <thread>
+#include <vector>
 
 #include "calib_kill_loop.hpp"
 #include "odo/drivers/nv_storage.hpp"
 #include "odo/firmware/calibration_io.hpp"
+#include "odo/firmware/calibration_reload.hpp"
 #include "odo/firmware/config.hpp"
 
 namespace odo::calib {
@@ -68,11 +73,18 @@ void check_applied(const fw::AppliedCalibration& a, const KinematicParams& nomin
   EXPECT_EQ(a.params.wheel_diameter, nominal.wheel_diameter);
 }
 
-TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
+// scratch_dir: an empty directory of this test process under $TMPDIR (or /tmp).
+std::filesystem::path scratch_dir(const std::string& name) {
   const char* base = std::getenv("TMPDIR");
   const std::filesystem::path dir =
-      std::filesystem::path(base ? base : "/tmp") / ("odo_reload_race_" + std::to_string(getpid()));
+      std::filesystem::path(base ? base : "/tmp") / (name + "_" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
+  return dir;
+}
+
+TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
+  const std::filesystem::path dir = scratch_dir("odo_reload_race");
   const std::string path = (dir / "calibration.bin").string();
   const KinematicParams nominal = fw::default_config().robot;
 
@@ -146,6 +158,90 @@ TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
   // Under heavy load a reload may come after the writer's 40 ms pause; most must not.
   EXPECT_GE(mid_write, rounds / 2);
   EXPECT_GT(torn_seen, 0);
+  std::filesystem::remove_all(dir);
+}
+
+std::vector<char> file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void put_file_bytes(const std::string& path, const std::vector<char>& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+TEST(CalibReloadRace, BothSlotsInFlightIsReadAgainUntilTheSaveSettles) {
+  // Two saves back to back write slot A, then slot B: a reload whose read overlaps both finds
+  // neither slot valid. Modelled here by both slots damaged at the first read and the finished
+  // store back in place during the pause before the re-read: the re-read must apply the newest
+  // record, not nominal values.
+  const std::filesystem::path dir = scratch_dir("odo_reload_settle");
+  const std::string path = (dir / "calibration.bin").string();
+  const KinematicParams nominal = fw::default_config().robot;
+  {
+    drv::FileNvStorage m(path);
+    auto store = CalibrationStore::create(m);
+    ASSERT_TRUE(store);
+    ASSERT_TRUE(store->save(record_for(1)));
+    ASSERT_TRUE(store->save(record_for(2)));
+  }
+  const std::vector<char> settled = file_bytes(path);
+  const std::vector<char> in_flight(settled.size(), '\x5a');  // neither valid nor blank
+  put_file_bytes(path, in_flight);
+  auto read = [&] { return fw::read_and_apply(nominal, path, "file"); };
+  ASSERT_EQ(read().state, 2) << "precondition: both slots unreadable";
+
+  int pauses = 0, rereads = -1;
+  fw::AppliedCalibration a = fw::read_settled(
+      read, 4,
+      [&] {
+        if (++pauses == 1) put_file_bytes(path, settled);  // the writer finishes
+        return true;
+      },
+      &rereads);
+  check_applied(a, nominal, 2);
+  EXPECT_EQ(pauses, 1);
+  EXPECT_EQ(rereads, 1);
+
+  // Really corrupt: read `attempts` times, then reported corrupt (state 2).
+  put_file_bytes(path, in_flight);
+  pauses = 0;
+  a = fw::read_settled(
+      read, 4, [&] { return ++pauses > 0; }, &rereads);
+  EXPECT_EQ(a.state, 2) << a.report;
+  EXPECT_EQ(pauses, 3);
+  EXPECT_EQ(rereads, 3);
+  // Stopping during the pause: no re-read.
+  a = fw::read_settled(
+      read, 4, [] { return false; }, &rereads);
+  EXPECT_EQ(a.state, 2);
+  EXPECT_EQ(rereads, 0);
+  // A good store is read once.
+  put_file_bytes(path, settled);
+  pauses = 0;
+  a = fw::read_settled(
+      read, 4, [&] { return ++pauses > 0; }, &rereads);
+  check_applied(a, nominal, 2);
+  EXPECT_EQ(pauses, 0);
+
+  // The reloader thread itself on a corrupt store: four reads, said in its log line, state 2.
+  put_file_bytes(path, in_flight);
+  fw::CalibrationHandover handover(1);
+  std::ostringstream log;
+  fw::CalibrationReloader reloader(handover, nominal, path, "file", log);
+  std::atomic<bool> request{true};
+  reloader.start(request);
+  fw::LoopSnapshot snap;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (handover.applied() == 0 && std::chrono::steady_clock::now() < deadline) {
+    handover.on_tick(snap);  // takes the offer, as the loop does between ticks
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  reloader.stop();
+  ASSERT_EQ(handover.applied(), 1u);
+  EXPECT_EQ(snap.calibration_state, 2);
+  EXPECT_NE(log.str().find("read 4 times (corrupt every time)"), std::string::npos) << log.str();
   std::filesystem::remove_all(dir);
 }
 

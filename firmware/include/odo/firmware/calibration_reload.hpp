@@ -6,12 +6,14 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <ostream>
 #include <string>
 #include <thread>
 
+#include "odo/firmware/calibration_io.hpp"
 #include "odo/firmware/loop.hpp"
 #include "odo/odometry/kinematics.hpp"
 
@@ -40,6 +42,14 @@ class CalibrationHandover final : public TickObserver {
   std::uint8_t state_;  // loop thread only
 };
 
+// read_settled: calls `read` until it gives a store that is not corrupt (state 2), `attempts`
+// times at most, and `pause` before each re-read (pause returns false: stop, keep the last
+// result). A store read while another process saves to both slots in turn (two saves back to
+// back) shows both slots in flight; once the writer is done, a re-read finds the new record.
+// `rereads` (optional) receives the number of re-reads.
+AppliedCalibration read_settled(const std::function<AppliedCalibration()>& read, int attempts,
+                                const std::function<bool()>& pause, int* rereads = nullptr);
+
 // CalibrationReloader: a thread that re-reads the store whenever `request` becomes true.
 class CalibrationReloader {
  public:
@@ -54,7 +64,13 @@ class CalibrationReloader {
   CalibrationReloader(const CalibrationReloader&) = delete;
   CalibrationReloader& operator=(const CalibrationReloader&) = delete;
 
-  // start: polls `request` every 50 ms; each time it is set: read, apply, log one line.
+  // Re-reads of a store found corrupt, and the pause before each [s]: a save to a file or an
+  // EEPROM takes milliseconds, an MTD erase block tens of them.
+  static constexpr int kReadAttempts = 4;
+  static constexpr double kRereadPause = 0.2;
+
+  // start: polls `request` every 50 ms; each time it is set: read (again while the store reads
+  // as corrupt, read_settled), apply, log one line.
   void start(std::atomic<bool>& request);
   // stop: ends the thread (idempotent).
   void stop();
