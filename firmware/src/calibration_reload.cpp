@@ -36,7 +36,13 @@ void CalibrationReloader::start(std::atomic<bool>& request) {
     std::unique_lock lk(m_);
     while (!done_.load()) {
       cv_.wait_for(lk, std::chrono::milliseconds(50));
-      if (request.exchange(false)) reload();
+      if (request.exchange(false)) {
+        // Without the lock: stop() must be able to set done_ while a reload pauses between
+        // reads or waits for a loop that no longer ticks to take its offer.
+        lk.unlock();
+        reload();
+        lk.lock();
+      }
     }
   });
 }

@@ -11,6 +11,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -242,6 +243,69 @@ TEST(CalibReloadRace, BothSlotsInFlightIsReadAgainUntilTheSaveSettles) {
   ASSERT_EQ(handover.applied(), 1u);
   EXPECT_EQ(snap.calibration_state, 2);
   EXPECT_NE(log.str().find("read 4 times (corrupt every time)"), std::string::npos) << log.str();
+  std::filesystem::remove_all(dir);
+}
+
+// LineCounter: an ostream sink that counts the lines written to it, readable from another
+// thread (an ostringstream would be a data race there).
+class LineCounter final : public std::streambuf {
+ public:
+  int lines() const { return lines_.load(); }
+
+ protected:
+  int overflow(int c) override {
+    if (c == '\n') lines_.fetch_add(1);
+    return c;
+  }
+
+ private:
+  std::atomic<int> lines_{0};
+};
+
+TEST(CalibReloadRace, StopReturnsWhileAReloadWaitsForALoopThatNoLongerTicks) {
+  // Two SIGHUPs at the end of a run: the first reload's offer fills the hand-over slot, the loop
+  // stops before taking it, the second reload waits for the slot. stop() must still end the
+  // reloader (it used to wait for the lock the waiting reload held: a hang at exit).
+  const std::filesystem::path dir = scratch_dir("odo_reload_stop");
+  const std::string path = (dir / "calibration.bin").string();
+  const KinematicParams nominal = fw::default_config().robot;
+  {
+    drv::FileNvStorage m(path);
+    auto store = CalibrationStore::create(m);
+    ASSERT_TRUE(store);
+    ASSERT_TRUE(store->save(record_for(1)));
+  }
+  fw::CalibrationHandover handover(0);  // no loop: nobody takes the offers
+  LineCounter sink;
+  std::ostream log(&sink);
+  fw::CalibrationReloader reloader(handover, nominal, path, "file", log);
+  std::atomic<bool> request{true};
+  reloader.start(request);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  auto wait_lines = [&](int n) {
+    while (sink.lines() < n && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    return sink.lines() >= n;
+  };
+  ASSERT_TRUE(wait_lines(1));  // first reload: offered, slot now full
+  request = true;
+  ASSERT_TRUE(wait_lines(2));  // second reload: logged, now waiting for the slot
+
+  std::atomic<bool> stopped{false};
+  std::thread stopper([&] {
+    reloader.stop();
+    stopped = true;
+  });
+  const auto stop_deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (!stopped && std::chrono::steady_clock::now() < stop_deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  if (!stopped) {
+    // The reloader is stuck for good; a join would hang the test binary instead of failing it.
+    std::fprintf(stderr, "CalibrationReloader::stop() did not return within 20 s\n");
+    std::_Exit(1);
+  }
+  stopper.join();
+  EXPECT_EQ(handover.applied(), 0u);
   std::filesystem::remove_all(dir);
 }
 
