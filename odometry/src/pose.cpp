@@ -6,30 +6,9 @@
 namespace odo {
 namespace {
 
-// Below this half-angle the Taylor series are exact to double precision: the first dropped
-// terms are h^9/9! < 6e-18 (sin) and h^10/10! < 3e-20 (cos) for |h| <= 0.05.
-constexpr double kSeriesHalfAngle = 0.05;
-
 // Re-derive sin/cos from theta every this many steps so that the rotated pair can never drift
 // from the cumulative heading by more than a few ulp.
 constexpr std::uint32_t kResyncSteps = 1024;
-
-struct HalfAngle {
-  double s;     // sin(h)
-  double c;     // cos(h)
-  double sinc;  // sin(h)/h, 1 at h = 0
-};
-
-inline HalfAngle half_angle(double h) noexcept {
-  if (std::fabs(h) < kSeriesHalfAngle) {
-    const double h2 = h * h;
-    const double sinc = 1.0 - h2 / 6.0 * (1.0 - h2 / 20.0 * (1.0 - h2 / 42.0 * (1.0 - h2 / 72.0)));
-    const double c = 1.0 - h2 / 2.0 * (1.0 - h2 / 12.0 * (1.0 - h2 / 30.0 * (1.0 - h2 / 56.0)));
-    return {h * sinc, c, sinc};
-  }
-  const double s = std::sin(h);
-  return {s, std::cos(h), s / h};
-}
 
 }  // namespace
 

@@ -7,10 +7,6 @@
 namespace odo::sim {
 namespace {
 
-// Below this half-angle of a step's turn the Taylor series are exact to double precision: the
-// first dropped terms are h^9/9! < 6e-18 (sin) and h^10/10! < 3e-20 (cos) for |h| <= 0.05.
-constexpr double kSeriesHalfAngle = 0.05;
-
 // Re-derive sin/cos of the true heading from theta every this many steps (and at every segment
 // boundary). A cached rotation repeats the same rounding every step, so the drift grows linearly
 // with the interval: at 32 steps the truth stays within 1.3e-12 m of a sin/cos per step after an
@@ -126,17 +122,16 @@ void SimRobot::move(double dt, const Segment& seg) noexcept {
     const double ds = 0.5 * (d_l + d_r);
     const double dth = (d_r - d_l) / g_.wheelbase;
     const double h = 0.5 * dth;
-    if (!(std::fabs(h) < kSeriesHalfAngle)) {
+    if (!(std::fabs(h) < kHalfAngleSeriesLimit)) {
       // A large turn in one step (coarse test steps): real trigonometry, then a fresh sin/cos.
       pose_ = arc_step(pose_, d_l, d_r, g_.wheelbase);
       resync_heading();
       return;
     }
-    const double h2 = h * h;
-    const double sinc = 1.0 - h2 / 6.0 * (1.0 - h2 / 20.0 * (1.0 - h2 / 42.0 * (1.0 - h2 / 72.0)));
-    step_cos_h_ = 1.0 - h2 / 2.0 * (1.0 - h2 / 12.0 * (1.0 - h2 / 30.0 * (1.0 - h2 / 56.0)));
-    step_sin_h_ = h * sinc;
-    step_chord_ = ds * sinc;
+    const HalfAngle a = half_angle(h);  // the series branch
+    step_cos_h_ = a.c;
+    step_sin_h_ = a.s;
+    step_chord_ = ds * a.sinc;
     step_dth_ = dth;
     step_d_l_ = d_l;
     step_d_r_ = d_r;

@@ -1,6 +1,7 @@
 // Planar pose integration of a differential-drive base (REP-103: x forward, y left, theta CCW).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 #include "odo/odometry/kinematics.hpp"
@@ -16,6 +17,30 @@ struct Pose2 {
 
 // wrap_angle: maps any angle [rad] into (-pi, pi].
 double wrap_angle(double a) noexcept;
+
+// Below this half-angle [rad] half_angle() uses Taylor series, exact to double precision: the
+// first dropped terms are h^9/9! < 6e-18 (sin) and h^10/10! < 3e-20 (cos) for |h| <= 0.05.
+inline constexpr double kHalfAngleSeriesLimit = 0.05;
+
+// Sine, cosine and sinc of the half-angle h of one step's turn.
+struct HalfAngle {
+  double s;     // sin(h)
+  double c;     // cos(h)
+  double sinc;  // sin(h)/h, 1 at h = 0
+};
+
+// half_angle: sin, cos and sinc of h [rad]; series (no library call) below
+// kHalfAngleSeriesLimit, where the ticks of a loop almost always are.
+inline HalfAngle half_angle(double h) noexcept {
+  if (std::fabs(h) < kHalfAngleSeriesLimit) {
+    const double h2 = h * h;
+    const double sinc = 1.0 - h2 / 6.0 * (1.0 - h2 / 20.0 * (1.0 - h2 / 42.0 * (1.0 - h2 / 72.0)));
+    const double c = 1.0 - h2 / 2.0 * (1.0 - h2 / 12.0 * (1.0 - h2 / 30.0 * (1.0 - h2 / 56.0)));
+    return {h * sinc, c, sinc};
+  }
+  const double s = std::sin(h);
+  return {s, std::cos(h), s / h};
+}
 
 // arc_step: exact pose change for wheel travels d_left, d_right [m] on a constant-curvature arc
 // of a base with wheelbase b [m]; stable for any turn, including none and on-the-spot.
