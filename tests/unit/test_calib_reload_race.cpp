@@ -84,6 +84,14 @@ std::filesystem::path scratch_dir(const std::string& name) {
   return dir;
 }
 
+// save_records: records of sequence 1, 2, ..., n saved in turn to the file store at `path`.
+void save_records(const std::string& path, std::uint64_t n) {
+  drv::FileNvStorage m(path);
+  auto store = CalibrationStore::create(m);
+  ASSERT_TRUE(store);
+  for (std::uint64_t seq = 1; seq <= n; ++seq) ASSERT_TRUE(store->save(record_for(seq)));
+}
+
 TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
   const std::filesystem::path dir = scratch_dir("odo_reload_race");
   const std::string path = (dir / "calibration.bin").string();
@@ -91,12 +99,7 @@ TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
 
   const std::size_t record_bytes = kRecordV1Bytes;  // one write() of a byte medium's slot
   std::uint64_t seq = 1;
-  {
-    drv::FileNvStorage m(path);
-    auto store = CalibrationStore::create(m);
-    ASSERT_TRUE(store);
-    ASSERT_TRUE(store->save(record_for(seq)));
-  }
+  ASSERT_NO_FATAL_FAILURE(save_records(path, seq));
   struct sigaction sa {};
   struct sigaction old {};
   sa.sa_handler = on_reload_signal;
@@ -180,13 +183,7 @@ TEST(CalibReloadRace, BothSlotsInFlightIsReadAgainUntilTheSaveSettles) {
   const std::filesystem::path dir = scratch_dir("odo_reload_settle");
   const std::string path = (dir / "calibration.bin").string();
   const KinematicParams nominal = fw::default_config().robot;
-  {
-    drv::FileNvStorage m(path);
-    auto store = CalibrationStore::create(m);
-    ASSERT_TRUE(store);
-    ASSERT_TRUE(store->save(record_for(1)));
-    ASSERT_TRUE(store->save(record_for(2)));
-  }
+  ASSERT_NO_FATAL_FAILURE(save_records(path, 2));  // slot A: 1, slot B: 2
   const std::vector<char> settled = file_bytes(path);
   const std::vector<char> in_flight(settled.size(), '\x5a');  // neither valid nor blank
   put_file_bytes(path, in_flight);
@@ -269,12 +266,7 @@ TEST(CalibReloadRace, StopReturnsWhileAReloadWaitsForALoopThatNoLongerTicks) {
   const std::filesystem::path dir = scratch_dir("odo_reload_stop");
   const std::string path = (dir / "calibration.bin").string();
   const KinematicParams nominal = fw::default_config().robot;
-  {
-    drv::FileNvStorage m(path);
-    auto store = CalibrationStore::create(m);
-    ASSERT_TRUE(store);
-    ASSERT_TRUE(store->save(record_for(1)));
-  }
+  ASSERT_NO_FATAL_FAILURE(save_records(path, 1));
   fw::CalibrationHandover handover(0);  // no loop: nobody takes the offers
   LineCounter sink;
   std::ostream log(&sink);
