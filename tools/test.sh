@@ -5,8 +5,9 @@
 #   soak        the `soak` tier of the default build: 24 h of simulated driving with random
 #               faults in virtual time (ODO_SOAK=0 skips it)
 #   kernel      the `kernel` tier of the default build, inside a QEMU VM with Debian's kernel
-#               (tools/vm-run.sh: vcan, gpio-sim, mtdram, at24); if the VM cannot start, those
-#               tests run on the host, where each one reports itself skipped with the reason
+#               (tools/vm-run.sh: vcan, gpio-sim, mtdram, at24); if the VM cannot start, the stage
+#               fails under CI; elsewhere those tests run on the host, where each one reports
+#               itself skipped with the reason
 #   debug-asan  Debug + AddressSanitizer + UndefinedBehaviorSanitizer: unit, sim, cli tiers
 #   tsan        ThreadSanitizer: unit, sim, cli tiers (every threaded test: TESTING.md)
 #   fuzz        clang-14 libFuzzer + ASan + UBSan: a short run of every fuzz target (ODO_FUZZ_ARGS,
@@ -22,20 +23,41 @@
 # Environment: ODO_JOBS (parallel build jobs, default nproc), ODO_CONFIGS (space-separated
 # subset of the configurations above), ODO_SOAK=0, ODO_KERNEL=0, ODO_PACKAGES=0 (skip those
 # stages), ODO_FRESH_INSTALL=0 (no chroot install).
+#
+# A skip is for a developer's machine that lacks something, never for CI: with CI=true (as CI
+# runs it) a stage in which any test reports skipped, a stage that cannot run at all (the VM
+# harness, the chroot), or a stage that ran no test fails the run, and the summary names why.
+# The stage functions can be sourced for tests (tests/ci/test_ci_gate.sh): main runs only when
+# this file is executed.
 set -euo pipefail
-cd "$(dirname "$0")/.."
-jobs=${ODO_JOBS:-$(nproc)}
-configs=${ODO_CONFIGS:-"default debug-asan tsan fuzz cross-aarch64 cross-armhf"}
-if [[ " $configs " == *" cross-"* ]]; then tools/setup.sh --tests --cross; else tools/setup.sh --tests; fi
-T_ALL=$(date +%s)
+ODO_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 status=0
 summary=()
 n_pass=0 n_fail=0 n_skip=0  # over every ctest run, for the closing line
+
+in_ci() { [[ ${CI:-} == true || ${CI:-} == 1 ]]; }
+
+# ci_gate STAGE SKIPPED RAN: under CI, a stage with skipped tests or with none run is a failure.
+# Prints the reason and returns 1 then; returns 0 otherwise (and always outside CI).
+ci_gate() {
+  local stage=$1 skipped=$2 ran=$3
+  in_ci || return 0
+  if ((skipped > 0)); then
+    echo "$stage: FAILED under CI: $skipped test(s) reported skipped (a skip is never a pass in CI)"
+    return 1
+  fi
+  if ((ran == 0)); then
+    echo "$stage: FAILED under CI: no test ran"
+    return 1
+  fi
+  return 0
+}
 
 # counted LOG CMD...: runs CMD (a ctest run, possibly inside the VM), output to the terminal and
 # LOG, and adds its "N% tests passed, F tests failed out of T" figures to the totals.
 counted() {
   local log=$1 rc line total failed skipped; shift
+  last_ran=0 last_skipped=0
   set +e
   "$@" 2>&1 | tee "$log"
   rc=${PIPESTATUS[0]}
@@ -47,8 +69,28 @@ counted() {
     skipped=$(grep -cE '\*\*\*Skipped' "$log" || true)
     n_pass=$((n_pass + total - failed - skipped)) n_fail=$((n_fail + failed))
     n_skip=$((n_skip + skipped))
+    last_ran=$total last_skipped=$skipped
+    if [[ $skipped != 0 ]]; then  # name them: the reason is in each test's output above
+      echo "skipped in $log:"; grep -E '\*\*\*Skipped' "$log" || true
+    fi
   elif [[ $rc != 0 ]]; then
     n_fail=$((n_fail + 1))  # the run itself failed before any test reported
+  fi
+  return "$rc"
+}
+
+# gated STAGE LOG CMD...: `counted`, then the CI gate over what that run reported. Returns 0
+# only when the run passed and (under CI) nothing was skipped and something ran.
+gated() {
+  local stage=$1 log=$2; shift 2
+  local rc=0
+  counted "$log" "$@" || rc=$?
+  if ! ci_gate "$stage" "$last_skipped" "$last_ran"; then
+    # Under CI a skipped test is a failed one, in the closing line too (its skipped count is 0).
+    if ((last_skipped > 0)); then
+      n_skip=$((n_skip - last_skipped)) n_fail=$((n_fail + last_skipped))
+    elif ((rc == 0)); then n_fail=$((n_fail + 1)); fi  # nothing ran: one failure for the stage
+    return 1
   fi
   return "$rc"
 }
@@ -60,10 +102,11 @@ stage_config() {  # build one configuration and run its ctest tiers
   cmake --preset "$c" >/dev/null
   if cmake --build --preset "$c" -j"$jobs"; then
     labels='unit|sim|cli'
-    # The UMBmark 20-seed noise study: seconds natively, so only in the native default build.
-    if [[ $c == default ]]; then labels='unit|sim|cli|study'; fi
+    # The UMBmark 20-seed noise study: seconds natively, so only in the native default build;
+    # likewise the self-test of this script's CI gate (label ci).
+    if [[ $c == default ]]; then labels='unit|sim|cli|study|ci'; fi
     if [[ $c == fuzz ]]; then labels=fuzz; fi
-    if counted "build/$c/ctest-tiers.log" ctest --preset "$c" -j"$jobs" --label-regex "$labels"
+    if gated "$c" "build/$c/ctest-tiers.log" ctest --preset "$c" -j"$jobs" --label-regex "$labels"
     then r=ok; else r=FAILED; status=1; fi
   else
     r="FAILED (build)"; status=1; n_fail=$((n_fail + 1))
@@ -75,21 +118,30 @@ stage_soak() {
   local t0 r
   echo "=== soak tier ==="
   t0=$(date +%s)
-  if counted build/default/soak.log ctest --test-dir build/default -L soak -V >/dev/null
+  if gated soak build/default/soak.log ctest --test-dir build/default -L soak -V >/dev/null
   then r=ok; else r=FAILED; status=1; tail -40 build/default/soak.log; fi
   grep -o 'soak: seed.*' build/default/soak.log || true
   summary+=("soak: $r ($(($(date +%s) - t0)) s)")
 }
 
+# The VM harness; a test may point this at another script (tests/ci/test_ci_gate.sh).
+VM_RUN=${ODO_VM_RUN:-$ODO_ROOT/tools/vm-run.sh}
+
 stage_kernel() {
   local t0 r prep
   echo "=== kernel tier (VM harness) ==="
   t0=$(date +%s)
-  if prep=$(tools/vm-run.sh --prepare 2>&1); then
+  if prep=$("$VM_RUN" --prepare 2>&1); then
     # One vCPU: with two, gpio-sim edges can be lost under TCG (see tools/vm-run.md).
-    if ODO_IN_VM=1 counted build/default/kernel.log tools/vm-run.sh --cpus 1 --mem 1G \
+    if ODO_IN_VM=1 gated kernel build/default/kernel.log "$VM_RUN" --cpus 1 --mem 1G \
         --timeout 1800 -- ctest --test-dir build/default -L kernel --output-on-failure
     then r=ok; else r=FAILED; status=1; fi
+  elif in_ci; then
+    # Under CI the kernel tier is not optional: a machine that cannot boot the VM fails the run.
+    echo "kernel tier: FAILED under CI: the VM harness cannot start:"
+    echo "$prep" | tail -5
+    r="FAILED (VM harness unavailable: $(grep -E '^vm-run:' <<<"$prep" | tail -1 || true))"
+    status=1; n_fail=$((n_fail + 1))
   else
     echo "kernel tier: the VM harness is unavailable; kernel tests will report SKIPPED:"
     echo "$prep" | tail -5
@@ -99,44 +151,64 @@ stage_kernel() {
   summary+=("kernel: $r ($(($(date +%s) - t0)) s)")
 }
 
+stage_fresh_install() {  # the amd64 package on a freshly bootstrapped Debian 12 chroot
+  local deb=$1 t0 r rc
+  echo "=== fresh install (debootstrap chroot) ==="
+  t0=$(date +%s)
+  rc=0; tests/package/fresh_install.sh "$deb" || rc=$?
+  case $rc in
+    0) r=ok; n_pass=$((n_pass + 1)) ;;
+    77) if in_ci; then r="FAILED under CI (skipped, see above)"; status=1; n_fail=$((n_fail + 1))
+        else r="skipped (see above)"; n_skip=$((n_skip + 1)); fi ;;
+    *) r=FAILED; status=1; n_fail=$((n_fail + 1)) ;;
+  esac
+  summary+=("fresh install amd64: $r ($(($(date +%s) - t0)) s)")
+}
+
 stage_package() {  # the Debian package of one build tree
-  local c=$1 t0 r log deb rc
+  local c=$1 t0 r log
   echo "=== package of $c ==="
   t0=$(date +%s)
   log=build/$c/package.log
   # ctest exits 0 for a skipped test; the summary then says why from the test output.
-  if ODO_PACKAGE_INSTALL=1 counted "$log" ctest --test-dir "build/$c" -L package \
+  if ODO_PACKAGE_INSTALL=1 gated "package $c" "$log" ctest --test-dir "build/$c" -L package \
       --output-on-failure -V >/dev/null
   then r=ok; else r=FAILED; status=1; fi
   grep -E '^[0-9]+: (FAIL|SKIPPED|size|package|check_deb)' "$log" | cut -d' ' -f2- || true
-  if grep -Eq '^[0-9]+: SKIPPED|check_deb .*SKIPPED' "$log"; then r="$r (part skipped, see above)"; fi
+  if grep -Eq '^[0-9]+: SKIPPED|check_deb .*SKIPPED' "$log"; then
+    # A check skipped inside check_deb.sh (no root, no systemd-analyze...): not a pass in CI.
+    if in_ci; then r="FAILED under CI (part skipped, see above)"; status=1; n_fail=$((n_fail + 1))
+    else r="$r (part skipped, see above)"; fi
+  fi
   summary+=("package $c: $r ($(($(date +%s) - t0)) s)")
   if [[ $c == default && ${ODO_FRESH_INSTALL:-1} == 1 ]]; then
-    # The amd64 package on a freshly bootstrapped Debian 12 (chroot): Depends from the mirror.
-    echo "=== fresh install (debootstrap chroot) ==="
-    t0=$(date +%s)
-    deb=$(ls -t build/default/diffodom_*_amd64.deb | head -1)
-    rc=0; tests/package/fresh_install.sh "$deb" || rc=$?
-    case $rc in 0) r=ok ;; 77) r="skipped (see above)"; n_skip=$((n_skip + 1)) ;;
-      *) r=FAILED; status=1; n_fail=$((n_fail + 1)) ;; esac
-    if [[ $rc == 0 ]]; then n_pass=$((n_pass + 1)); fi
-    summary+=("fresh install amd64: $r ($(($(date +%s) - t0)) s)")
+    stage_fresh_install "$(ls -t build/default/diffodom_*_amd64.deb | head -1)"
   fi
 }
 
-for c in $configs; do
-  stage_config "$c"
-  if [[ $c == default ]]; then
-    if [[ ${ODO_SOAK:-1} == 1 ]]; then stage_soak; fi
-    if [[ ${ODO_KERNEL:-1} == 1 ]]; then stage_kernel; fi
-  fi
-done
-if [[ ${ODO_PACKAGES:-1} == 1 ]]; then
+main() {
+  cd "$ODO_ROOT"
+  jobs=${ODO_JOBS:-$(nproc)}
+  configs=${ODO_CONFIGS:-"default debug-asan tsan fuzz cross-aarch64 cross-armhf"}
+  if [[ " $configs " == *" cross-"* ]]; then tools/setup.sh --tests --cross; else tools/setup.sh --tests; fi
+  if in_ci; then echo "test.sh: CI=$CI: a skipped test or a stage that cannot run fails the run"; fi
+  T_ALL=$(date +%s)
   for c in $configs; do
-    if [[ $c == default || $c == cross-* ]]; then stage_package "$c"; fi
+    stage_config "$c"
+    if [[ $c == default ]]; then
+      if [[ ${ODO_SOAK:-1} == 1 ]]; then stage_soak; fi
+      if [[ ${ODO_KERNEL:-1} == 1 ]]; then stage_kernel; fi
+    fi
   done
-fi
-echo "=== summary ($(($(date +%s) - T_ALL)) s in all) ==="
-printf '%s\n' "${summary[@]}"
-echo "all stages: $n_pass passed, $n_fail failed, $n_skip skipped"
-exit $status
+  if [[ ${ODO_PACKAGES:-1} == 1 ]]; then
+    for c in $configs; do
+      if [[ $c == default || $c == cross-* ]]; then stage_package "$c"; fi
+    done
+  fi
+  echo "=== summary ($(($(date +%s) - T_ALL)) s in all) ==="
+  printf '%s\n' "${summary[@]}"
+  echo "all stages: $n_pass passed, $n_fail failed, $n_skip skipped"
+  exit $status
+}
+
+if [[ ${BASH_SOURCE[0]} == "$0" ]]; then main "$@"; fi
