@@ -3,7 +3,7 @@
 #include <chrono>
 #include <string>
 
-#include "odo/firmware/calibration_io.hpp"
+#include "odo/firmware/calibration_store.hpp"
 
 namespace odo::fw {
 
@@ -20,7 +20,7 @@ bool CalibrationHandover::offer(const Kinematics& k, std::uint8_t state,
   return true;
 }
 
-void CalibrationHandover::on_tick(LoopSnapshot& snap) noexcept {
+void CalibrationHandover::on_tick(loop::LoopSnapshot& snap) noexcept {
   if (full_.load(std::memory_order_acquire)) {
     // Between two ticks: the next tick integrates with the new factors.
     if (loop_ != nullptr && pending_) loop_->set_kinematics(*pending_);

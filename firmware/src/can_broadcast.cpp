@@ -119,7 +119,7 @@ void CanLogWriter::stop() {
 
 // ---- CanBroadcaster ----
 
-CanBroadcaster::CanBroadcaster(const CanBroadcastOptions& o, CanBus& bus, OdometryLoop* loop,
+CanBroadcaster::CanBroadcaster(const CanBroadcastOptions& o, CanBus& bus, loop::OdometryLoop* loop,
                                sim::SimCanPort* wire, CanFrameRing* log) noexcept
     : o_(o), bus_(&bus), loop_(loop), wire_(wire), log_(log) {}
 
@@ -162,11 +162,11 @@ void CanBroadcaster::take_commands(CanFrame& f) noexcept {
   for (std::size_t i = 0; i < o_.max_rx_per_tick; ++i) {
     if (i > 0 && !bus_->receive(f)) break;
     int node = 0;
-    can::Msg m{};
-    if (!can::split_id(o_.base_id, f, node, m) || node != o_.node_id || m != can::Msg::kSetPose)
+    protocol::Msg m{};
+    if (!protocol::split_id(o_.base_id, f, node, m) || node != o_.node_id || m != protocol::Msg::kSetPose)
       continue;  // not for us (a SocketCAN filter normally keeps these out)
-    can::SetPoseCmd cmd;
-    if (!can::decode_set_pose(f, cmd)) {
+    protocol::SetPoseCmd cmd;
+    if (!protocol::decode_set_pose(f, cmd)) {
       ++c_.set_pose_rejected;
       continue;
     }
@@ -176,25 +176,25 @@ void CanBroadcaster::take_commands(CanFrame& f) noexcept {
   }
 }
 
-void CanBroadcaster::send_pose_group(const LoopSnapshot& s) noexcept {
+void CanBroadcaster::send_pose_group(const loop::LoopSnapshot& s) noexcept {
   if (sent_any_pose_) ++seq_;
   sent_any_pose_ = true;
-  const can::PoseMsg p{s.pose.x, s.pose.y, s.pose.theta, seq_};
+  const protocol::PoseMsg p{s.pose.x, s.pose.y, s.pose.theta, seq_};
   CanFrame f;
-  can::encode_pose_x(id(can::Msg::kPoseX), p, f);
+  protocol::encode_pose_x(id(protocol::Msg::kPoseX), p, f);
   send(f, s.loop_time);
-  can::encode_pose_y_theta(id(can::Msg::kPoseYTheta), p, f);
+  protocol::encode_pose_y_theta(id(protocol::Msg::kPoseYTheta), p, f);
   send(f, s.loop_time);
 }
 
-void CanBroadcaster::send_velocity(const LoopSnapshot& s) noexcept {
+void CanBroadcaster::send_velocity(const loop::LoopSnapshot& s) noexcept {
   CanFrame f;
-  can::encode_velocity(id(can::Msg::kVelocity), can::VelocityMsg{s.v, s.w, seq_}, f);
+  protocol::encode_velocity(id(protocol::Msg::kVelocity), protocol::VelocityMsg{s.v, s.w, seq_}, f);
   send(f, s.loop_time);
 }
 
-void CanBroadcaster::send_uncertainty(const LoopSnapshot& s) noexcept {
-  can::UncertaintyMsg u;
+void CanBroadcaster::send_uncertainty(const loop::LoopSnapshot& s) noexcept {
+  protocol::UncertaintyMsg u;
   u.seq = seq_;
   if (s.has_cov) {
     u.sigma_x = std::sqrt(std::max(0.0, s.cov[0]));
@@ -206,12 +206,12 @@ void CanBroadcaster::send_uncertainty(const LoopSnapshot& s) noexcept {
     u.sigma_x = u.sigma_y = u.sigma_theta = std::nan("");  // unknown: sent as the maximum
   }
   CanFrame f;
-  can::encode_uncertainty(id(can::Msg::kUncertainty), u, f);
+  protocol::encode_uncertainty(id(protocol::Msg::kUncertainty), u, f);
   send(f, s.loop_time);
 }
 
-void CanBroadcaster::send_status(const LoopSnapshot& s, bool stopping) noexcept {
-  can::StatusMsg m;
+void CanBroadcaster::send_status(const loop::LoopSnapshot& s, bool stopping) noexcept {
+  protocol::StatusMsg m;
   m.encoder_flags = static_cast<std::uint8_t>(s.encoder_flags & 0xFFu);
   m.calibration_state = s.calibration_state;
   m.stopping = stopping;
@@ -221,23 +221,23 @@ void CanBroadcaster::send_status(const LoopSnapshot& s, bool stopping) noexcept 
                            : static_cast<std::uint32_t>(s.stats.missed_deadlines);
   m.uptime = to_seconds(s.loop_time);
   CanFrame f;
-  can::encode_status(id(can::Msg::kStatus), m, f);
+  protocol::encode_status(id(protocol::Msg::kStatus), m, f);
   send(f, s.loop_time);
 }
 
-void CanBroadcaster::send_timing(const LoopSnapshot& s) noexcept {
-  can::TimingMsg t;
+void CanBroadcaster::send_timing(const loop::LoopSnapshot& s) noexcept {
+  protocol::TimingMsg t;
   t.wakeup_p99 = to_seconds(s.stats.wakeup_latency.p99);
   t.wakeup_max = to_seconds(s.stats.wakeup_latency_max);
   t.compute_max = to_seconds(s.stats.compute_max);
   const std::uint64_t d = c_.dropped();
   t.tx_dropped = d > 0xFFFFFFFFu ? 0xFFFFFFFFu : static_cast<std::uint32_t>(d);
   CanFrame f;
-  can::encode_timing(id(can::Msg::kTiming), t, f);
+  protocol::encode_timing(id(protocol::Msg::kTiming), t, f);
   send(f, s.loop_time);
 }
 
-void CanBroadcaster::on_tick(LoopSnapshot& s) noexcept {
+void CanBroadcaster::on_tick(loop::LoopSnapshot& s) noexcept {
   // Commands taken last tick were applied at the start of this one: acknowledge them now, so a
   // receiver that sees the ack also sees the new pose in the same or a later pose group.
   ack_ = static_cast<std::uint8_t>(ack_ + pending_ack_);
@@ -256,7 +256,7 @@ void CanBroadcaster::on_tick(LoopSnapshot& s) noexcept {
   if (wire_ != nullptr && wire_->tx_queued() != 0) drain_wire(s.loop_time);
 }
 
-void CanBroadcaster::send_due(const LoopSnapshot& s) noexcept {
+void CanBroadcaster::send_due(const loop::LoopSnapshot& s) noexcept {
   const std::uint64_t t = s.tick;
   const CanDivisors& d = o_.div;
   if (d.pose != 0 && t % d.pose == 0) send_pose_group(s);
@@ -273,7 +273,7 @@ void CanBroadcaster::send_due(const LoopSnapshot& s) noexcept {
   quiet_span_ = next - t - 1;
 }
 
-void CanBroadcaster::send_final(const LoopSnapshot& s) noexcept {
+void CanBroadcaster::send_final(const loop::LoopSnapshot& s) noexcept {
   ack_ = static_cast<std::uint8_t>(ack_ + pending_ack_);
   pending_ack_ = 0;
   send_pose_group(s);
@@ -291,7 +291,7 @@ CanLink::~CanLink() {
 }
 
 Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loop_hz,
-                                                 OdometryLoop& loop, const std::string& can_log,
+                                                 loop::OdometryLoop& loop, const std::string& can_log,
                                                  bool virtual_time) {
   std::unique_ptr<CanLink> link(new CanLink());
   if (s.bus == "none") {
@@ -307,7 +307,7 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
     so.reopen_period = s.reopen_period;
     if (s.set_pose)
       so.filters.push_back(drivers::CanFilter{
-          can::frame_id(static_cast<std::uint32_t>(s.base_id), s.node_id, can::Msg::kSetPose),
+          protocol::frame_id(static_cast<std::uint32_t>(s.base_id), s.node_id, protocol::Msg::kSetPose),
           0x7FF, false});
     auto bus = drivers::SocketCanBus::open(so);
     if (!bus) return std::move(bus).error();
@@ -331,7 +331,7 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
   o.set_pose = s.set_pose;
   o.lossless_log = virtual_time;
   auto div = [&](double hz) {
-    const std::int64_t d = can::divisor_for(loop_hz, hz);
+    const std::int64_t d = protocol::divisor_for(loop_hz, hz);
     return d > 0 ? static_cast<std::uint32_t>(d) : 0u;
   };
   o.div = CanDivisors{div(s.pose_hz), div(s.velocity_hz), div(s.uncertainty_hz), div(s.status_hz),
@@ -342,7 +342,7 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
     return make_error(Errc::kInvalidArgument, "can: too many loop observers");
   char idtxt[16];
   std::snprintf(idtxt, sizeof idtxt, "0x%03X",
-                can::frame_id(o.base_id, o.node_id, can::Msg::kPoseX));
+                protocol::frame_id(o.base_id, o.node_id, protocol::Msg::kPoseX));
   link->describe_ =
       (s.bus == "socketcan" ? "SocketCAN " + s.interface : std::string("simulated bus")) +
       ", node " + std::to_string(s.node_id) + ", ids from " + idtxt +
@@ -359,7 +359,7 @@ void CanLink::close_log() {
   if (log_) log_->stop();
 }
 
-void CanLink::finish(const LoopSnapshot& snap) {
+void CanLink::finish(const loop::LoopSnapshot& snap) {
   send_final(snap);
   close_log();
 }

@@ -5,7 +5,7 @@
 #include <cstring>
 #include <sstream>
 
-#include "odo/firmware/can_protocol.hpp"
+#include "odo/protocol/can_protocol.hpp"
 #include "odo/firmware/toml_reader.hpp"
 
 namespace odo::fw {
@@ -164,18 +164,18 @@ void read_can(TableReader t, CanSection& s, double loop_hz) {
   if (s.interface.empty() || s.interface.size() > 15)
     t.reject("interface",
              "= \"" + s.interface + "\" must be 1..15 characters (a network interface)");
-  s.node_id = static_cast<int>(t.integer("node_id", s.node_id, 0, can::kMaxNodeId));
+  s.node_id = static_cast<int>(t.integer("node_id", s.node_id, 0, protocol::kMaxNodeId));
   s.base_id = static_cast<int>(t.integer("base_id", s.base_id, 0, 1024));
   if (s.base_id % 16 != 0)
     t.reject("base_id", "= " + std::to_string(s.base_id) + " must be a multiple of 16");
   // The ranges keep every node's block of 16 ids inside 11 bits.
-  static_assert(can::frame_id(1024, can::kMaxNodeId, can::Msg::kSetPose) + 7 <= 0x7FF);
+  static_assert(protocol::frame_id(1024, protocol::kMaxNodeId, protocol::Msg::kSetPose) + 7 <= 0x7FF);
   for (auto [key, rate] :
        {std::pair{"pose_hz", &s.pose_hz}, std::pair{"velocity_hz", &s.velocity_hz},
         std::pair{"uncertainty_hz", &s.uncertainty_hz}, std::pair{"status_hz", &s.status_hz},
         std::pair{"timing_hz", &s.timing_hz}}) {
     *rate = t.number(key, *rate, 0.0, 2000.0, "Hz");
-    if (t.ok() && can::divisor_for(loop_hz, *rate) < 0) {
+    if (t.ok() && protocol::divisor_for(loop_hz, *rate) < 0) {
       std::ostringstream o;
       o << "= " << *rate
         << " Hz must be 0 or loop.rate_hz / n for a whole n >= 1 (loop.rate_hz = " << loop_hz

@@ -14,11 +14,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "odo/firmware/calibration_io.hpp"
+#include "odo/firmware/calibration_store.hpp"
 #include "odo/firmware/calibration_reload.hpp"
 #include "odo/firmware/can_broadcast.hpp"
 #include "odo/firmware/config.hpp"
-#include "odo/firmware/loop.hpp"
+#include "odo/loop/loop.hpp"
 #include "odo/firmware/realtime_setup.hpp"
 #include "odo/firmware/rig.hpp"
 #include "odo/firmware/timing_report.hpp"
@@ -43,11 +43,11 @@ std::string flags_text(std::uint32_t f) {
   return s;
 }
 
-double position_error(const LoopSnapshot& s) {
+double position_error(const loop::LoopSnapshot& s) {
   return std::hypot(s.pose.x - s.truth.x, s.pose.y - s.truth.y);
 }
 
-void print_status(std::ostream& out, const LoopSnapshot& s, double rate_hz) {
+void print_status(std::ostream& out, const loop::LoopSnapshot& s, double rate_hz) {
   char line[320];
   std::snprintf(line, sizeof line, "t=%7.2f s  x=%+8.4f m  y=%+8.4f m  th=%+8.2f deg  v=%+5.2f m/s",
                 to_seconds(s.loop_time), s.pose.x, s.pose.y, wrap_angle(s.pose.theta) * kRadToDeg,
@@ -105,16 +105,16 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
     err << "odometryd: " << rig.error().message << "\n";
     return 2;
   }
-  LoopConfig lc;
+  loop::LoopConfig lc;
   lc.rate_hz = cfg->loop.rate_hz;
   lc.error_model = cfg->error_model;
-  auto created = OdometryLoop::create(lc, *calibrated, rig->encoder(), rig->clock());
+  auto created = loop::OdometryLoop::create(lc, *calibrated, rig->encoder(), rig->clock());
   if (!created) {
     err << "odometryd: " << cfg->source << ": " << created.error().message << "\n";
     return 2;
   }
-  std::unique_ptr<OdometryLoop> loop = std::move(created).value();
-  if (TickObserver* t = rig->truth_observer()) loop->add_observer(t);
+  std::unique_ptr<loop::OdometryLoop> loop = std::move(created).value();
+  if (loop::TickObserver* t = rig->truth_observer()) loop->add_observer(t);
   CalibrationHandover cal_handover(cal.state);
   cal_handover.attach(loop.get());
   loop->add_observer(&cal_handover);
@@ -151,7 +151,7 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
   const bool want_status = !o.quiet && cfg->loop.status_period > 0.0 && !o.virtual_time;
   if (want_status) {
     status = std::thread([&] {
-      LoopSnapshot s;
+      loop::LoopSnapshot s;
       std::uint64_t last_tick = 0;
       auto last = std::chrono::steady_clock::now();
       std::unique_lock lk(m);
@@ -205,8 +205,8 @@ int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& ou
   reloader.stop();
   stop_status();
 
-  const LoopSnapshot& s = loop->snapshot();
-  const LoopStats& st = loop->stats();
+  const loop::LoopSnapshot& s = loop->snapshot();
+  const loop::LoopStats& st = loop->stats();
   const double loop_s = to_seconds(s.loop_time);
   const double mean_rate = loop_s > 0 ? static_cast<double>(st.ticks) / loop_s : 0.0;
   log << "odometryd: stopped after " << st.ticks << " ticks (" << loop_s << " s of loop time, "

@@ -13,10 +13,10 @@ namespace odo::fw {
 namespace {
 
 // TruthObserver: copies the simulator's exact pose into every snapshot.
-class TruthObserver final : public TickObserver {
+class TruthObserver final : public loop::TickObserver {
  public:
   explicit TruthObserver(const sim::SimRobot& robot) : robot_(robot) {}
-  void on_tick(LoopSnapshot& snap) noexcept override {
+  void on_tick(loop::LoopSnapshot& snap) noexcept override {
     snap.has_truth = true;
     snap.truth = robot_.true_pose();
   }
@@ -90,7 +90,7 @@ Clock& Rig::clock() noexcept {
 EncoderSource& Rig::encoder() noexcept {
   return *impl_->encoder;
 }
-TickObserver* Rig::truth_observer() noexcept {
+loop::TickObserver* Rig::truth_observer() noexcept {
   return impl_->truth.get();
 }
 const std::string& Rig::describe() const noexcept {

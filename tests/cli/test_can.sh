@@ -8,7 +8,7 @@ set -u
 src=$1
 . "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
-dbc="$src/firmware/can/odometry.dbc"
+dbc="$src/protocol/odometry.dbc"
 
 # 1. The whole demo square (97 s of virtual time), theta passing through +-pi on the way.
 run "$ODOMETRYD" --virtual-time --json --can-log "$tmp/can.log" >"$tmp/out.json" 2>"$tmp/err"

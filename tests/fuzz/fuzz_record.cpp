@@ -13,7 +13,8 @@
 #include "fuzz_check.hpp"
 #include "odo/calibration/record.hpp"
 #include "odo/calibration/store.hpp"
-#include "odo/firmware/calibration_io.hpp"
+#include "odo/firmware/calibration_store.hpp"
+#include "odo/analysis/calibration_json.hpp"
 #include "odo/odometry/kinematics.hpp"
 #include "odo/sim/sim_nv_storage.hpp"
 

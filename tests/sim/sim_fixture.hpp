@@ -4,7 +4,7 @@
 #include <atomic>
 #include <memory>
 
-#include "odo/firmware/loop.hpp"
+#include "odo/loop/loop.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_encoder.hpp"
 #include "odo/sim/virtual_clock.hpp"
@@ -21,7 +21,7 @@ struct SimRun {
          std::int64_t counter_offset = 0, double rate_hz = 100.0)
       : robot(*sim::SimRobot::create(g, std::move(sc))),
         encoder(robot, bits, counter_offset),
-        loop(fw::OdometryLoop::create(fw::LoopConfig{rate_hz}, believed, encoder, clock).value()) {}
+        loop(loop::OdometryLoop::create(loop::LoopConfig{rate_hz}, believed, encoder, clock).value()) {}
 
   // drive: runs the loop for the scenario plus `extra` seconds of standstill.
   void drive(double extra = 1.0) {
@@ -32,7 +32,7 @@ struct SimRun {
   sim::VirtualClock clock;
   sim::SimRobot robot;
   sim::SimEncoderSource encoder;
-  std::unique_ptr<fw::OdometryLoop> loop;
+  std::unique_ptr<loop::OdometryLoop> loop;
 };
 
 }  // namespace odo::test

@@ -26,7 +26,7 @@ TEST(Threads, SetPoseRequestsAreNeverTorn) {
   SimRun run(g, k, {});
   std::atomic<bool> stop{false};
   std::thread loop([&] { run.loop->run(0, stop); });
-  fw::LoopSnapshot s;
+  loop::LoopSnapshot s;
   std::uint64_t changes = 0;  // snapshots showing a newly applied request
   double last_x = 0.0;
   int i = 0;

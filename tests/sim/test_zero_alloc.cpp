@@ -9,9 +9,9 @@
 #include <new>
 
 #include "odo/firmware/can_broadcast.hpp"
-#include "odo/firmware/can_protocol.hpp"
+#include "odo/protocol/can_protocol.hpp"
 #include "odo/firmware/config.hpp"
-#include "odo/firmware/loop.hpp"
+#include "odo/loop/loop.hpp"
 #include "odo/firmware/rig.hpp"
 #include "odo/sim/sim_can_bus.hpp"
 
@@ -262,8 +262,8 @@ TEST(ZeroAlloc, CountersSeeEveryKindOfAllocation) {
 }
 
 // An observer that breaks the rule: allocates on every tick.
-struct AllocatingObserver final : fw::TickObserver {
-  void on_tick(fw::LoopSnapshot& s) noexcept override {
+struct AllocatingObserver final : loop::TickObserver {
+  void on_tick(loop::LoopSnapshot& s) noexcept override {
     auto* p = new std::uint64_t(s.tick);
     escape(p);
     delete p;
@@ -277,7 +277,7 @@ TEST(ZeroAlloc, AnAllocationInsideATickIsCaught) {
   auto rig = fw::Rig::create(cfg, *kin, true);
   ASSERT_TRUE(rig.ok());
   auto loop =
-      fw::OdometryLoop::create(fw::LoopConfig{}, *kin, rig->encoder(), rig->clock()).value();
+      loop::OdometryLoop::create(loop::LoopConfig{}, *kin, rig->encoder(), rig->clock()).value();
   AllocatingObserver bad;
   loop->add_observer(&bad);
   loop->start();
@@ -298,9 +298,9 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   ASSERT_TRUE(kin.ok());
   auto rig = fw::Rig::create(cfg, *kin, /*virtual_time=*/true);
   ASSERT_TRUE(rig.ok()) << rig.error().message;
-  fw::LoopConfig lc;
+  loop::LoopConfig lc;
   lc.rate_hz = cfg.loop.rate_hz;
-  auto loop = fw::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
+  auto loop = loop::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
   ASSERT_NE(rig->truth_observer(), nullptr);
   loop->add_observer(rig->truth_observer());
   // The CAN broadcast at the default rates on the simulated bus, with the candump log (its
@@ -313,7 +313,7 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   loop->start();
 
   constexpr std::uint64_t kTicks = 200'000;  // 200 s at 1 kHz: both squares, then standstill
-  fw::LoopSnapshot reader;
+  loop::LoopSnapshot reader;
   std::uint64_t published = 0;
   {
     AllocWindow w;
@@ -323,9 +323,9 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
       if ((i & 1023) == 0 && loop->snapshots().latest(reader)) ++published;
       if (i == 150'000) {  // a set-pose command (reset to zero) arrives on the bus
         CanFrame cmd;
-        fw::can::encode_set_pose(
-            fw::can::frame_id(fw::can::kDefaultBaseId, cfg.can.node_id, fw::can::Msg::kSetPose),
-            fw::can::SetPoseCmd{true, 0, 0, 0}, cmd);
+        protocol::encode_set_pose(
+            protocol::frame_id(protocol::kDefaultBaseId, cfg.can.node_id, protocol::Msg::kSetPose),
+            protocol::SetPoseCmd{true, 0, 0, 0}, cmd);
         (*can)->sim_port()->inject(cmd);
       }
     }
@@ -349,7 +349,7 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   ASSERT_LT(rig->scenario_duration(), 199.0);
   EXPECT_NEAR(loop->odometry().distance(), 32.0, 0.2);  // two 4 m squares: 32 m of legs
   EXPECT_EQ(loop->wakeup_histogram().count(), kTicks);
-  EXPECT_EQ(loop->stats().wakeup_latency.count, kTicks - kTicks % fw::OdometryLoop::kSummaryTicks);
+  EXPECT_EQ(loop->stats().wakeup_latency.count, kTicks - kTicks % loop::OdometryLoop::kSummaryTicks);
 }
 
 TEST(ZeroAlloc, CanReceiveFloodWithoutAllocating) {
@@ -364,18 +364,18 @@ TEST(ZeroAlloc, CanReceiveFloodWithoutAllocating) {
   ASSERT_TRUE(kin.ok());
   auto rig = fw::Rig::create(cfg, *kin, /*virtual_time=*/true);
   ASSERT_TRUE(rig.ok()) << rig.error().message;
-  fw::LoopConfig lc;
+  loop::LoopConfig lc;
   lc.rate_hz = cfg.loop.rate_hz;
-  auto loop = fw::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
+  auto loop = loop::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
   auto can = fw::CanLink::create(cfg.can, cfg.loop.rate_hz, *loop, "");
   ASSERT_TRUE(can.ok()) << can.error().message;
   sim::SimCanPort* port = (*can)->sim_port();
   ASSERT_NE(port, nullptr);
   loop->start();
   CanFrame ours;
-  fw::can::encode_set_pose(
-      fw::can::frame_id(fw::can::kDefaultBaseId, cfg.can.node_id, fw::can::Msg::kSetPose),
-      fw::can::SetPoseCmd{false, 1.0, 2.0, 0.5}, ours);
+  protocol::encode_set_pose(
+      protocol::frame_id(protocol::kDefaultBaseId, cfg.can.node_id, protocol::Msg::kSetPose),
+      protocol::SetPoseCmd{false, 1.0, 2.0, 0.5}, ours);
   CanFrame foreign;
   foreign.len = 8;
   constexpr std::uint64_t kTicks = 20'000;
@@ -421,9 +421,9 @@ TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
   ASSERT_TRUE(kin.ok());
   auto rig = fw::Rig::create(cfg, *kin, /*virtual_time=*/true);
   ASSERT_TRUE(rig.ok()) << rig.error().message;
-  fw::LoopConfig lc;
+  loop::LoopConfig lc;
   lc.rate_hz = cfg.loop.rate_hz;
-  auto loop = fw::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
+  auto loop = loop::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
   loop->start();
   constexpr std::uint64_t kTicks = 40'000;  // 40 s at 1 kHz
   {
@@ -433,7 +433,7 @@ TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
     EXPECT_EQ(g_allocs.load(), 0u) << "heap allocations during " << kTicks << " ticks";
     EXPECT_EQ(g_frees.load(), 0u) << "heap deallocations during " << kTicks << " ticks";
   }
-  fw::LoopSnapshot snap;
+  loop::LoopSnapshot snap;
   ASSERT_TRUE(loop->snapshots().latest(snap));
   EXPECT_EQ(snap.encoder_flags, static_cast<std::uint32_t>(kEncoderStaleLeft));
   EXPECT_EQ(snap.encoder_counters.stale_events, 1u);

@@ -21,7 +21,8 @@
 
 #include "calib_kill_loop.hpp"
 #include "odo/drivers/nv_storage.hpp"
-#include "odo/firmware/calibration_io.hpp"
+#include "odo/firmware/calibration_store.hpp"
+#include "odo/analysis/calibration_json.hpp"
 #include "odo/firmware/calibration_reload.hpp"
 #include "odo/firmware/config.hpp"
 
@@ -230,7 +231,7 @@ TEST(CalibReloadRace, BothSlotsInFlightIsReadAgainUntilTheSaveSettles) {
   fw::CalibrationReloader reloader(handover, nominal, path, "file", log);
   std::atomic<bool> request{true};
   reloader.start(request);
-  fw::LoopSnapshot snap;
+  loop::LoopSnapshot snap;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   while (handover.applied() == 0 && std::chrono::steady_clock::now() < deadline) {
     handover.on_tick(snap);  // takes the offer, as the loop does between ticks

@@ -5,7 +5,8 @@
 #include <nlohmann/json.hpp>
 
 #include "odo/calibration/store.hpp"
-#include "odo/firmware/calibration_io.hpp"
+#include "odo/firmware/calibration_store.hpp"
+#include "odo/analysis/calibration_json.hpp"
 #include "odo/firmware/calibration_reload.hpp"
 #include "odo/firmware/config.hpp"
 
@@ -30,7 +31,7 @@ TEST(CalibrationIo, ImportsUmbmarkComputeOutput) {
   const char* text =
       R"({"c_l":0.99925,"c_r":1.00075,"b_new":0.33702,"e_max_syst":0.232,"n_cw":5,"n_ccw":5,
           "alpha":0.0012,"beta":-0.0004,"e_d":1.0015,"e_b":0.9912})";
-  auto r = parse_calibration_json(text, "u.json", 1795000000);
+  auto r = analysis::parse_calibration_json(text, "u.json", 1795000000);
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_DOUBLE_EQ(r->c_l, 0.99925);
   EXPECT_DOUBLE_EQ(r->c_r, 1.00075);
@@ -57,30 +58,30 @@ TEST(CalibrationIo, ExportImportRoundTrip) {
   r.e_max_before = 0.3;
   r.e_max_after = 0.02;
   r.runs = 10;
-  auto back = parse_calibration_json(export_json(r), "e.json", 0);
+  auto back = analysis::parse_calibration_json(analysis::export_json(r), "e.json", 0);
   ASSERT_TRUE(back) << back.error().message;
   r.sequence = 0;  // the store assigns sequence numbers; import does not carry them
   EXPECT_EQ(*back, r);
 }
 
 TEST(CalibrationIo, BadInputNamesTheField) {
-  auto r = parse_calibration_json(R"({"c_l":1.3,"c_r":1.0})", "x.json", 0);
+  auto r = analysis::parse_calibration_json(R"({"c_l":1.3,"c_r":1.0})", "x.json", 0);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("x.json"), std::string::npos);
   EXPECT_NE(r.error().message.find("c_l"), std::string::npos);
   EXPECT_NE(r.error().message.find("[0.9, 1.1]"), std::string::npos);
-  r = parse_calibration_json(R"({"c_l":"one","c_r":1.0})", "x.json", 0);
+  r = analysis::parse_calibration_json(R"({"c_l":"one","c_r":1.0})", "x.json", 0);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("field c_l: expected a number"), std::string::npos);
-  r = parse_calibration_json(R"({"c_l":1.0})", "x.json", 0);
+  r = analysis::parse_calibration_json(R"({"c_l":1.0})", "x.json", 0);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("c_r is missing"), std::string::npos);
-  r = parse_calibration_json(R"({"c_l":1.0,"c_r":1.0,"b_new":-0.3})", "x.json", 0);
+  r = analysis::parse_calibration_json(R"({"c_l":1.0,"c_r":1.0,"b_new":-0.3})", "x.json", 0);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("wheelbase"), std::string::npos);
-  EXPECT_FALSE(parse_calibration_json("{not json", "x.json", 0));
-  EXPECT_FALSE(parse_calibration_json("[1,2]", "x.json", 0));
-  r = parse_calibration_json(R"({"status":"corrupt","c_l":null,"c_r":null})", "s.json", 0);
+  EXPECT_FALSE(analysis::parse_calibration_json("{not json", "x.json", 0));
+  EXPECT_FALSE(analysis::parse_calibration_json("[1,2]", "x.json", 0));
+  r = analysis::parse_calibration_json(R"({"status":"corrupt","c_l":null,"c_r":null})", "s.json", 0);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("corrupt"), std::string::npos);
 }
@@ -95,7 +96,7 @@ TEST(CalibrationIo, ShowJsonHasTheRequiredKeys) {
   r.wheelbase = 0.337;
   l.record = r;
   l.slot = 1;
-  auto j = nlohmann::json::parse(show_json(l));
+  auto j = nlohmann::json::parse(analysis::show_json(l));
   EXPECT_EQ(j["status"], "ok");
   EXPECT_EQ(j["sequence"], 4);
   EXPECT_EQ(j["c_l"], 0.999);
@@ -104,7 +105,7 @@ TEST(CalibrationIo, ShowJsonHasTheRequiredKeys) {
   EXPECT_TRUE(j["wheel_diameter"].is_null());
   LoadResult bad;
   bad.status = StoreStatus::kCorrupt;
-  j = nlohmann::json::parse(show_json(bad));
+  j = nlohmann::json::parse(analysis::show_json(bad));
   EXPECT_EQ(j["status"], "corrupt");
   EXPECT_TRUE(j["c_l"].is_null());  // no made-up values for a corrupt store
 }
@@ -147,7 +148,7 @@ TEST(CalibrationHandover, AppliedOnTheLoopThreadBetweenTicks) {
   // Without a loop attached the observer only stamps the state; an offer is taken on the next
   // tick and the state changes with it.
   CalibrationHandover h(0);
-  LoopSnapshot snap;
+  loop::LoopSnapshot snap;
   h.on_tick(snap);
   EXPECT_EQ(snap.calibration_state, 0);
   std::atomic<bool> stop{false};

@@ -13,28 +13,28 @@
 #include <string>
 #include <thread>
 
-#include "odo/firmware/calibration_io.hpp"
-#include "odo/firmware/loop.hpp"
+#include "odo/firmware/calibration_store.hpp"
+#include "odo/loop/loop.hpp"
 #include "odo/odometry/kinematics.hpp"
 
 namespace odo::fw {
 
-// CalibrationHandover: a TickObserver that swaps in offered kinematics on the loop thread and
-// stamps LoopSnapshot::calibration_state on every tick.
-class CalibrationHandover final : public TickObserver {
+// CalibrationHandover: a loop::TickObserver that swaps in offered kinematics on the loop thread and
+// stamps loop::LoopSnapshot::calibration_state on every tick.
+class CalibrationHandover final : public loop::TickObserver {
  public:
   explicit CalibrationHandover(std::uint8_t state) : state_(state) {}
   // attach: the loop whose kinematics are replaced (configure time).
-  void attach(OdometryLoop* loop) noexcept { loop_ = loop; }
+  void attach(loop::OdometryLoop* loop) noexcept { loop_ = loop; }
   // offer: producer side (one thread). False when the loop has not taken the previous offer
   // before `stop` was set.
   bool offer(const Kinematics& k, std::uint8_t state, const std::atomic<bool>& stop);
-  void on_tick(LoopSnapshot& snap) noexcept override;
+  void on_tick(loop::LoopSnapshot& snap) noexcept override;
   // applied: offers the loop has taken so far.
   std::uint64_t applied() const noexcept { return applied_.load(std::memory_order_acquire); }
 
  private:
-  OdometryLoop* loop_ = nullptr;
+  loop::OdometryLoop* loop_ = nullptr;
   std::optional<Kinematics> pending_;  // written only while full_ is false
   std::uint8_t pending_state_ = 0;
   std::atomic<bool> full_{false};

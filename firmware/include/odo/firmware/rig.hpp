@@ -7,7 +7,7 @@
 #include <string>
 
 #include "odo/firmware/config.hpp"
-#include "odo/firmware/loop.hpp"
+#include "odo/loop/loop.hpp"
 #include "odo/hal/clock.hpp"
 #include "odo/hal/encoder.hpp"
 #include "odo/hal/result.hpp"
@@ -28,7 +28,7 @@ class Rig {
   Clock& clock() noexcept;
   EncoderSource& encoder() noexcept;
   // truth_observer: fills the snapshot's ground truth (simulation only; null otherwise).
-  TickObserver* truth_observer() noexcept;
+  loop::TickObserver* truth_observer() noexcept;
   // describe: one line saying what is wired, for the start-up report.
   const std::string& describe() const noexcept;
   // scenario_duration: length of the simulated motion [s], 0 when not simulated.
