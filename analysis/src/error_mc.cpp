@@ -5,11 +5,9 @@
 #include <sstream>
 
 #include "odo/analysis/error_model_tools.hpp"
-#include "odo/loop/loop.hpp"
 #include "odo/analysis/seed.hpp"
 #include "odo/sim/robot.hpp"
-#include "odo/sim/sim_encoder.hpp"
-#include "odo/sim/virtual_clock.hpp"
+#include "odo/sim/sim_run.hpp"
 #include "odo/sim/wheel_noise.hpp"
 
 namespace odo::analysis {
@@ -94,33 +92,27 @@ Result<McResult> run_error_monte_carlo(const McOptions& o,
   g.gear_ratio = p.gear_ratio;
   const sim::Scenario path = make_path(o);
   // Two periods of standstill after the path so that the last reading sees the robot stopped.
-  const TimeNs duration = from_seconds(sim::scenario_duration(path) + 2.0 / o.rate_hz);
-  loop::LoopConfig lc;
-  lc.rate_hz = o.rate_hz;
-  lc.error_model = o.k;
+  const double standstill = 2.0 / o.rate_hz;
+  sim::WheelNoise noise(o.k.k_left, o.k.k_right, 0);
+  sim::SimRunOptions so;
+  so.loop.rate_hz = o.rate_hz;
+  so.loop.error_model = o.k;
+  so.perturbation = &noise;
 
   McResult r;
   r.runs = o.runs;
   r.errors.reserve(static_cast<std::size_t>(o.runs));
-  sim::WheelNoise noise(o.k.k_left, o.k.k_right, 0);
   const int report_every = std::max(1, o.runs / 20);
   for (int i = 0; i < o.runs; ++i) {
-    auto robot = sim::SimRobot::create(g, path);
-    if (!robot) return std::move(robot).error();
     noise.reseed(seed_of(o.seed, static_cast<std::uint64_t>(i)));
-    robot->set_travel_perturbation(&noise);
-    sim::SimEncoderSource enc(*robot, 32);
-    sim::VirtualClock clock;
-    auto loop = loop::OdometryLoop::create(lc, *k, enc, clock);
-    if (!loop) return std::move(loop).error();
-    std::atomic<bool> stop{false};
-    (*loop)->run(duration, stop);
-    const loop::LoopSnapshot& s = (*loop)->snapshot();
-    const Pose2& truth = robot->true_pose();
-    r.errors.push_back({truth.x - s.pose.x, truth.y - s.pose.y, truth.theta - s.pose.theta});
+    auto run = sim::SimRun::create(g, *k, path, so);
+    if (!run) return std::move(run).error();
+    (*run)->drive(standstill);
+    const Pose2 e = (*run)->error();
+    r.errors.push_back({e.x, e.y, e.theta});
     // The encoders count the wheels' rotation, which the noise does not touch, so every run's
     // odometry and covariance are the same; keep the last.
-    r.predicted = s.cov;
+    r.predicted = (*run)->loop().snapshot().cov;
     if (progress && ((i + 1) % report_every == 0 || i + 1 == o.runs)) progress(i + 1, o.runs);
   }
   r.sample = sample_covariance(r.errors, &r.mean);

@@ -4,13 +4,11 @@
 #include <random>
 #include <sstream>
 
-#include "odo/loop/loop.hpp"
 #include "odo/analysis/seed.hpp"
 #include "odo/analysis/umbmark_tools.hpp"
 #include "odo/sim/floor.hpp"
 #include "odo/sim/robot.hpp"
-#include "odo/sim/sim_encoder.hpp"
-#include "odo/sim/virtual_clock.hpp"
+#include "odo/sim/sim_run.hpp"
 
 namespace odo::analysis {
 namespace {
@@ -41,8 +39,6 @@ struct Driver {
     sim::SquareOptions so;
     so.side = o.side;
     so.direction = d == Direction::kCw ? sim::Turn::kClockwise : sim::Turn::kCounterClockwise;
-    auto robot = sim::SimRobot::create(truth, sim::square_scenario(*k, so));
-    if (!robot) return std::move(robot).error();
     const bool paper = o.noise == "paper";
     const std::uint64_t seed = seed_of(o.seed, run_index++);
     sim::UmbmarkFloor::Options fo;
@@ -53,22 +49,19 @@ struct Driver {
     fo.first_leg = o.side;
     fo.bumps_under_left = d == Direction::kCcw;  // the wheel facing the inside of the square
     sim::UmbmarkFloor floor(fo, seed);
-    robot->set_travel_perturbation(&floor);
-    sim::SimEncoderSource enc(*robot, 32);
-    sim::VirtualClock clock;
-    auto loop = loop::OdometryLoop::create(loop::LoopConfig{}, *k, enc, clock);
-    if (!loop) return std::move(loop).error();
-    std::atomic<bool> stop{false};
+    sim::SimRunOptions ro;
+    ro.perturbation = &floor;
+    auto run = sim::SimRun::create(truth, *k, sim::square_scenario(*k, so), ro);
+    if (!run) return std::move(run).error();
     // One second of standstill after the path: the last readings see the robot stopped.
-    (*loop)->run(from_seconds(sim::scenario_duration(robot->scenario()) + 1.0), stop);
-    const Pose2& odo = (*loop)->odometry().pose();
-    const Pose2& t = robot->true_pose();
+    (*run)->drive(1.0);
+    const Pose2 e = (*run)->error();
     UmbmarkRun r;
     r.direction = d;
     r.bumps = bumps;
-    r.ex = t.x - odo.x;
-    r.ey = t.y - odo.y;
-    r.etheta = t.theta - odo.theta;
+    r.ex = e.x;
+    r.ey = e.y;
+    r.etheta = e.theta;
     if (paper) {
       // The reference ("sonar calibrator") measures the absolute pose with its own error.
       std::mt19937_64 rng(seed ^ 0x5EC0ADULL);

@@ -33,7 +33,7 @@ AppliedCalibration apply_calibration(const KinematicParams& nominal,
   std::ostringstream m;
   m << "calibration " << where << ": ";
   if (!loaded) {
-    a.state = 2;
+    a.state = StoreStatus::kCorrupt;
     m << "ERROR: cannot read the store (" << loaded.error().message
       << "); running on NOMINAL values";
     a.report = m.str();
@@ -41,7 +41,7 @@ AppliedCalibration apply_calibration(const KinematicParams& nominal,
   }
   const LoadResult& l = *loaded;
   if (l.status == StoreStatus::kCorrupt) {
-    a.state = 2;
+    a.state = StoreStatus::kCorrupt;
     m << "ERROR: store corrupt (" << l.describe() << "); running on NOMINAL values";
     a.report = m.str();
     return a;
@@ -61,14 +61,14 @@ AppliedCalibration apply_calibration(const KinematicParams& nominal,
   auto ok = Kinematics::create(p);
   auto range = calib::validate_record(r);
   if (!ok || !range) {
-    a.state = 2;
+    a.state = StoreStatus::kCorrupt;
     m << "ERROR: stored values rejected (" << (!range ? range.error().message : ok.error().message)
       << "); running on NOMINAL values";
     a.report = m.str();
     return a;
   }
   a.params = p;
-  a.state = 1;
+  a.state = StoreStatus::kOk;
   a.sequence = r.sequence;
   m << "ok, sequence " << r.sequence << ": c_l=" << r.c_l << " c_r=" << r.c_r
     << " b=" << p.wheelbase << " m" << (r.wheelbase ? "" : " (nominal)")

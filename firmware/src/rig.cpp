@@ -6,47 +6,12 @@
 #include "odo/drivers/monotonic_clock.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_encoder.hpp"
+#include "odo/sim/truth.hpp"
 #include "odo/sim/virtual_clock.hpp"
 
 namespace odo::fw {
 
 namespace {
-
-// TruthObserver: copies the simulator's exact pose into every snapshot.
-class TruthObserver final : public loop::TickObserver {
- public:
-  explicit TruthObserver(const sim::SimRobot& robot) : robot_(robot) {}
-  void on_tick(loop::LoopSnapshot& snap) noexcept override {
-    snap.has_truth = true;
-    snap.truth = robot_.true_pose();
-  }
-
- private:
-  const sim::SimRobot& robot_;
-};
-
-// EpochEncoder: the simulated encoders on a real clock, with the robot's time zero at the first
-// read (the loop's reference reading), so the robot does not drive off during start-up while
-// the odometry is not yet counting (seen as a 36 mm error after a 0.18 s start in the VM).
-class EpochEncoder final : public EncoderSource {
- public:
-  explicit EpochEncoder(sim::SimEncoderSource& inner) : inner_(inner) {}
-  EncoderSample read(TimeNs now) noexcept override {
-    if (!started_) {
-      epoch_ = now;
-      started_ = true;
-    }
-    EncoderSample s = inner_.read(now - epoch_);
-    s.stamp = now;
-    return s;
-  }
-  int counter_bits() const noexcept override { return inner_.counter_bits(); }
-
- private:
-  sim::SimEncoderSource& inner_;
-  TimeNs epoch_ = 0;
-  bool started_ = false;
-};
 
 sim::Scenario make_scenario(const SimSection& s, const Kinematics& k) {
   sim::SquareOptions o;
@@ -73,7 +38,7 @@ struct Rig::Impl {
   std::unique_ptr<sim::SimEncoderSource> sim_encoder;
   std::unique_ptr<EncoderSource> encoder_wrapper;
   EncoderSource* encoder = nullptr;
-  std::unique_ptr<TruthObserver> truth;
+  std::unique_ptr<sim::TruthRecorder> truth;
   std::unique_ptr<EncoderBackend> backend;  // hctl1100 / gpio (encoder_backends.hpp)
   std::string description;
   double scenario_duration = 0.0;
@@ -90,7 +55,7 @@ Clock& Rig::clock() noexcept {
 EncoderSource& Rig::encoder() noexcept {
   return *impl_->encoder;
 }
-loop::TickObserver* Rig::truth_observer() noexcept {
+sim::TruthRecorder* Rig::truth() noexcept {
   return impl_->truth.get();
 }
 const std::string& Rig::describe() const noexcept {
@@ -150,7 +115,7 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     impl->encoder = impl->sim_encoder.get();
   } else {
     impl->clock = std::make_unique<drivers::MonotonicClock>();
-    impl->encoder_wrapper = std::make_unique<EpochEncoder>(*impl->sim_encoder);
+    impl->encoder_wrapper = std::make_unique<sim::EpochEncoder>(*impl->sim_encoder);
     impl->encoder = impl->encoder_wrapper.get();
   }
   if (hctl_sim) {
@@ -167,7 +132,7 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     impl->backend = std::move(b).value();
     impl->encoder = &impl->backend->encoder();
   }
-  impl->truth = std::make_unique<TruthObserver>(*impl->robot);
+  impl->truth = std::make_unique<sim::TruthRecorder>(*impl->robot);
   std::ostringstream d;
   d << "simulated robot '" << cfg.sim.robot << "' (true wheelbase " << g.wheelbase * 1e3
     << " mm, D_R/D_L " << g.wheel_diameter_right / g.wheel_diameter_left << "), scenario '"

@@ -26,8 +26,8 @@ Result<std::unique_ptr<OdometryLoop>> OdometryLoop::create(const LoopConfig& cfg
 OdometryLoop::OdometryLoop(TimeNs period, const LoopConfig& cfg, const Kinematics& k,
                            EncoderSource& enc, Clock& clock)
     : period_(period),
-      odom_(k),
-      cov_(cfg.error_model),
+      odom_(k, cfg.error_model),
+      calibration_(cfg.calibration),
       enc_(&enc),
       clock_(&clock),
       bits_(enc.counter_bits()) {}
@@ -51,6 +51,7 @@ void OdometryLoop::start() noexcept {
   LoopSnapshot& b = copy_newest();
   b.encoder_flags = s.flags;
   b.encoder_counters = s.counters;
+  b.calibration_state = calibration_;
   published_.publish();
 }
 
@@ -61,16 +62,16 @@ LoopSnapshot& OdometryLoop::copy_newest() noexcept {
   return b;
 }
 
-void OdometryLoop::request_pose(const Pose2& p) noexcept {
-  // Seqlock writer: odd sequence while the three values are being replaced. Release stores
-  // instead of fences (ThreadSanitizer models no fences): a reader that sees any new value also
-  // sees the odd sequence written before it.
-  const std::uint32_t s = pose_req_seq_.load(std::memory_order_relaxed);
-  pose_req_seq_.store(s + 1, std::memory_order_relaxed);
-  req_x_.store(p.x, std::memory_order_release);
-  req_y_.store(p.y, std::memory_order_release);
-  req_theta_.store(p.theta, std::memory_order_release);
-  pose_req_seq_.store(s + 2, std::memory_order_release);
+void OdometryLoop::apply_commands() noexcept {
+  const std::size_t n = commands_.drain([this](const Command& c) {
+    if (const auto* p = std::get_if<SetPose>(&c)) {
+      odom_.reset(p->pose);  // and its covariance: a set pose is exact
+    } else if (const auto* k = std::get_if<SetKinematics>(&c)) {
+      odom_.set_kinematics(k->kinematics);
+      calibration_ = k->calibration;
+    }
+  });
+  commands_applied_.fetch_add(n, std::memory_order_release);
 }
 
 void OdometryLoop::tick() noexcept {
@@ -78,29 +79,15 @@ void OdometryLoop::tick() noexcept {
   const TimeNs woke = clock_->now();
   const TimeNs latency = woke - deadline_;
 
-  // A pending set-pose command takes effect before this tick's motion is added.
-  const std::uint32_t seq = pose_req_seq_.load(std::memory_order_acquire);
-  if (seq != pose_req_seen_ && (seq & 1u) == 0) {
-    // Acquire loads keep the re-check of the sequence after them (seqlock reader).
-    const Pose2 p{req_x_.load(std::memory_order_acquire), req_y_.load(std::memory_order_acquire),
-                  req_theta_.load(std::memory_order_acquire)};
-    if (pose_req_seq_.load(std::memory_order_relaxed) == seq) {
-      odom_.reset(p);
-      cov_.reset();
-      pose_req_seen_ = seq;
-    }
-  }
+  // Commands take effect before this tick's motion is added; nearly every tick finds none.
+  if (!commands_.empty()) apply_commands();
 
   const EncoderSample s = enc_->read(woke);
   if ((s.flags & kEncoderReadError) == 0) {
     // Counts are cumulative, so a late tick simply integrates a longer interval: nothing is lost.
     const std::int64_t dl = wrap_delta(prev_left_, s.left, bits_);
     const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
-    // The covariance needs the heading at the start of the tick; the integrator's cached sine
-    // and cosine of it spare a trigonometric call.
-    const double s0 = odom_.sin_theta(), c0 = odom_.cos_theta();
-    odom_.update(dl, dr, to_seconds(s.stamp - prev_stamp_));
-    cov_.step_sc(s0, c0, odom_.last_d_left(), odom_.last_d_right(), odom_.kinematics().wheelbase());
+    odom_.advance(dl, dr, to_seconds(s.stamp - prev_stamp_));
     prev_left_ = s.left;
     prev_right_ = s.right;
     prev_stamp_ = s.stamp;
@@ -122,8 +109,9 @@ void OdometryLoop::tick() noexcept {
   snap.v = odom_.linear_velocity();
   snap.w = odom_.angular_velocity();
   snap.distance = odom_.distance();
-  snap.cov = cov_.cov();
+  snap.cov = odom_.covariance();
   snap.has_cov = true;
+  snap.calibration_state = calibration_;
   snap.encoder_flags = s.flags;
   snap.encoder_counters = s.counters;
   // Observers see the statistics up to this tick's wake-up; the fields that change after them

@@ -4,25 +4,10 @@
 #include <limits>
 
 #include "odo/odometry/pose.hpp"
+#include "odo/protocol/signals.hpp"
 
 namespace odo::protocol {
 namespace {
-
-// Little-endian (Intel) byte-aligned fields.
-void put_le(CanFrame& f, int byte, int bytes, std::uint64_t raw) noexcept {
-  for (int i = 0; i < bytes; ++i)
-    f.data[static_cast<std::size_t>(byte + i)] = static_cast<std::uint8_t>(raw >> (8 * i));
-}
-std::uint64_t get_le(const CanFrame& f, int byte, int bytes) noexcept {
-  std::uint64_t v = 0;
-  for (int i = bytes - 1; i >= 0; --i) v = (v << 8) | f.data[static_cast<std::size_t>(byte + i)];
-  return v;
-}
-std::int64_t get_le_signed(const CanFrame& f, int byte, int bytes) noexcept {
-  const std::uint64_t v = get_le(f, byte, bytes);
-  const int shift = 64 - 8 * bytes;
-  return static_cast<std::int64_t>(v << shift) >> shift;  // sign-extend
-}
 
 // quantise: round(value / scale) clamped to [lo, hi]; NaN gives `nan_raw`.
 std::int64_t quantise(double value, double scale, std::int64_t lo, std::int64_t hi,
@@ -34,6 +19,17 @@ std::int64_t quantise(double value, double scale, std::int64_t lo, std::int64_t 
   return static_cast<std::int64_t>(r);
 }
 
+// put_value: `value` quantised to the signal (saturating at its range); NaN gives `nan_raw`.
+void put_value(CanFrame& f, const Signal& s, double value, std::int64_t nan_raw = 0) noexcept {
+  put_raw(f, s, quantise(value, s.scale, s.raw_min, s.raw_max, nan_raw));
+}
+
+// put_count: an unsigned counter, saturating at the signal's maximum.
+void put_count(CanFrame& f, const Signal& s, std::uint64_t n) noexcept {
+  const auto hi = static_cast<std::uint64_t>(s.raw_max);
+  put_raw(f, s, static_cast<std::int64_t>(n > hi ? hi : n));
+}
+
 void start(std::uint32_t id, CanFrame& f) noexcept {
   f.id = id;
   f.extended = false;
@@ -42,12 +38,13 @@ void start(std::uint32_t id, CanFrame& f) noexcept {
   f.stamp = 0;
 }
 
-constexpr std::int64_t kI32Min = std::numeric_limits<std::int32_t>::min();
-constexpr std::int64_t kI32Max = std::numeric_limits<std::int32_t>::max();
-constexpr std::int64_t kI24Min = -(1 << 23);
-constexpr std::int64_t kI24Max = (1 << 23) - 1;
-
 }  // namespace
+
+const MessageSpec& message_spec(Msg m) noexcept {
+  for (const MessageSpec& s : kMessages)
+    if (s.msg == m) return s;
+  return kMessages[0];  // unreachable: every Msg is in the table
+}
 
 bool valid_addressing(std::uint32_t base_id, int node) noexcept {
   return base_id % 16 == 0 && node >= 0 && node <= kMaxNodeId &&
@@ -83,55 +80,54 @@ std::int16_t theta_raw(double theta) noexcept {
 
 void encode_pose_x(std::uint32_t id, const PoseMsg& p, CanFrame& f) noexcept {
   start(id, f);
-  put_le(f, 0, 4, static_cast<std::uint64_t>(quantise(p.x, kPosScale, kI32Min, kI32Max, 0)));
-  f.data[7] = p.seq;
+  put_value(f, sig::x, p.x);
+  put_raw(f, sig::seq, p.seq);
 }
 
 void encode_pose_y_theta(std::uint32_t id, const PoseMsg& p, CanFrame& f) noexcept {
   start(id, f);
-  put_le(f, 0, 4, static_cast<std::uint64_t>(quantise(p.y, kPosScale, kI32Min, kI32Max, 0)));
-  put_le(f, 4, 2, static_cast<std::uint16_t>(theta_raw(p.theta)));
-  f.data[7] = p.seq;
+  put_value(f, sig::y, p.y);
+  put_raw(f, sig::theta, theta_raw(p.theta));
+  put_raw(f, sig::seq, p.seq);
 }
 
 void encode_velocity(std::uint32_t id, const VelocityMsg& v, CanFrame& f) noexcept {
   start(id, f);
-  put_le(f, 0, 2, static_cast<std::uint64_t>(quantise(v.v, kVelScale, -32768, 32767, 0)));
-  put_le(f, 2, 2, static_cast<std::uint64_t>(quantise(v.w, kOmegaScale, -32768, 32767, 0)));
-  f.data[7] = v.seq;
+  put_value(f, sig::v, v.v);
+  put_value(f, sig::w, v.w);
+  put_raw(f, sig::seq, v.seq);
 }
 
 void encode_uncertainty(std::uint32_t id, const UncertaintyMsg& u, CanFrame& f) noexcept {
   start(id, f);
-  auto sigma = [](double s, double scale) {
-    if (!std::isfinite(s)) return std::int64_t{65535};
-    return quantise(s, scale, 0, 65535, 65535);
+  // Unknown (NaN) or infinite standard deviations are sent as the maximum.
+  auto sigma = [&f](const Signal& s, double value) {
+    put_value(f, s, std::isfinite(value) ? value : HUGE_VAL, s.raw_max);
   };
-  put_le(f, 0, 2, static_cast<std::uint64_t>(sigma(u.sigma_x, kSigmaPosScale)));
-  put_le(f, 2, 2, static_cast<std::uint64_t>(sigma(u.sigma_y, kSigmaPosScale)));
-  put_le(f, 4, 2, static_cast<std::uint64_t>(sigma(u.sigma_theta, kSigmaThetaScale)));
-  f.data[6] = static_cast<std::uint8_t>(quantise(u.rho_xy, kRhoScale, -100, 100, 0));
-  f.data[7] = u.seq;
+  sigma(sig::sigma_x, u.sigma_x);
+  sigma(sig::sigma_y, u.sigma_y);
+  sigma(sig::sigma_theta, u.sigma_theta);
+  put_value(f, sig::rho_xy, u.rho_xy);
+  put_raw(f, sig::seq, u.seq);
 }
 
 void encode_status(std::uint32_t id, const StatusMsg& s, CanFrame& f) noexcept {
   start(id, f);
-  f.data[0] = s.encoder_flags;
-  f.data[1] = static_cast<std::uint8_t>((s.calibration_state & 0x3u) | (s.stopping ? 0x4u : 0u));
-  f.data[2] = s.set_pose_ack;
-  put_le(f, 3, 2, s.missed_deadlines > 65535u ? 65535u : s.missed_deadlines);
-  put_le(f, 5, 3, static_cast<std::uint64_t>(quantise(std::floor(s.uptime), 1.0, 0, 0xFFFFFF, 0)));
+  put_raw(f, sig::encoder_flags, s.encoder_flags);
+  put_raw(f, sig::calibration_state, s.calibration_state & 0x3u);
+  put_raw(f, sig::stopping, s.stopping ? 1 : 0);
+  put_raw(f, sig::set_pose_ack, s.set_pose_ack);
+  put_count(f, sig::missed_deadlines, s.missed_deadlines);
+  put_value(f, sig::uptime, std::floor(s.uptime));
 }
 
 void encode_timing(std::uint32_t id, const TimingMsg& t, CanFrame& f) noexcept {
   start(id, f);
-  auto us = [](double s) {
-    return static_cast<std::uint64_t>(quantise(s, kLatencyScale, 0, 65535, 65535));
-  };
-  put_le(f, 0, 2, us(t.wakeup_p99));
-  put_le(f, 2, 2, us(t.wakeup_max));
-  put_le(f, 4, 2, us(t.compute_max));
-  put_le(f, 6, 2, t.tx_dropped > 65535u ? 65535u : t.tx_dropped);
+  const std::int64_t over = sig::wakeup_p99.raw_max;  // NaN: sent as the maximum
+  put_value(f, sig::wakeup_p99, t.wakeup_p99, over);
+  put_value(f, sig::wakeup_max, t.wakeup_max, over);
+  put_value(f, sig::compute_max, t.compute_max, over);
+  put_count(f, sig::tx_dropped, t.tx_dropped);
 }
 
 void encode_set_pose(std::uint32_t id, const SetPoseCmd& c, CanFrame& f) noexcept {
@@ -140,61 +136,61 @@ void encode_set_pose(std::uint32_t id, const SetPoseCmd& c, CanFrame& f) noexcep
     f.len = 0;
     return;
   }
-  put_le(f, 0, 3, static_cast<std::uint64_t>(quantise(c.x, kSetPosScale, kI24Min, kI24Max, 0)));
-  put_le(f, 3, 3, static_cast<std::uint64_t>(quantise(c.y, kSetPosScale, kI24Min, kI24Max, 0)));
-  put_le(f, 6, 2, static_cast<std::uint16_t>(theta_raw(c.theta)));
+  put_value(f, sig::set_x, c.x);
+  put_value(f, sig::set_y, c.y);
+  put_raw(f, sig::set_theta, theta_raw(c.theta));
 }
 
 bool decode_pose_x(const CanFrame& f, double& x, std::uint8_t& seq) noexcept {
   if (f.len != 8) return false;
-  x = static_cast<double>(get_le_signed(f, 0, 4)) * kPosScale;
-  seq = f.data[7];
+  x = get_value(f, sig::x);
+  seq = static_cast<std::uint8_t>(get_raw(f, sig::seq));
   return true;
 }
 
 bool decode_pose_y_theta(const CanFrame& f, double& y, double& theta, std::uint8_t& seq) noexcept {
   if (f.len != 8) return false;
-  y = static_cast<double>(get_le_signed(f, 0, 4)) * kPosScale;
-  theta = static_cast<double>(get_le_signed(f, 4, 2)) * kThetaScale;
-  seq = f.data[7];
+  y = get_value(f, sig::y);
+  theta = get_value(f, sig::theta);
+  seq = static_cast<std::uint8_t>(get_raw(f, sig::seq));
   return true;
 }
 
 bool decode_velocity(const CanFrame& f, VelocityMsg& v) noexcept {
   if (f.len != 8) return false;
-  v.v = static_cast<double>(get_le_signed(f, 0, 2)) * kVelScale;
-  v.w = static_cast<double>(get_le_signed(f, 2, 2)) * kOmegaScale;
-  v.seq = f.data[7];
+  v.v = get_value(f, sig::v);
+  v.w = get_value(f, sig::w);
+  v.seq = static_cast<std::uint8_t>(get_raw(f, sig::seq));
   return true;
 }
 
 bool decode_uncertainty(const CanFrame& f, UncertaintyMsg& u) noexcept {
   if (f.len != 8) return false;
-  u.sigma_x = static_cast<double>(get_le(f, 0, 2)) * kSigmaPosScale;
-  u.sigma_y = static_cast<double>(get_le(f, 2, 2)) * kSigmaPosScale;
-  u.sigma_theta = static_cast<double>(get_le(f, 4, 2)) * kSigmaThetaScale;
-  u.rho_xy = static_cast<double>(get_le_signed(f, 6, 1)) * kRhoScale;
-  u.seq = f.data[7];
+  u.sigma_x = get_value(f, sig::sigma_x);
+  u.sigma_y = get_value(f, sig::sigma_y);
+  u.sigma_theta = get_value(f, sig::sigma_theta);
+  u.rho_xy = get_value(f, sig::rho_xy);
+  u.seq = static_cast<std::uint8_t>(get_raw(f, sig::seq));
   return true;
 }
 
 bool decode_status(const CanFrame& f, StatusMsg& s) noexcept {
   if (f.len != 8) return false;
-  s.encoder_flags = f.data[0];
-  s.calibration_state = f.data[1] & 0x3u;
-  s.stopping = (f.data[1] & 0x4u) != 0;
-  s.set_pose_ack = f.data[2];
-  s.missed_deadlines = static_cast<std::uint32_t>(get_le(f, 3, 2));
-  s.uptime = static_cast<double>(get_le(f, 5, 3));
+  s.encoder_flags = static_cast<std::uint8_t>(get_raw(f, sig::encoder_flags));
+  s.calibration_state = static_cast<std::uint8_t>(get_raw(f, sig::calibration_state));
+  s.stopping = get_raw(f, sig::stopping) != 0;
+  s.set_pose_ack = static_cast<std::uint8_t>(get_raw(f, sig::set_pose_ack));
+  s.missed_deadlines = static_cast<std::uint32_t>(get_raw(f, sig::missed_deadlines));
+  s.uptime = get_value(f, sig::uptime);
   return true;
 }
 
 bool decode_timing(const CanFrame& f, TimingMsg& t) noexcept {
   if (f.len != 8) return false;
-  t.wakeup_p99 = static_cast<double>(get_le(f, 0, 2)) * kLatencyScale;
-  t.wakeup_max = static_cast<double>(get_le(f, 2, 2)) * kLatencyScale;
-  t.compute_max = static_cast<double>(get_le(f, 4, 2)) * kLatencyScale;
-  t.tx_dropped = static_cast<std::uint32_t>(get_le(f, 6, 2));
+  t.wakeup_p99 = get_value(f, sig::wakeup_p99);
+  t.wakeup_max = get_value(f, sig::wakeup_max);
+  t.compute_max = get_value(f, sig::compute_max);
+  t.tx_dropped = static_cast<std::uint32_t>(get_raw(f, sig::tx_dropped));
   return true;
 }
 
@@ -204,12 +200,12 @@ bool decode_set_pose(const CanFrame& f, SetPoseCmd& c) noexcept {
     return true;
   }
   if (f.len != 8) return false;
-  const std::int64_t th = get_le_signed(f, 6, 2);
-  if (th < -kThetaRawMax || th > kThetaRawMax) return false;
+  const std::int64_t th = get_raw(f, sig::set_theta);
+  if (th < sig::set_theta.raw_min || th > sig::set_theta.raw_max) return false;
   c.reset = false;
-  c.x = static_cast<double>(get_le_signed(f, 0, 3)) * kSetPosScale;
-  c.y = static_cast<double>(get_le_signed(f, 3, 3)) * kSetPosScale;
-  c.theta = static_cast<double>(th) * kThetaScale;
+  c.x = get_value(f, sig::set_x);
+  c.y = get_value(f, sig::set_y);
+  c.theta = static_cast<double>(th) * sig::set_theta.scale;
   return true;
 }
 

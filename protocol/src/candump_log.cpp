@@ -1,5 +1,9 @@
 #include "odo/protocol/candump_log.hpp"
 
+#include <cstdio>
+
+#include "odo/protocol/signals.hpp"
+
 #include <cctype>
 #include <string>
 
@@ -92,82 +96,44 @@ Result<CandumpLine> parse_candump_line(std::string_view line) {
 
 bool decode_protocol_frame(std::uint32_t base_id, const CanFrame& f, DecodedFrame& out) noexcept {
   if (!split_id(base_id, f, out.node, out.msg)) return false;
-  std::size_t n = 0;
-  auto add = [&](const char* name, double v) { out.fields[n++] = DecodedField{name, v}; };
-  switch (out.msg) {
-    case Msg::kPoseX: {
-      double x = 0;
-      std::uint8_t seq = 0;
-      if (!decode_pose_x(f, x, seq)) return false;
-      out.message = "PoseX";
-      add("x", x);
-      add("seq", seq);
-      break;
+  const MessageSpec& m = message_spec(out.msg);
+  out.message = m.name;
+  out.n_fields = m.signals.size();
+  if (out.msg == Msg::kSetPose) {
+    SetPoseCmd c;
+    if (!decode_set_pose(f, c)) return false;  // DLC 0 or 8, theta within its range
+    if (c.reset) {
+      out.message = "SetPose(reset)";
+      for (std::size_t i = 0; i < out.n_fields; ++i) out.fields[i] = {m.signals[i]->name, 0.0};
+      return true;
     }
-    case Msg::kPoseYTheta: {
-      double y = 0, th = 0;
-      std::uint8_t seq = 0;
-      if (!decode_pose_y_theta(f, y, th, seq)) return false;
-      out.message = "PoseYTheta";
-      add("y", y);
-      add("theta", th);
-      add("seq", seq);
-      break;
-    }
-    case Msg::kVelocity: {
-      VelocityMsg v;
-      if (!decode_velocity(f, v)) return false;
-      out.message = "Velocity";
-      add("v", v.v);
-      add("w", v.w);
-      add("seq", v.seq);
-      break;
-    }
-    case Msg::kUncertainty: {
-      UncertaintyMsg u;
-      if (!decode_uncertainty(f, u)) return false;
-      out.message = "Uncertainty";
-      add("sigma_x", u.sigma_x);
-      add("sigma_y", u.sigma_y);
-      add("sigma_theta", u.sigma_theta);
-      add("rho_xy", u.rho_xy);
-      add("seq", u.seq);
-      break;
-    }
-    case Msg::kStatus: {
-      StatusMsg s;
-      if (!decode_status(f, s)) return false;
-      out.message = "Status";
-      add("encoder_flags", s.encoder_flags);
-      add("calibration_state", s.calibration_state);
-      add("stopping", s.stopping ? 1 : 0);
-      add("set_pose_ack", s.set_pose_ack);
-      add("missed_deadlines", s.missed_deadlines);
-      add("uptime", s.uptime);
-      break;
-    }
-    case Msg::kTiming: {
-      TimingMsg t;
-      if (!decode_timing(f, t)) return false;
-      out.message = "Timing";
-      add("wakeup_p99", t.wakeup_p99);
-      add("wakeup_max", t.wakeup_max);
-      add("compute_max", t.compute_max);
-      add("tx_dropped", t.tx_dropped);
-      break;
-    }
-    case Msg::kSetPose: {
-      SetPoseCmd c;
-      if (!decode_set_pose(f, c)) return false;
-      out.message = c.reset ? "SetPose(reset)" : "SetPose";
-      add("set_x", c.x);
-      add("set_y", c.y);
-      add("set_theta", c.theta);
-      break;
-    }
+  } else if (f.len != 8) {
+    return false;
   }
-  out.n_fields = n;
+  for (std::size_t i = 0; i < out.n_fields; ++i)
+    out.fields[i] = {m.signals[i]->name, get_value(f, *m.signals[i])};
   return true;
+}
+
+std::size_t format_candump_line(char* buf, std::size_t size, std::int64_t wall_ns,
+                                const char* iface, const CanFrame& f) noexcept {
+  const long long sec = wall_ns / 1'000'000'000;
+  const long long usec = (wall_ns % 1'000'000'000) / 1000;
+  int n = f.extended ? std::snprintf(buf, size, "(%lld.%06lld) %s %08X#", sec, usec, iface,
+                                     static_cast<unsigned>(f.id & 0x1FFFFFFFu))
+                     : std::snprintf(buf, size, "(%lld.%06lld) %s %03X#", sec, usec, iface,
+                                     static_cast<unsigned>(f.id & 0x7FFu));
+  if (n < 0 || static_cast<std::size_t>(n) >= size) return 0;
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  const std::size_t len = f.len > 8 ? 8 : f.len;
+  if (static_cast<std::size_t>(n) + 2 * len + 2 > size) return 0;
+  for (std::size_t i = 0; i < len; ++i) {
+    buf[n++] = kHex[f.data[i] >> 4];
+    buf[n++] = kHex[f.data[i] & 0xF];
+  }
+  buf[n++] = '\n';
+  buf[n] = '\0';
+  return static_cast<std::size_t>(n);
 }
 
 }  // namespace odo::protocol

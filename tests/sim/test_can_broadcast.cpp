@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "odo/firmware/can_broadcast.hpp"
-#include "odo/protocol/can_protocol.hpp"
 #include "odo/firmware/config.hpp"
-#include "odo/loop/loop.hpp"
 #include "odo/firmware/rig.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/protocol/can_protocol.hpp"
 #include "odo/sim/sim_can_bus.hpp"
 
 namespace odo::test {
@@ -32,7 +32,8 @@ struct Bench {
         loop(loop::OdometryLoop::create(loop::LoopConfig{100.0}, kin, rig.encoder(), rig.clock())
                  .value()),
         port(tx_cap, 16),
-        bc(opts(), port, loop.get(), drain ? &port : nullptr, &ring) {
+        bc(opts(), port, &loop->commands(), &ring) {
+    if (drain) port.connect_wire();
     loop->add_observer(&bc);
     loop->start();
   }
@@ -111,7 +112,8 @@ TEST(CanBroadcast, RatesFollowTheTickNumberWhenItRepeatsJumpsOrGoesBack) {
   fw::CanFrameRing ring{1 << 10};
   fw::CanBroadcastOptions o;
   o.div = fw::CanDivisors{3, 4, 10, 0, 7};  // status off
-  fw::CanBroadcaster bc(o, port, nullptr, &port, &ring);
+  port.connect_wire();
+  fw::CanBroadcaster bc(o, port, nullptr, &ring);
   std::vector<std::uint64_t> ticks;
   for (std::uint64_t t = 0; t <= 50; ++t) ticks.push_back(t);
   for (std::uint64_t t : {50, 50, 21, 22, 23, 24, 1000, 1001, 1004, 1008, 5, 6, 0, 0, 70, 69})
@@ -190,7 +192,7 @@ TEST(CanBroadcast, FullTransmitQueueDropsCountsAndNeverBlocks) {
 CanFrame set_pose_frame(int node, double x, double y, double th, bool reset = false) {
   CanFrame f;
   protocol::encode_set_pose(protocol::frame_id(0x400, node, Msg::kSetPose),
-                           protocol::SetPoseCmd{reset, x, y, th}, f);
+                            protocol::SetPoseCmd{reset, x, y, th}, f);
   return f;
 }
 
@@ -281,7 +283,8 @@ TEST(CanBroadcast, ReceiveFloodIsReadAtMostMaxRxPerTickAndSetPoseStillApplies) {
   fw::CanBroadcastOptions o = Bench::opts();
   const std::size_t cap = o.max_rx_per_tick;
   ASSERT_GT(cap, 0u);
-  fw::CanBroadcaster bc(o, bus, b.loop.get(), &port, nullptr);
+  port.connect_wire();
+  fw::CanBroadcaster bc(o, bus, &b.loop->commands(), nullptr);
   b.loop->add_observer(&bc);
   constexpr int kTicks = 500, kBurst = 100;
   constexpr double kStep = 1e-3;  // x of command k: k mm, exact at the protocol's resolution

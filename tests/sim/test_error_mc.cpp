@@ -87,7 +87,7 @@ class ErrorAt final : public loop::TickObserver {
  public:
   ErrorAt(const sim::SimRobot& robot, std::vector<std::uint64_t> ticks)
       : robot_(robot), ticks_(std::move(ticks)) {}
-  void on_tick(loop::LoopSnapshot& s) noexcept override {
+  void on_tick(const loop::LoopSnapshot& s) noexcept override {
     if (next_ < ticks_.size() && s.tick == ticks_[next_]) {
       errors[next_] = {robot_.true_pose().x - s.pose.x, robot_.true_pose().y - s.pose.y,
                        robot_.true_pose().theta - s.pose.theta};

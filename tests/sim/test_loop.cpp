@@ -34,7 +34,7 @@ TEST(Loop, SixteenBitCountersWrapWithoutLoss) {
 // by metres per count, which is an integer count up to rounding).
 struct TickRecorder final : loop::TickObserver {
   explicit TickRecorder(const loop::OdometryLoop*& l) : loop(l) { stamps.reserve(4096); }
-  void on_tick(loop::LoopSnapshot& s) noexcept override {
+  void on_tick(const loop::LoopSnapshot& s) noexcept override {
     const Odometry& o = loop->odometry();
     stamps.push_back(s.stamp);
     counts_left += std::llround(o.last_d_left() / o.kinematics().metres_per_count_left());
@@ -56,7 +56,7 @@ TEST(Loop, OverrunsSkipPeriodsAndLoseNoCount) {
   SimRun slow(g, k, wiggle(), 16, 32767 - 50);
   SimRun fast(g, k, wiggle());
   slow.encoder.set_read_delay(&slow.clock, 25'000'000);
-  const loop::OdometryLoop* slow_loop = slow.loop.get();
+  const loop::OdometryLoop* slow_loop = slow.loop;
   TickRecorder rec(slow_loop);
   slow.loop->add_observer(&rec);
   slow.drive();
@@ -116,7 +116,7 @@ TEST(Loop, SetPoseTakesEffectAtNextTick) {
   SimRun run(g, k, {{1.0, 0.0, 0.0}});
   run.loop->start();
   run.loop->tick();
-  run.loop->request_pose({1.5, -2.0, 0.25});
+  run.loop->post(loop::SetPose{{1.5, -2.0, 0.25}});
   EXPECT_DOUBLE_EQ(run.loop->odometry().pose().x, 0.0);  // not before the next tick
   run.loop->tick();
   EXPECT_DOUBLE_EQ(run.loop->odometry().pose().x, 1.5);

@@ -41,7 +41,7 @@ TEST(LoopCovariance, SetPoseResetsCovarianceToZero) {
   run.loop->run(from_seconds(2.0), stop);
   const double before = run.loop->snapshot().cov[8];
   EXPECT_GT(before, 0.0);
-  run.loop->request_pose({1.0, 2.0, 0.5});
+  run.loop->post(loop::SetPose{{1.0, 2.0, 0.5}});
   run.loop->tick();
   // One tick of motion after the reset: the covariance is that of the tick alone.
   const loop::LoopSnapshot& s = run.loop->snapshot();

@@ -263,7 +263,7 @@ TEST(Soak, ODO_SOAK_NAME) {
       }
       ASSERT_LE(perr, budget) << "tick " << s.tick << " at " << to_seconds(s.stamp) << " s";
       if (perr > 0.0) {
-        loop->request_pose({t.x, t.y, s.pose.theta});
+        loop->post(loop::SetPose{{t.x, t.y, s.pose.theta}});
         ++anchors;
       }
       budget = 0.0;

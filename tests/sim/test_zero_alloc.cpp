@@ -9,11 +9,12 @@
 #include <new>
 
 #include "odo/firmware/can_broadcast.hpp"
-#include "odo/protocol/can_protocol.hpp"
 #include "odo/firmware/config.hpp"
-#include "odo/loop/loop.hpp"
 #include "odo/firmware/rig.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/protocol/can_protocol.hpp"
 #include "odo/sim/sim_can_bus.hpp"
+#include "odo/sim/truth.hpp"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define ODO_COUNT_MALLOC 0
@@ -263,7 +264,7 @@ TEST(ZeroAlloc, CountersSeeEveryKindOfAllocation) {
 
 // An observer that breaks the rule: allocates on every tick.
 struct AllocatingObserver final : loop::TickObserver {
-  void on_tick(loop::LoopSnapshot& s) noexcept override {
+  void on_tick(const loop::LoopSnapshot& s) noexcept override {
     auto* p = new std::uint64_t(s.tick);
     escape(p);
     delete p;
@@ -301,8 +302,8 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   loop::LoopConfig lc;
   lc.rate_hz = cfg.loop.rate_hz;
   auto loop = loop::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
-  ASSERT_NE(rig->truth_observer(), nullptr);
-  loop->add_observer(rig->truth_observer());
+  ASSERT_NE(rig->truth(), nullptr);
+  loop->add_observer(rig->truth());
   // The CAN broadcast at the default rates on the simulated bus, with the candump log (its
   // writer thread formats and writes frames while the window is open) and set-pose commands.
   const std::string can_log = ::testing::TempDir() + "zero_alloc_can.log";
@@ -321,6 +322,8 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
       loop->tick();
       // The status thread's side of the hand-over too, now and then.
       if ((i & 1023) == 0 && loop->snapshots().latest(reader)) ++published;
+      if (i == 100'000)  // new calibration from the reloader thread: the other producer
+        ASSERT_TRUE(loop->post(loop::SetKinematics{*kin, calib::StoreStatus::kOk}));
       if (i == 150'000) {  // a set-pose command (reset to zero) arrives on the bus
         CanFrame cmd;
         protocol::encode_set_pose(
@@ -341,6 +344,8 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   EXPECT_EQ((*can)->counters().sent, 171u * (kTicks / 1000) + 6u);
   EXPECT_EQ((*can)->counters().dropped(), 0u);
   EXPECT_EQ((*can)->counters().set_pose_applied, 1u);
+  EXPECT_EQ(loop->commands_applied(), 2u);  // the calibration and the set-pose command
+  EXPECT_EQ(loop->snapshot().calibration_state, calib::StoreStatus::kOk);
   // The writer runs on wall time and the loop here is faster than real time: what the ring
   // could not hold is counted, never waited for.
   EXPECT_EQ((*can)->log_written() + (*can)->log_dropped(), (*can)->counters().sent);
@@ -349,7 +354,8 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   ASSERT_LT(rig->scenario_duration(), 199.0);
   EXPECT_NEAR(loop->odometry().distance(), 32.0, 0.2);  // two 4 m squares: 32 m of legs
   EXPECT_EQ(loop->wakeup_histogram().count(), kTicks);
-  EXPECT_EQ(loop->stats().wakeup_latency.count, kTicks - kTicks % loop::OdometryLoop::kSummaryTicks);
+  EXPECT_EQ(loop->stats().wakeup_latency.count,
+            kTicks - kTicks % loop::OdometryLoop::kSummaryTicks);
 }
 
 TEST(ZeroAlloc, CanReceiveFloodWithoutAllocating) {

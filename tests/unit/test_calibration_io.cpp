@@ -4,11 +4,13 @@
 #include <atomic>
 #include <nlohmann/json.hpp>
 
-#include "odo/calibration/store.hpp"
-#include "odo/firmware/calibration_store.hpp"
 #include "odo/analysis/calibration_json.hpp"
+#include "odo/calibration/store.hpp"
 #include "odo/firmware/calibration_reload.hpp"
+#include "odo/firmware/calibration_store.hpp"
 #include "odo/firmware/config.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/sim/sim_run.hpp"
 
 namespace odo::fw {
 namespace {
@@ -81,7 +83,8 @@ TEST(CalibrationIo, BadInputNamesTheField) {
   EXPECT_NE(r.error().message.find("wheelbase"), std::string::npos);
   EXPECT_FALSE(analysis::parse_calibration_json("{not json", "x.json", 0));
   EXPECT_FALSE(analysis::parse_calibration_json("[1,2]", "x.json", 0));
-  r = analysis::parse_calibration_json(R"({"status":"corrupt","c_l":null,"c_r":null})", "s.json", 0);
+  r = analysis::parse_calibration_json(R"({"status":"corrupt","c_l":null,"c_r":null})", "s.json",
+                                       0);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("corrupt"), std::string::npos);
 }
@@ -120,7 +123,7 @@ TEST(CalibrationIo, ApplyUsesStoredValuesOnlyWhenOk) {
   r.wheelbase = 0.337;
   l.record = r;
   AppliedCalibration a = apply_calibration(nominal(), Result<LoadResult>(l), "test");
-  EXPECT_EQ(a.state, 1);
+  EXPECT_EQ(a.state, calib::StoreStatus::kOk);
   EXPECT_EQ(a.sequence, 2U);
   EXPECT_DOUBLE_EQ(a.params.c_l, 0.999);
   EXPECT_DOUBLE_EQ(a.params.wheelbase, 0.337);
@@ -130,40 +133,43 @@ TEST(CalibrationIo, ApplyUsesStoredValuesOnlyWhenOk) {
   l.status = StoreStatus::kCorrupt;
   l.record.reset();
   a = apply_calibration(nominal(), Result<LoadResult>(l), "test");
-  EXPECT_EQ(a.state, 2);
+  EXPECT_EQ(a.state, calib::StoreStatus::kCorrupt);
   EXPECT_DOUBLE_EQ(a.params.c_l, 1.0);
   EXPECT_NE(a.report.find("ERROR"), std::string::npos);
   EXPECT_NE(a.report.find("NOMINAL"), std::string::npos);
 
   a = apply_calibration(nominal(), Result<LoadResult>(make_error(Errc::kIo, "EACCES")), "test");
-  EXPECT_EQ(a.state, 2);
+  EXPECT_EQ(a.state, calib::StoreStatus::kCorrupt);
 
   l.status = StoreStatus::kUncalibrated;
   a = apply_calibration(nominal(), Result<LoadResult>(l), "test");
-  EXPECT_EQ(a.state, 0);
+  EXPECT_EQ(a.state, calib::StoreStatus::kUncalibrated);
   EXPECT_NE(a.report.find("nominal values"), std::string::npos);
 }
 
 TEST(CalibrationHandover, AppliedOnTheLoopThreadBetweenTicks) {
-  // Without a loop attached the observer only stamps the state; an offer is taken on the next
-  // tick and the state changes with it.
-  CalibrationHandover h(0);
-  loop::LoopSnapshot snap;
-  h.on_tick(snap);
-  EXPECT_EQ(snap.calibration_state, 0);
-  std::atomic<bool> stop{false};
+  // The loop stamps the store's status of its kinematics on every snapshot; kinematics posted
+  // as a command are taken at the top of the next tick and the state changes with them.
   auto k = Kinematics::create(nominal());
   ASSERT_TRUE(k);
-  ASSERT_TRUE(h.offer(*k, 1, stop));
-  EXPECT_EQ(h.applied(), 0U);
-  h.on_tick(snap);
-  EXPECT_EQ(snap.calibration_state, 1);
-  EXPECT_EQ(h.applied(), 1U);
-  ASSERT_TRUE(h.offer(*k, 2, stop));
-  stop = true;
-  EXPECT_FALSE(h.offer(*k, 1, stop));  // previous offer not yet taken, and stopping
-  h.on_tick(snap);
-  EXPECT_EQ(snap.calibration_state, 2);
+  auto run = sim::SimRun::create(sim::labmate_geometry(), *k, {{10.0, 1.0, 1.0}});
+  ASSERT_TRUE(run);
+  loop::OdometryLoop& l = (*run)->loop();
+  l.start();
+  l.tick();
+  EXPECT_EQ(l.snapshot().calibration_state, StoreStatus::kUncalibrated);
+  ASSERT_TRUE(l.post(loop::SetKinematics{*k, StoreStatus::kOk}));
+  EXPECT_EQ(l.commands_applied(), 0U);
+  l.tick();
+  EXPECT_EQ(l.snapshot().calibration_state, StoreStatus::kOk);
+  EXPECT_EQ(l.commands_applied(), 1U);
+  ASSERT_TRUE(l.post(loop::SetKinematics{*k, StoreStatus::kCorrupt}));
+  for (std::size_t i = 1; i < loop::CommandQueue::kCapacity; ++i)
+    ASSERT_TRUE(l.post(loop::SetPose{l.snapshot().pose}));
+  EXPECT_FALSE(l.post(loop::SetPose{}));  // queue full: the loop has not ticked
+  l.tick();
+  EXPECT_EQ(l.snapshot().calibration_state, StoreStatus::kCorrupt);
+  EXPECT_EQ(l.commands_applied(), 1U + loop::CommandQueue::kCapacity);
 }
 
 }  // namespace
@@ -190,7 +196,7 @@ TEST(CalibrationConfig, NoStoreConfiguredMeansNominal) {
   p.counts_per_rev = 2048;
   p.wheelbase_nominal = p.wheelbase = 0.34;
   AppliedCalibration a = read_and_apply(p, "", "auto");
-  EXPECT_EQ(a.state, 0);
+  EXPECT_EQ(a.state, calib::StoreStatus::kUncalibrated);
   EXPECT_NE(a.report.find("no store configured"), std::string::npos);
 }
 

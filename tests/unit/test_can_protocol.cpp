@@ -4,12 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "odo/protocol/can_protocol.hpp"
 #include "odo/protocol/candump_log.hpp"
+#include "odo/protocol/signals.hpp"
 
 namespace odo::protocol {
 namespace {
@@ -273,6 +276,32 @@ TEST(CandumpLog, TimeStampsBeyondTheNanosecondClockAreRefused) {
     EXPECT_NE(bad.error().message.find("beyond the range"), std::string::npos)
         << bad.error().message;
   }
+}
+
+// The DBC file is the signal table written out: its BO_ and SG_ lines are exactly those derived
+// from protocol/signals.hpp (ids for node 1 at base 0x400), factors and limits as plain decimals.
+TEST(CanProtocolDbc, FileMatchesTheSignalTable) {
+  std::ifstream in(std::string(ODO_SOURCE_DIR) + "/protocol/odometry.dbc");
+  ASSERT_TRUE(in) << "protocol/odometry.dbc not found";
+  std::vector<std::string> got;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("BO_ ", 0) == 0 || line.rfind(" SG_ ", 0) == 0) got.push_back(line);
+  }
+  std::vector<std::string> want;
+  for (const MessageSpec& m : kMessages) {
+    want.push_back(dbc_message_line(m));
+    for (const Signal* s : m.signals) want.push_back(dbc_signal_line(m, *s));
+  }
+  EXPECT_EQ(got, want);
+  for (const std::string& l : got) EXPECT_EQ(l.find("e-"), std::string::npos) << l;
+}
+
+TEST(CanProtocolDbc, DecimalsArePlain) {
+  EXPECT_EQ(dbc_decimal(1e-5), "0.00001");
+  EXPECT_EQ(dbc_decimal(1e-6), "0.000001");
+  EXPECT_EQ(dbc_decimal(1.0), "1");
+  EXPECT_EQ(dbc_decimal(-2147483648 * 1e-4), "-214748.3648");
+  EXPECT_EQ(dbc_decimal(65535 * 1e-5), "0.65535");
 }
 
 }  // namespace

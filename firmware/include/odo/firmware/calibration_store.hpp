@@ -15,7 +15,6 @@
 
 namespace odo::fw {
 
-
 // Where the store lives on a target (the Debian package creates /var/lib/odometryd).
 inline constexpr const char* kDefaultCalibrationStore = "/var/lib/odometryd/calibration.bin";
 
@@ -32,10 +31,11 @@ Result<OpenStore> open_calibration_store(const std::string& path, std::string_vi
 
 // AppliedCalibration: what odometryd runs on after reading the store.
 struct AppliedCalibration {
-  KinematicParams params;      // nominal values with the stored corrections applied
-  std::uint8_t state = 0;      // loop::LoopSnapshot::calibration_state: 0 nominal, 1 ok, 2 corrupt
-  std::uint64_t sequence = 0;  // of the record in use (0: none)
-  std::string report;          // one line for the log
+  KinematicParams params;  // nominal values with the stored corrections applied
+  calib::StoreStatus state = calib::StoreStatus::kUncalibrated;  // of the store; kCorrupt also
+                                                                 // when it cannot be read
+  std::uint64_t sequence = 0;                                    // of the record in use (0: none)
+  std::string report;                                            // one line for the log
 };
 
 // apply_calibration: overrides c_l, c_r and, when stored, the effective wheelbase and the wheel

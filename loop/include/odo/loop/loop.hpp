@@ -1,5 +1,6 @@
-// OdometryLoop: the fixed-rate loop. One tick: sleep to an absolute deadline, read the encoders,
-// take wrap-aware deltas, integrate the pose, update timing statistics, notify observers.
+// OdometryLoop: the fixed-rate loop. One tick: sleep to an absolute deadline, apply the commands
+// posted since the last tick, read the encoders, take wrap-aware deltas, integrate the pose and
+// its covariance, update timing statistics, hand the snapshot to the (read-only) observers.
 // The same code runs against real drivers and against sim_hal; only the wiring differs.
 #pragma once
 
@@ -8,11 +9,13 @@
 #include <cstdint>
 #include <memory>
 
-#include "odo/loop/latency_histogram.hpp"
-#include "odo/loop/triple_buffer.hpp"
+#include "odo/calibration/store.hpp"
 #include "odo/hal/clock.hpp"
 #include "odo/hal/encoder.hpp"
 #include "odo/hal/result.hpp"
+#include "odo/loop/command.hpp"
+#include "odo/loop/latency_histogram.hpp"
+#include "odo/loop/triple_buffer.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
 #include "odo/odometry/pose.hpp"
@@ -45,27 +48,28 @@ struct LoopSnapshot {
   std::uint32_t encoder_flags = 0;  // EncoderFlag bits of the last sample
   EncoderCounters encoder_counters;
   LoopStats stats;
-  bool has_truth = false;  // a simulated or external absolute reference was available
-  Pose2 truth;             // ground truth pose at the sample time (simulation only)
   // Pose covariance of (x, y, theta), row-major [m^2, m rad, rad^2]; valid when has_cov.
   std::array<double, 9> cov{};
   bool has_cov = false;
-  std::uint8_t calibration_state = 0;  // 0 uncalibrated (nominal values), 1 calibrated, 2 corrupt
+  // The calibration store's status of the kinematics in use (kUncalibrated: nominal values).
+  calib::StoreStatus calibration_state = calib::StoreStatus::kUncalibrated;
 };
 
-// TickObserver: called on the loop thread after every tick; must not block or allocate. The
-// snapshot it gets is built in place in the triple buffer, in a slot that still holds an older
-// tick's values: an observer that sets a field sets it on every tick. Its stats are those up to
-// this tick's wake-up (compute time and missed deadlines: up to the previous tick).
+// TickObserver: called on the loop thread after every tick with that tick's snapshot; reads it,
+// must not block or allocate. An observer that wants to change the loop posts a Command. Its
+// stats are those up to this tick's wake-up (compute time and missed deadlines: up to the
+// previous tick).
 class TickObserver {
  public:
   virtual ~TickObserver() = default;
-  virtual void on_tick(LoopSnapshot& snap) noexcept = 0;
+  virtual void on_tick(const LoopSnapshot& snap) noexcept = 0;
 };
 
 struct LoopConfig {
   double rate_hz = 100.0;        // [Hz], 50..2000
   ErrorModelParams error_model;  // Chong-Kleeman k_L, k_R for the pose covariance
+  // The store's status of the kinematics the loop starts with (snapshot calibration_state).
+  calib::StoreStatus calibration = calib::StoreStatus::kUncalibrated;
 };
 
 class OdometryLoop {
@@ -88,11 +92,15 @@ class OdometryLoop {
   // limit). Calls start() first.
   void run(TimeNs duration, const std::atomic<bool>& stop) noexcept;
 
-  // request_pose: thread-safe; the pose is replaced at the start of the next tick and its
-  // covariance reset to zero (a set pose is taken as exact).
-  void request_pose(const Pose2& p) noexcept;
-  // set_kinematics: swap calibration between ticks (same thread as tick()).
-  void set_kinematics(const Kinematics& k) noexcept { odom_.set_kinematics(k); }
+  // post: any thread (observers included); the command is applied at the top of the next tick.
+  // False when the queue is full (CommandQueue::kCapacity commands not yet taken).
+  bool post(const Command& c) noexcept { return commands_.post(c); }
+  // commands: the inbound queue, for producers that are handed the queue rather than the loop.
+  CommandQueue& commands() noexcept { return commands_; }
+  // commands_applied: commands applied so far, readable from any thread.
+  std::uint64_t commands_applied() const noexcept {
+    return commands_applied_.load(std::memory_order_acquire);
+  }
 
   const Odometry& odometry() const noexcept { return odom_; }
   const LoopStats& stats() const noexcept { return stats_; }
@@ -113,7 +121,7 @@ class OdometryLoop {
 
   TimeNs period_;
   Odometry odom_;
-  PoseCovariance cov_;
+  calib::StoreStatus calibration_;
   EncoderSource* enc_;
   Clock* clock_;
   int bits_;
@@ -136,10 +144,11 @@ class OdometryLoop {
   // published (start-up and end of run only: it copies the whole snapshot).
   LoopSnapshot& copy_newest() noexcept;
 
-  // Set-pose hand-over from another thread: a sequence number guards the three doubles.
-  std::atomic<std::uint32_t> pose_req_seq_{0};
-  std::atomic<double> req_x_{0.0}, req_y_{0.0}, req_theta_{0.0};
-  std::uint32_t pose_req_seen_ = 0;
+  // apply_commands: everything posted since the last tick, oldest first (top of a tick).
+  void apply_commands() noexcept;
+
+  CommandQueue commands_;
+  std::atomic<std::uint64_t> commands_applied_{0};
 };
 
 }  // namespace odo::loop

@@ -85,7 +85,7 @@ struct SetPoseCmd {
   double theta = 0.0;  // [rad], (-pi, pi]
 };
 
-// Encoders: fill f (id, len 8, data) for node `node`.
+// Encoders: fill f (id, len 8, data) as the frame with id `id`.
 void encode_pose_x(std::uint32_t id, const PoseMsg& p, CanFrame& f) noexcept;
 void encode_pose_y_theta(std::uint32_t id, const PoseMsg& p, CanFrame& f) noexcept;
 void encode_velocity(std::uint32_t id, const VelocityMsg& v, CanFrame& f) noexcept;

@@ -7,9 +7,9 @@
 #include <string>
 #include <string_view>
 
-#include "odo/protocol/can_protocol.hpp"
 #include "odo/hal/can_bus.hpp"
 #include "odo/hal/result.hpp"
+#include "odo/protocol/can_protocol.hpp"
 
 namespace odo::protocol {
 
@@ -22,6 +22,10 @@ struct CandumpLine {
 
 // Largest accepted time stamp [s]: sec * 1e9 + 999999000 still fits a signed 64-bit TimeNs.
 inline constexpr std::int64_t kCandumpMaxSeconds = 9'223'372'035;
+
+// format_candump_line: "(sec.usec) iface ID#HEX\n" of candump -L into buf; returns the length.
+std::size_t format_candump_line(char* buf, std::size_t size, std::int64_t wall_ns,
+                                const char* iface, const CanFrame& f) noexcept;
 
 // parse_candump_line: one log line (no newline); the error says what is wrong (no file/line).
 // The time stamp's seconds are at most kCandumpMaxSeconds.
