@@ -8,8 +8,8 @@
 #include <sstream>
 
 #include "commands.hpp"
-#include "odo/firmware/calibration_store.hpp"
 #include "odo/analysis/calibration_json.hpp"
+#include "odo/firmware/calibration_store.hpp"
 
 namespace odo::ctl {
 namespace {
@@ -24,7 +24,7 @@ void add_store_options(CLI::App* c, StoreOpts& o, bool json) {
   c->add_option("--store", o.path, "store: a file, an nvmem file or /dev/mtdN")
       ->capture_default_str();
   c->add_option("--backend", o.backend, "auto | file | nvmem | mtd (auto: from the path)")
-      ->check(CLI::IsMember({"auto", "file", "nvmem", "mtd"}))
+      ->check(CLI::IsMember(fw::choice_names<fw::StoreBackend>()))
       ->capture_default_str();
   if (json) c->add_flag("--json", o.json, "print one JSON object");
 }
@@ -32,7 +32,10 @@ void add_store_options(CLI::App* c, StoreOpts& o, bool json) {
 // Opens the store and loads it; on failure prints why and sets exit_code.
 std::optional<fw::OpenStore> open_loaded(const char* cmd, const StoreOpts& o,
                                          calib::LoadResult& loaded, int& exit_code) {
-  auto s = fw::open_calibration_store(o.path, o.backend);
+  // --backend is one of the spellings (CLI::IsMember above).
+  const auto backend =
+      fw::parse_choice<fw::StoreBackend>(o.backend).value_or(fw::StoreBackend::kAuto);
+  auto s = fw::open_calibration_store(o.path, backend);
   if (!s) {
     std::cerr << "odomctl calib " << cmd << ": " << s.error().message << "\n";
     exit_code = kExitFailed;
@@ -74,6 +77,106 @@ void write_and_report(const char* cmd, const StoreOpts& o, fw::OpenStore& s,
   exit_code = kExitOk;
 }
 
+struct SetOpts {
+  StoreOpts store;
+  std::optional<double> cl, cr, wheelbase, wheel_diameter;
+};
+
+struct ImportOpts {
+  StoreOpts store;
+  std::string file;
+};
+
+// calib_show: `calib show`: the record and the store status (exit 1 when corrupt).
+void calib_show(const StoreOpts& o, int& exit_code) {
+  calib::LoadResult l;
+  if (!open_loaded("show", o, l, exit_code)) return;
+  std::cout << (o.json ? analysis::show_json(l) + "\n" : analysis::show_text(l));
+  exit_code = l.status == calib::StoreStatus::kCorrupt ? kExitFailed : kExitOk;
+}
+
+// calib_set: `calib set`: changes the given values, keeps the rest.
+void calib_set(const SetOpts& o, int& exit_code) {
+  if (!o.cl && !o.cr && !o.wheelbase && !o.wheel_diameter) {
+    std::cerr << "odomctl calib set: give at least one of --cl, --cr, --wheelbase, "
+                 "--wheel-diameter\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  calib::LoadResult l;
+  auto s = open_loaded("set", o.store, l, exit_code);
+  if (!s) return;
+  if (l.status == calib::StoreStatus::kCorrupt) {
+    std::cerr << "odomctl calib set: " << o.store.path << ": store corrupt (" << l.describe()
+              << "); there are no stored values to keep: use `odomctl calib import` or "
+                 "`odomctl calib reset`\n";
+    exit_code = kExitFailed;
+    return;
+  }
+  calib::CalibrationRecord r;
+  if (l.status == calib::StoreStatus::kOk) r = *l.record;
+  if (o.cl) r.c_l = *o.cl;
+  if (o.cr) r.c_r = *o.cr;
+  if (o.wheelbase) r.wheelbase = *o.wheelbase;
+  if (o.wheel_diameter) r.wheel_diameter = *o.wheel_diameter;
+  r.method = "set";
+  r.time = static_cast<std::int64_t>(std::time(nullptr));
+  if (auto v = calib::validate_record(r); !v) {
+    std::cerr << "odomctl calib set: " << v.error().message << "; store left unchanged\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  write_and_report("set", o.store, *s, r, exit_code);
+}
+
+// calib_import: `calib import`: a record from JSON (file or stdin).
+void calib_import(const ImportOpts& o, int& exit_code) {
+  std::string text;
+  if (o.file == "-") {
+    text.assign(std::istreambuf_iterator<char>(std::cin), {});
+  } else {
+    std::ifstream in(o.file, std::ios::binary);
+    if (!in) {
+      std::cerr << "odomctl calib import: " << o.file << ": cannot open\n";
+      exit_code = kExitBadInput;
+      return;
+    }
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  auto r = analysis::parse_calibration_json(text, o.file == "-" ? "<stdin>" : o.file,
+                                            std::time(nullptr));
+  if (!r) {
+    std::cerr << "odomctl calib import: " << r.error().message << "; store left unchanged\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  calib::LoadResult l;
+  auto s = open_loaded("import", o.store, l, exit_code);
+  if (!s) return;
+  write_and_report("import", o.store, *s, *r, exit_code);
+}
+
+// calib_export: `calib export`: the stored record in the exchange format.
+void calib_export(const StoreOpts& o, int& exit_code) {
+  calib::LoadResult l;
+  if (!open_loaded("export", o, l, exit_code)) return;
+  if (l.status != calib::StoreStatus::kOk) {
+    std::cerr << "odomctl calib export: " << o.path << ": " << l.describe()
+              << "; nothing to export\n";
+    exit_code = kExitFailed;
+    return;
+  }
+  std::cout << analysis::export_json(*l.record) << "\n";
+  exit_code = kExitOk;
+}
+
+// calib_reset: `calib reset`: marks the store uncalibrated.
+void calib_reset(const StoreOpts& o, int& exit_code) {
+  calib::LoadResult l;
+  auto s = open_loaded("reset", o, l, exit_code);
+  if (!s) return;
+  write_and_report("reset", o, *s, std::nullopt, exit_code);
+}
 }  // namespace
 
 void add_calib(CLI::App& app, int& exit_code) {
@@ -83,17 +186,8 @@ void add_calib(CLI::App& app, int& exit_code) {
   auto show = std::make_shared<StoreOpts>();
   CLI::App* c_show = calib->add_subcommand("show", "print the stored calibration and its status");
   add_store_options(c_show, *show, true);
-  c_show->callback([show, &exit_code] {
-    calib::LoadResult l;
-    if (!open_loaded("show", *show, l, exit_code)) return;
-    std::cout << (show->json ? analysis::show_json(l) + "\n" : analysis::show_text(l));
-    exit_code = l.status == calib::StoreStatus::kCorrupt ? kExitFailed : kExitOk;
-  });
+  c_show->callback([show, &exit_code] { calib_show(*show, exit_code); });
 
-  struct SetOpts {
-    StoreOpts store;
-    std::optional<double> cl, cr, wheelbase, wheel_diameter;
-  };
   auto set = std::make_shared<SetOpts>();
   CLI::App* c_set = calib->add_subcommand("set", "change stored values (the rest are kept)");
   add_store_options(c_set, set->store, true);
@@ -102,101 +196,26 @@ void add_calib(CLI::App& app, int& exit_code) {
   c_set->add_option("--wheelbase", set->wheelbase, "effective wheelbase b [m], [0.01, 20]");
   c_set->add_option("--wheel-diameter", set->wheel_diameter,
                     "corrected wheel diameter Dn* [m], [0.005, 5]");
-  c_set->callback([set, &exit_code] {
-    if (!set->cl && !set->cr && !set->wheelbase && !set->wheel_diameter) {
-      std::cerr << "odomctl calib set: give at least one of --cl, --cr, --wheelbase, "
-                   "--wheel-diameter\n";
-      exit_code = kExitBadInput;
-      return;
-    }
-    calib::LoadResult l;
-    auto s = open_loaded("set", set->store, l, exit_code);
-    if (!s) return;
-    if (l.status == calib::StoreStatus::kCorrupt) {
-      std::cerr << "odomctl calib set: " << set->store.path << ": store corrupt (" << l.describe()
-                << "); there are no stored values to keep: use `odomctl calib import` or "
-                   "`odomctl calib reset`\n";
-      exit_code = kExitFailed;
-      return;
-    }
-    calib::CalibrationRecord r;
-    if (l.status == calib::StoreStatus::kOk) r = *l.record;
-    if (set->cl) r.c_l = *set->cl;
-    if (set->cr) r.c_r = *set->cr;
-    if (set->wheelbase) r.wheelbase = *set->wheelbase;
-    if (set->wheel_diameter) r.wheel_diameter = *set->wheel_diameter;
-    r.method = "set";
-    r.time = static_cast<std::int64_t>(std::time(nullptr));
-    if (auto v = calib::validate_record(r); !v) {
-      std::cerr << "odomctl calib set: " << v.error().message << "; store left unchanged\n";
-      exit_code = kExitBadInput;
-      return;
-    }
-    write_and_report("set", set->store, *s, r, exit_code);
-  });
+  c_set->callback([set, &exit_code] { calib_set(*set, exit_code); });
 
-  struct ImportOpts {
-    StoreOpts store;
-    std::string file;
-  };
   auto imp = std::make_shared<ImportOpts>();
   CLI::App* c_imp = calib->add_subcommand(
       "import", "store a calibration from JSON (`umbmark compute --json`, `calib export`)");
   add_store_options(c_imp, imp->store, true);
   c_imp->add_option("file", imp->file, "JSON file, - for stdin")->required();
-  c_imp->callback([imp, &exit_code] {
-    std::string text;
-    if (imp->file == "-") {
-      text.assign(std::istreambuf_iterator<char>(std::cin), {});
-    } else {
-      std::ifstream in(imp->file, std::ios::binary);
-      if (!in) {
-        std::cerr << "odomctl calib import: " << imp->file << ": cannot open\n";
-        exit_code = kExitBadInput;
-        return;
-      }
-      text.assign(std::istreambuf_iterator<char>(in), {});
-    }
-    auto r = analysis::parse_calibration_json(text, imp->file == "-" ? "<stdin>" : imp->file,
-                                        std::time(nullptr));
-    if (!r) {
-      std::cerr << "odomctl calib import: " << r.error().message << "; store left unchanged\n";
-      exit_code = kExitBadInput;
-      return;
-    }
-    calib::LoadResult l;
-    auto s = open_loaded("import", imp->store, l, exit_code);
-    if (!s) return;
-    write_and_report("import", imp->store, *s, *r, exit_code);
-  });
+  c_imp->callback([imp, &exit_code] { calib_import(*imp, exit_code); });
 
   auto exp = std::make_shared<StoreOpts>();
   CLI::App* c_exp =
       calib->add_subcommand("export", "print the stored calibration as JSON (for `import`)");
   add_store_options(c_exp, *exp, true);
-  c_exp->callback([exp, &exit_code] {
-    calib::LoadResult l;
-    if (!open_loaded("export", *exp, l, exit_code)) return;
-    if (l.status != calib::StoreStatus::kOk) {
-      std::cerr << "odomctl calib export: " << exp->path << ": " << l.describe()
-                << "; nothing to export\n";
-      exit_code = kExitFailed;
-      return;
-    }
-    std::cout << analysis::export_json(*l.record) << "\n";
-    exit_code = kExitOk;
-  });
+  c_exp->callback([exp, &exit_code] { calib_export(*exp, exit_code); });
 
   auto reset = std::make_shared<StoreOpts>();
   CLI::App* c_reset = calib->add_subcommand(
       "reset", "mark the store uncalibrated (the firmware then runs on nominal values)");
   add_store_options(c_reset, *reset, true);
-  c_reset->callback([reset, &exit_code] {
-    calib::LoadResult l;
-    auto s = open_loaded("reset", *reset, l, exit_code);
-    if (!s) return;
-    write_and_report("reset", *reset, *s, std::nullopt, exit_code);
-  });
+  c_reset->callback([reset, &exit_code] { calib_reset(*reset, exit_code); });
 }
 
 }  // namespace odo::ctl

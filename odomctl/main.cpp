@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "odo/firmware/cli_parse.hpp"
 #include "odo/firmware/version.hpp"
 
 int main(int argc, char** argv) {
@@ -14,17 +15,7 @@ int main(int argc, char** argv) {
   odo::ctl::add_errormodel(app, exit_code);
   odo::ctl::add_umbmark(app, exit_code);
   odo::ctl::add_decode(app, exit_code);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "odomctl: " << e.what() << "\n";
-    return odo::ctl::kExitBadInput;
-  }
+  // Parse errors give kExitBadInput (2), as odometryd.
+  if (auto rc = odo::fw::parse_command_line(app, argc, argv, "odomctl")) return *rc;
   return exit_code;
 }

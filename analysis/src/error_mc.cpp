@@ -6,6 +6,7 @@
 
 #include "odo/analysis/error_model_tools.hpp"
 #include "odo/analysis/seed.hpp"
+#include "odo/hal/field_range.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_run.hpp"
 #include "odo/sim/wheel_noise.hpp"
@@ -42,18 +43,18 @@ std::string path_description(const std::string& path) {
 Status check_mc_options(const McOptions& o) {
   std::ostringstream m;
   if (o.runs < 2 || o.runs > 1000000) {
-    m << "--runs = " << o.runs << " is outside the allowed range [2, 1000000]";
+    m << range_message({"--runs", static_cast<double>(o.runs), 2, 1000000, "", false, true});
   } else if (o.path != "outback" && o.path != "arc") {
     m << "--path = '" << o.path << "' must be outback or arc";
   } else if (!(o.wheelbase >= 0.05 && o.wheelbase <= 5.0)) {
-    m << "--wheelbase = " << o.wheelbase << " m is outside the allowed range [0.05, 5] m";
+    m << range_message({"--wheelbase", o.wheelbase, 0.05, 5.0, "m"});
   } else if (!(o.wheel_diameter >= 0.01 && o.wheel_diameter <= 2.0)) {
     m << "wheel diameter = " << o.wheel_diameter << " m is outside [0.01, 2] m";
   } else if (!(o.speed > 0.0 && o.speed <= 5.0)) {
     m << "speed = " << o.speed << " m/s is outside (0, 5] m/s";
-  } else if (auto s = check_error_model(o.k); !s) {
-    const std::string& e = s.error().message;  // "k_left = ..." -> "--k-left = ..."
-    m << "--k-" << e.substr(2, e.find(' ') - 2) << e.substr(e.find(' '));
+  } else if (auto r = error_model_range(o.k)) {
+    r->field = r->field == "k_left" ? "--k-left" : "--k-right";  // the options' names
+    m << range_message(*r);
   } else {
     return Ok{};
   }

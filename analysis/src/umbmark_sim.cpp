@@ -6,6 +6,7 @@
 
 #include "odo/analysis/seed.hpp"
 #include "odo/analysis/umbmark_tools.hpp"
+#include "odo/hal/field_range.hpp"
 #include "odo/sim/floor.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_run.hpp"
@@ -99,11 +100,11 @@ Status check_umbmark_sim_options(const UmbmarkSimOptions& o) {
   if (o.robot != "labmate") {
     m << "--robot = '" << o.robot << "' is not known (allowed: labmate)";
   } else if (o.runs < 1 || o.runs > 1000) {
-    m << "--runs = " << o.runs << " is outside the allowed range [1, 1000]";
+    m << range_message({"--runs", static_cast<double>(o.runs), 1, 1000, "", false, true});
   } else if (o.passes < 1 || o.passes > 10) {
-    m << "--passes = " << o.passes << " is outside the allowed range [1, 10]";
+    m << range_message({"--passes", static_cast<double>(o.passes), 1, 10, "", false, true});
   } else if (!(o.side >= 0.5 && o.side <= 20.0)) {
-    m << "--side = " << o.side << " m is outside the allowed range [0.5, 20] m";
+    m << range_message({"--side", o.side, 0.5, 20.0, "m"});
   } else if (o.noise != "none" && o.noise != "paper") {
     m << "--noise = '" << o.noise << "' must be none or paper";
   } else {

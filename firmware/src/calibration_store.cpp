@@ -10,13 +10,25 @@ using calib::CalibrationRecord;
 using calib::LoadResult;
 using calib::StoreStatus;
 
-Result<OpenStore> open_calibration_store(const std::string& path, std::string_view backend) {
-  auto kind = drv::parse_nv_backend(backend);
-  if (!kind) return std::move(kind).error();
-  const drv::NvBackend k = *kind == drv::NvBackend::kAuto ? drv::detect_nv_backend(path) : *kind;
+Result<OpenStore> open_calibration_store(const std::string& path, StoreBackend backend) {
+  drivers::NvBackend k = drivers::NvBackend::kAuto;
+  switch (backend) {
+    case StoreBackend::kAuto:
+      k = drivers::detect_nv_backend(path);
+      break;
+    case StoreBackend::kFile:
+      k = drivers::NvBackend::kFile;
+      break;
+    case StoreBackend::kNvmem:
+      k = drivers::NvBackend::kNvmem;
+      break;
+    case StoreBackend::kMtd:
+      k = drivers::NvBackend::kMtd;
+      break;
+  }
   OpenStore o;
-  o.backend = drv::nv_backend_name(k);
-  auto m = drv::open_nv_storage(path, k);
+  o.backend = drivers::nv_backend_name(k);
+  auto m = drivers::open_nv_storage(path, k);
   if (!m) return std::move(m).error();
   o.medium = std::move(m).value();
   auto s = calib::CalibrationStore::create(*o.medium);
@@ -79,7 +91,7 @@ AppliedCalibration apply_calibration(const KinematicParams& nominal,
 }
 
 AppliedCalibration read_and_apply(const KinematicParams& nominal, const std::string& path,
-                                  std::string_view backend) {
+                                  StoreBackend backend) {
   if (path.empty()) {
     AppliedCalibration a;
     a.params = nominal;

@@ -262,13 +262,13 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
                                                  loop::OdometryLoop& loop,
                                                  const std::string& can_log, bool virtual_time) {
   std::unique_ptr<CanLink> link(new CanLink());
-  if (s.bus == "none") {
+  if (s.bus == CanBusKind::kNone) {
     if (!can_log.empty())
       return make_error(Errc::kInvalidArgument, "--can-log needs a CAN bus: [can] bus is \"none\"");
     return std::unique_ptr<CanLink>();
   }
   std::string iface;
-  if (s.bus == "socketcan") {
+  if (s.bus == CanBusKind::kSocketCan) {
     drivers::SocketCanOptions so;
     so.interface = s.interface;
     so.reopen_period = s.reopen_period;
@@ -312,7 +312,7 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
   std::snprintf(idtxt, sizeof idtxt, "0x%03X",
                 protocol::frame_id(o.base_id, o.node_id, protocol::Msg::kPoseX));
   link->describe_ =
-      (s.bus == "socketcan" ? "SocketCAN " + s.interface : std::string("simulated bus")) +
+      (s.bus == CanBusKind::kSocketCan ? "SocketCAN " + s.interface : std::string("simulated bus")) +
       ", node " + std::to_string(s.node_id) + ", ids from " + idtxt +
       (s.set_pose ? ", set-pose on" : ", set-pose off") +
       (can_log.empty() ? std::string() : ", log " + can_log);

@@ -25,8 +25,9 @@ sim::Scenario make_scenario(const SimSection& s, const Kinematics& k) {
     const sim::Scenario sq = sim::square_scenario(k, o);
     out.insert(out.end(), sq.begin(), sq.end());
   };
-  if (s.scenario == "square-ccw" || s.scenario == "squares") add(sim::Turn::kCounterClockwise);
-  if (s.scenario == "square-cw" || s.scenario == "squares") add(sim::Turn::kClockwise);
+  const bool both = s.scenario == SimScenario::kSquares;
+  if (both || s.scenario == SimScenario::kSquareCcw) add(sim::Turn::kCounterClockwise);
+  if (both || s.scenario == SimScenario::kSquareCw) add(sim::Turn::kClockwise);
   return out;
 }
 
@@ -67,18 +68,18 @@ double Rig::scenario_duration() const noexcept {
 
 Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_time) {
   auto impl = std::make_unique<Impl>();
-  const std::string& be = cfg.encoder.backend;
-  const bool hctl_sim = be == "hctl1100" && cfg.hctl1100.bus == "sim";
-  const bool can_sim = be == "can" && cfg.can_encoder.bus == "sim";
-  if (be == "gpio" || (be == "hctl1100" && !hctl_sim) || (be == "can" && !can_sim)) {
+  const EncoderKind be = cfg.encoder.backend;
+  const bool hctl_sim = be == EncoderKind::kHctl1100 && cfg.hctl1100.bus == HctlBus::kSim;
+  const bool can_sim = be == EncoderKind::kCan && cfg.can_encoder.bus == CanEncoderBus::kSim;
+  if (be != EncoderKind::kSim && !hctl_sim && !can_sim) {
     if (virtual_time)
       return make_error(Errc::kInvalidArgument,
                         "--virtual-time needs a simulated encoder "
                         "backend (encoder.backend = \"" +
-                            be + "\")");
-    auto b = be == "gpio"       ? make_gpio_backend(cfg)
-             : be == "hctl1100" ? make_hctl_gpio_backend(cfg, k)
-                                : make_can_socketcan_backend(cfg, k);
+                            std::string(name_of(be)) + "\")");
+    auto b = be == EncoderKind::kGpio       ? make_gpio_backend(cfg)
+             : be == EncoderKind::kHctl1100 ? make_hctl_gpio_backend(cfg, k)
+                                            : make_can_socketcan_backend(cfg, k);
     if (!b) return std::move(b).error();
     impl->backend = std::move(b).value();
     impl->clock = std::make_unique<drivers::MonotonicClock>();
@@ -86,16 +87,11 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     impl->description = impl->backend->describe() + ", real time (CLOCK_MONOTONIC)";
     return Rig(std::move(impl));
   }
-  if (be != "sim" && !hctl_sim && !can_sim) {
-    return make_error(Errc::kUnsupported, cfg.source + ": encoder.backend = \"" +
-                                              cfg.encoder.backend +
-                                              "\" is not available in this build yet");
-  }
   const KinematicParams& p = k.params();
   sim::RobotGeometry g;
   g.counts_per_rev = p.counts_per_rev;
   g.gear_ratio = p.gear_ratio;
-  if (cfg.sim.robot == "labmate") {
+  if (cfg.sim.robot == SimRobotKind::kLabmate) {
     const sim::RobotGeometry lm = sim::labmate_geometry(p.wheel_diameter);
     g.wheel_diameter_left = lm.wheel_diameter_left;
     g.wheel_diameter_right = lm.wheel_diameter_right;
@@ -134,10 +130,11 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
   }
   impl->truth = std::make_unique<sim::TruthRecorder>(*impl->robot);
   std::ostringstream d;
-  d << "simulated robot '" << cfg.sim.robot << "' (true wheelbase " << g.wheelbase * 1e3
+  d << "simulated robot '" << name_of(cfg.sim.robot) << "' (true wheelbase " << g.wheelbase * 1e3
     << " mm, D_R/D_L " << g.wheel_diameter_right / g.wheel_diameter_left << "), scenario '"
-    << cfg.sim.scenario << "' (" << impl->scenario_duration << " s), " << cfg.sim.counter_bits
-    << "-bit counters, " << (hctl_sim || can_sim ? impl->backend->describe() + ", " : std::string())
+    << name_of(cfg.sim.scenario) << "' (" << impl->scenario_duration << " s), "
+    << cfg.sim.counter_bits << "-bit counters, "
+    << (hctl_sim || can_sim ? impl->backend->describe() + ", " : std::string())
     << (virtual_time ? "virtual time" : "real time (CLOCK_MONOTONIC)");
   impl->description = d.str();
   return Rig(std::move(impl));

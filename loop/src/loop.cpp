@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "odo/hal/field_range.hpp"
 #include "odo/odometry/count_delta.hpp"
 
 namespace odo::loop {
@@ -11,9 +12,8 @@ Result<std::unique_ptr<OdometryLoop>> OdometryLoop::create(const LoopConfig& cfg
                                                            const Kinematics& k,
                                                            EncoderSource& encoder, Clock& clock) {
   if (!(cfg.rate_hz >= 50.0 && cfg.rate_hz <= 2000.0)) {
-    std::ostringstream m;
-    m << "loop.rate_hz = " << cfg.rate_hz << " is outside the allowed range [50, 2000] Hz";
-    return make_error(Errc::kInvalidArgument, m.str());
+    return make_error(Errc::kInvalidArgument,
+                      range_message({"loop.rate_hz", cfg.rate_hz, 50.0, 2000.0, "Hz", false}));
   }
   if (auto s = check_counter_bits(encoder.counter_bits()); !s) return std::move(s).error();
   if (auto s = check_error_model(cfg.error_model); !s) {

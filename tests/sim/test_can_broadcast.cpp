@@ -39,8 +39,8 @@ struct Bench {
   }
   static fw::Config make_cfg(const std::string& scenario) {
     fw::Config c = fw::default_config();
-    c.sim.scenario = scenario;
-    c.sim.robot = "nominal";
+    c.sim.scenario = *fw::parse_choice<fw::SimScenario>(scenario);
+    c.sim.robot = fw::SimRobotKind::kNominal;
     return c;
   }
   static fw::CanBroadcastOptions opts() {

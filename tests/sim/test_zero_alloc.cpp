@@ -294,7 +294,7 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   // the virtual clock, ground-truth observer attached. Start-up may allocate; ticks may not.
   fw::Config cfg = fw::default_config();
   cfg.loop.rate_hz = 1000.0;
-  cfg.sim.scenario = "squares";
+  cfg.sim.scenario = fw::SimScenario::kSquares;
   auto kin = Kinematics::create(cfg.robot);
   ASSERT_TRUE(kin.ok());
   auto rig = fw::Rig::create(cfg, *kin, /*virtual_time=*/true);
@@ -364,7 +364,7 @@ TEST(ZeroAlloc, CanReceiveFloodWithoutAllocating) {
   // set-pose command for this node), far more than the broadcaster reads per tick.
   fw::Config cfg = fw::default_config();
   cfg.loop.rate_hz = 1000.0;
-  cfg.sim.scenario = "idle";
+  cfg.sim.scenario = fw::SimScenario::kIdle;
   ASSERT_TRUE(cfg.can.set_pose);
   auto kin = Kinematics::create(cfg.robot);
   ASSERT_TRUE(kin.ok());
@@ -420,8 +420,8 @@ TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
   // sending at 20 s; none of it may allocate.
   fw::Config cfg = fw::default_config();
   cfg.loop.rate_hz = 1000.0;
-  cfg.encoder.backend = "can";
-  cfg.can_encoder.bus = "sim";
+  cfg.encoder.backend = fw::EncoderKind::kCan;
+  cfg.can_encoder.bus = fw::CanEncoderBus::kSim;
   cfg.can_encoder.sim_stop_left_after = 20.0;
   auto kin = Kinematics::create(cfg.robot);
   ASSERT_TRUE(kin.ok());

@@ -58,7 +58,7 @@ class PausingFileStorage final : public NvStorage {
   Status erase(std::size_t off, std::size_t len) override { return file_.erase(off, len); }
 
  private:
-  drv::FileNvStorage file_;
+  drivers::FileNvStorage file_;
   std::size_t split_;
   std::chrono::milliseconds pause_;
 };
@@ -87,7 +87,7 @@ std::filesystem::path scratch_dir(const std::string& name) {
 
 // save_records: records of sequence 1, 2, ..., n saved in turn to the file store at `path`.
 void save_records(const std::string& path, std::uint64_t n) {
-  drv::FileNvStorage m(path);
+  drivers::FileNvStorage m(path);
   auto store = CalibrationStore::create(m);
   ASSERT_TRUE(store);
   for (std::uint64_t seq = 1; seq <= n; ++seq) ASSERT_TRUE(store->save(record_for(seq)));
@@ -126,14 +126,15 @@ TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while (!g_reload.exchange(false) && std::chrono::steady_clock::now() < deadline)
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    const fw::AppliedCalibration during = fw::read_and_apply(nominal, path, "file");
+    const fw::AppliedCalibration during =
+        fw::read_and_apply(nominal, path, fw::StoreBackend::kFile);
     // The writer had written part of the record and had not finished when we read.
     int status = 0;
     const pid_t w = waitpid(pid, &status, WNOHANG);
     ASSERT_GE(w, 0);
     if (w == 0) ++mid_write;
     // The store as it stood: the slot being written half old, half new (not valid, not blank)?
-    drv::FileNvStorage probe(path);
+    drivers::FileNvStorage probe(path);
     auto ps = CalibrationStore::create(probe);
     ASSERT_TRUE(ps);
     auto l = ps->load();
@@ -153,7 +154,7 @@ TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
     ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "writer status " << status;
     ++seq;
     // A SIGHUP after the save: the new record.
-    check_applied(fw::read_and_apply(nominal, path, "file"), nominal, seq);
+    check_applied(fw::read_and_apply(nominal, path, fw::StoreBackend::kFile), nominal, seq);
     ++rounds;
   }
   sigaction(SIGHUP, &old, nullptr);
@@ -188,7 +189,7 @@ TEST(CalibReloadRace, BothSlotsInFlightIsReadAgainUntilTheSaveSettles) {
   const std::vector<char> settled = file_bytes(path);
   const std::vector<char> in_flight(settled.size(), '\x5a');  // neither valid nor blank
   put_file_bytes(path, in_flight);
-  auto read = [&] { return fw::read_and_apply(nominal, path, "file"); };
+  auto read = [&] { return fw::read_and_apply(nominal, path, fw::StoreBackend::kFile); };
   ASSERT_EQ(read().state, calib::StoreStatus::kCorrupt) << "precondition: both slots unreadable";
 
   int pauses = 0, rereads = -1;
@@ -228,7 +229,7 @@ TEST(CalibReloadRace, BothSlotsInFlightIsReadAgainUntilTheSaveSettles) {
   put_file_bytes(path, in_flight);
   loop::CommandQueue commands;
   std::ostringstream log;
-  fw::CalibrationReloader reloader(commands, nominal, path, "file", log);
+  fw::CalibrationReloader reloader(commands, nominal, path, fw::StoreBackend::kFile, log);
   std::atomic<bool> request{true};
   reloader.start(request);
   calib::StoreStatus state = calib::StoreStatus::kOk;
@@ -277,7 +278,7 @@ TEST(CalibReloadRace, StopReturnsWhileAReloadWaitsForALoopThatNoLongerTicks) {
     ASSERT_TRUE(commands.post(loop::SetPose{}));
   LineCounter sink;
   std::ostream log(&sink);
-  fw::CalibrationReloader reloader(commands, nominal, path, "file", log);
+  fw::CalibrationReloader reloader(commands, nominal, path, fw::StoreBackend::kFile, log);
   std::atomic<bool> request{true};
   reloader.start(request);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);

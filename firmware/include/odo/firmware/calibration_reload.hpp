@@ -33,11 +33,11 @@ class CalibrationReloader {
  public:
   // commands: the loop's inbound queue (OdometryLoop::commands()).
   CalibrationReloader(loop::CommandQueue& commands, const KinematicParams& nominal,
-                      std::string path, std::string backend, std::ostream& log)
+                      std::string path, StoreBackend backend, std::ostream& log)
       : commands_(commands),
         nominal_(nominal),
         path_(std::move(path)),
-        backend_(std::move(backend)),
+        backend_(backend),
         log_(log) {}
   ~CalibrationReloader() { stop(); }
   CalibrationReloader(const CalibrationReloader&) = delete;
@@ -61,7 +61,7 @@ class CalibrationReloader {
   loop::CommandQueue& commands_;
   KinematicParams nominal_;
   std::string path_;
-  std::string backend_;
+  StoreBackend backend_;
   std::ostream& log_;
   std::thread thread_;
   std::mutex m_;

@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "odo/calibration/store.hpp"
+#include "odo/firmware/config.hpp"
 #include "odo/hal/nv_storage.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/kinematics.hpp"
@@ -25,9 +26,9 @@ struct OpenStore {
   std::string backend;  // "file", "nvmem" or "mtd"
 };
 
-// open_calibration_store: `backend` is auto | file | nvmem | mtd (auto: /dev/mtd* is MTD, a
-// path under /sys/ or named nvmem is nvmem, anything else a regular file).
-Result<OpenStore> open_calibration_store(const std::string& path, std::string_view backend);
+// open_calibration_store: the medium `backend` (kAuto: /dev/mtd* is MTD, a path under /sys/ or
+// named nvmem is nvmem, anything else a regular file).
+Result<OpenStore> open_calibration_store(const std::string& path, StoreBackend backend);
 
 // AppliedCalibration: what odometryd runs on after reading the store.
 struct AppliedCalibration {
@@ -47,6 +48,6 @@ AppliedCalibration apply_calibration(const KinematicParams& nominal,
 
 // read_and_apply: opens `path` (empty: no store configured), loads and applies.
 AppliedCalibration read_and_apply(const KinematicParams& nominal, const std::string& path,
-                                  std::string_view backend);
+                                  StoreBackend backend);
 
 }  // namespace odo::fw
