@@ -7,21 +7,15 @@
 # /lib/systemd/system/odometryd.service. Package paths are absolute Debian paths, so install()
 # uses absolute destinations for everything outside /usr.
 
-# Binaries: firmware/CMakeLists.txt installs odometryd and odomctl to bin (prefix /usr here).
+# Binaries: firmware/ and odomctl/ install odometryd and odomctl to bin (prefix /usr here).
 set(ODO_PKG_SOURCE ${CMAKE_CURRENT_SOURCE_DIR})
 install(FILES ${ODO_PKG_SOURCE}/firmware/config/odometryd.toml DESTINATION /etc/odometryd)
 # The calibration store's default location (/var/lib/odometryd/calibration.bin); postinst also
 # creates it, so a purge followed by a reinstall works.
 install(DIRECTORY DESTINATION /var/lib/odometryd)
-# Written in parallel by other issues; installed as soon as they exist.
-# TODO(lead): drop the two if(EXISTS) guards once firmware/can/ and firmware/systemd/ are merged.
-if(EXISTS ${ODO_PKG_SOURCE}/firmware/can/odometry.dbc)
-  install(FILES ${ODO_PKG_SOURCE}/firmware/can/odometry.dbc DESTINATION /usr/share/odometryd)
-endif()
-if(EXISTS ${ODO_PKG_SOURCE}/firmware/systemd/odometryd.service)
-  install(FILES ${ODO_PKG_SOURCE}/firmware/systemd/odometryd.service
-    DESTINATION /lib/systemd/system)
-endif()
+install(FILES ${ODO_PKG_SOURCE}/protocol/odometry.dbc DESTINATION /usr/share/odometryd)
+install(FILES ${ODO_PKG_SOURCE}/firmware/systemd/odometryd.service
+  DESTINATION /lib/systemd/system)
 
 # Debian architecture of the target: the cross toolchains set CMAKE_SYSTEM_PROCESSOR, while CPack
 # would otherwise ask `dpkg --print-architecture`, which names the build machine.

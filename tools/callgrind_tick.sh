@@ -25,7 +25,7 @@ status=0
 echo "callgrind: $n ticks at 1 kHz, $(g++ --version | head -1), preset bench (-O2 -DNDEBUG), $(uname -m)"
 for mode in sim counting; do
   valgrind --tool=callgrind --callgrind-out-file="$tmp/$mode.out" \
-    --toggle-collect='odo::fw::OdometryLoop::tick()' "$drv" "$mode" "$n" >"$tmp/$mode.log" 2>&1
+    --toggle-collect='odo::loop::OdometryLoop::tick()' "$drv" "$mode" "$n" >"$tmp/$mode.log" 2>&1
   callgrind_annotate --inclusive=yes --threshold=100 "$tmp/$mode.out" >"$tmp/$mode.txt" 2>/dev/null
   echo
   echo "encoder = $mode: instructions per tick (inclusive; rows below the tick are its callees)"

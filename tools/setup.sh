@@ -13,7 +13,10 @@ build_pkgs=(g++ cmake make pkg-config python3 libeigen3-dev libgpiod-dev libtoml
 test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind
   can-utils python3-can iproute2  # CAN kernel tests in the VM (candump, cansend, ip, tc)
   rt-tests stress-ng systemd  # cyclictest + load for tools/jitter.sh; systemd-analyze verify
-  clang-14 libclang-rt-14-dev libfuzzer-14-dev)  # fuzz preset: clang-14 + libFuzzer (TESTING.md)
+  clang-14 libclang-rt-14-dev libfuzzer-14-dev  # fuzz preset: clang-14 + libFuzzer (TESTING.md)
+  nodejs npm)  # cli_can: the DBC read by the npm library candied (tests/tools/dbc_candied.cjs)
+# npm packages of the tests, installed into tools/node/ (not committed; cli_can looks there).
+npm_test_pkgs=(candied@2.2.0)
 # Cross builds (toolchains/, presets cross-aarch64 and cross-armhf) and the package checks
 # (tests/package/: check_deb.sh uses dpkg-shlibdeps, file, systemd-analyze; fresh_install.sh
 # uses debootstrap).
@@ -26,9 +29,10 @@ cross_arch_pkgs=(libgpiod-dev libtomlplusplus-dev libgtest-dev libgmock-dev)
 
 want=("${build_pkgs[@]}")
 add_archs=()
+npm_want=()
 for arg in "$@"; do
   case $arg in
-    --tests) want+=("${test_pkgs[@]}") ;;
+    --tests) want+=("${test_pkgs[@]}"); npm_want+=("${npm_test_pkgs[@]}") ;;
     --cross)
       want+=("${cross_pkgs[@]}")
       for a in "${cross_archs[@]}"; do
@@ -40,12 +44,28 @@ for arg in "$@"; do
   esac
 done
 
+# npm_install: the npm test packages into tools/node (after the Debian packages: needs npm).
+npm_install() {
+  ((${#npm_want[@]} == 0)) && return 0
+  local dir
+  dir="$(cd "$(dirname "$0")" && pwd)/node"
+  for p in "${npm_want[@]}"; do
+    if [ -f "$dir/node_modules/${p%@*}/package.json" ] &&
+      grep -q "\"version\": \"${p#*@}\"" "$dir/node_modules/${p%@*}/package.json"; then
+      continue
+    fi
+    echo "setup.sh: npm install --prefix $dir $p"
+    npm install --no-audit --no-fund --prefix "$dir" "$p"
+  done
+}
+
 missing=()
 for p in "${want[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
 done
 if ((${#missing[@]} == 0)); then
   echo "setup.sh: all ${#want[@]} packages present"
+  npm_install
   exit 0
 fi
 SUDO=
@@ -57,3 +77,4 @@ for a in "${add_archs[@]}"; do
 done
 $SUDO apt-get update -qq || echo "setup.sh: apt-get update reported an error (continuing; see above)" >&2
 DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+npm_install

@@ -1,5 +1,7 @@
 #include "odo/calibration/record.hpp"
 
+#include <ctime>
+
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -184,6 +186,15 @@ Status validate_record(const CalibrationRecord& r) {
     return make_error(Errc::kInvalidArgument, "method \"" + r.method + "\" is longer than " +
                                                   std::to_string(kMethodBytes - 1) + " bytes");
   return Ok{};
+}
+
+std::string utc_text(std::int64_t t) {
+  const std::time_t tt = static_cast<std::time_t>(t);
+  std::tm tm{};
+  gmtime_r(&tt, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
 }
 
 }  // namespace odo::calib

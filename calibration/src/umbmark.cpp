@@ -73,13 +73,12 @@ double wheelbase_factor(double alpha, WheelbaseFormula f) {
   return q / (q - alpha);
 }
 
-Factors wheel_factors(double e_d) {
-  return Factors{2.0 / (e_d + 1.0), 2.0 / (1.0 / e_d + 1.0), 1.0};
+PassFactors wheel_factors(double e_d) {
+  return PassFactors{2.0 / (e_d + 1.0), 2.0 / (1.0 / e_d + 1.0), 1.0};
 }
 
-Factors compose(const Factors& current, const Factors& pass) {
-  return Factors{current.c_l * pass.c_l, current.c_r * pass.c_r,
-                 current.wheelbase * pass.wheelbase};
+Factors compose(const Factors& current, const PassFactors& pass) {
+  return Factors{current.c_l * pass.c_l, current.c_r * pass.c_r, current.wheelbase * pass.e_b};
 }
 
 std::optional<double> return_spread(std::span<const UmbmarkRun> runs, const CentreOfGravity& cw,
@@ -176,7 +175,7 @@ Result<UmbmarkResult> umbmark_compute(const UmbmarkInput& in) {
   out.e_d = diameter_ratio(out.radius, in.current.wheelbase);
   out.e_b = wheelbase_factor(out.ab.alpha, in.formula);
   out.pass = wheel_factors(out.e_d);
-  out.pass.wheelbase = out.e_b;
+  out.pass.e_b = out.e_b;
   out.composed = compose(in.current, out.pass);
   for (auto [f, v] : {std::pair{"c_l", out.composed.c_l}, {"c_r", out.composed.c_r}}) {
     if (!(v >= L::kFactorMin && v <= L::kFactorMax))

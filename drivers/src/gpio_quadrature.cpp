@@ -45,6 +45,7 @@ struct WheelAtomics {
   std::atomic<std::uint64_t> invalid{0};
   std::atomic<std::uint64_t> index_pulses{0};
   std::atomic<std::int64_t> index_count{0};
+  std::atomic<std::uint64_t> dropped{0};
 };
 
 }  // namespace
@@ -60,11 +61,11 @@ struct GpioQuadratureEncoder::Impl {
   std::array<std::uint64_t, 2> index_pulses{};
   std::array<std::int64_t, 2> index_count{};
   std::array<TimeNs, 2> last_ts{};  // timestamp of the last applied A/B edge per wheel
-  TimeNs seen_ts[2][2] = {};
-  std::uint64_t events_read = 0;  // all events read from the kernel
-  bool suspect = false;           // idle check saw a difference once
+  TimeNs seen_ts[2][2] = {};        // newest received timestamp per wheel and line (A, B)
+  std::uint64_t events_read = 0;    // all events read from the kernel
+  bool suspect = false;             // idle check saw a difference once
   std::array<QuadState, 2> suspect_levels{};
-  std::uint64_t suspect_events = 0;  // newest received timestamp per wheel and line (A, B)
+  std::uint64_t suspect_events = 0;  // events_read when the idle check first saw a difference
   std::array<WheelAtomics, 2> pub;
   std::atomic<bool> stop{false};
   std::atomic<bool> held{false};
@@ -193,8 +194,12 @@ void GpioQuadratureEncoder::Impl::run() noexcept {
           failed.store(true, std::memory_order_release);
           return;
         }
-        for (int e = 0; e < got && pending.size() < pending.capacity(); ++e) {
-          const gpiod_line_event& ev = buf[static_cast<std::size_t>(e)];
+        const BatchSplit split =
+            split_batch(static_cast<std::size_t>(got), pending.capacity() - pending.size());
+        if (split.dropped > 0)
+          pub[roles[idx].wheel].dropped.fetch_add(split.dropped, std::memory_order_relaxed);
+        for (std::size_t e = 0; e < split.taken; ++e) {
+          const gpiod_line_event& ev = buf[e];
           const TimeNs ts = static_cast<TimeNs>(ev.ts.tv_sec) * kNsPerSecond + ev.ts.tv_nsec;
           ++events_read;
           if (roles[idx].role != Role::kIndex) {
@@ -335,6 +340,7 @@ GpioWheelStats GpioQuadratureEncoder::wheel(int i) const noexcept {
   s.invalid = a.invalid.load(std::memory_order_relaxed);
   s.index_pulses = a.index_pulses.load(std::memory_order_relaxed);
   s.index_count = a.index_count.load(std::memory_order_relaxed);
+  s.dropped = a.dropped.load(std::memory_order_relaxed);
   return s;
 }
 

@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <vector>
 
-namespace odo::drv {
+namespace odo::drivers {
 namespace {
 
 Error sys_error(const std::string& path, const char* what, int err) {
@@ -73,15 +73,6 @@ Status fsync_dir(const std::string& file) {
 }
 
 }  // namespace
-
-Result<NvBackend> parse_nv_backend(std::string_view name) {
-  if (name == "auto") return NvBackend::kAuto;
-  if (name == "file") return NvBackend::kFile;
-  if (name == "nvmem") return NvBackend::kNvmem;
-  if (name == "mtd") return NvBackend::kMtd;
-  return make_error(Errc::kInvalidArgument, "storage backend \"" + std::string(name) +
-                                                "\": allowed auto, file, nvmem, mtd");
-}
 
 const char* nv_backend_name(NvBackend b) noexcept {
   switch (b) {
@@ -271,4 +262,4 @@ Result<std::unique_ptr<NvStorage>> open_nv_storage(const std::string& path, NvBa
   }
 }
 
-}  // namespace odo::drv
+}  // namespace odo::drivers

@@ -3,33 +3,9 @@
 #include <chrono>
 #include <string>
 
-#include "odo/firmware/calibration_io.hpp"
+#include "odo/firmware/calibration_store.hpp"
 
 namespace odo::fw {
-
-bool CalibrationHandover::offer(const Kinematics& k, std::uint8_t state,
-                                const std::atomic<bool>& stop) {
-  // Wait until the loop has taken the previous offer: the slot is ours only while empty.
-  while (full_.load(std::memory_order_acquire)) {
-    if (stop.load()) return false;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-  pending_ = k;
-  pending_state_ = state;
-  full_.store(true, std::memory_order_release);
-  return true;
-}
-
-void CalibrationHandover::on_tick(LoopSnapshot& snap) noexcept {
-  if (full_.load(std::memory_order_acquire)) {
-    // Between two ticks: the next tick integrates with the new factors.
-    if (loop_ != nullptr && pending_) loop_->set_kinematics(*pending_);
-    state_ = pending_state_;
-    full_.store(false, std::memory_order_release);
-    applied_.fetch_add(1, std::memory_order_acq_rel);
-  }
-  snap.calibration_state = state_;
-}
 
 void CalibrationReloader::start(std::atomic<bool>& request) {
   thread_ = std::thread([this, &request] {
@@ -60,7 +36,7 @@ AppliedCalibration read_settled(const std::function<AppliedCalibration()>& read,
                                 const std::function<bool()>& pause, int* rereads) {
   AppliedCalibration a = read();
   int n = 0;
-  while (a.state == 2 && n + 1 < attempts && pause()) {
+  while (a.state == calib::StoreStatus::kCorrupt && n + 1 < attempts && pause()) {
     ++n;
     a = read();
   }
@@ -84,9 +60,11 @@ void CalibrationReloader::reload() {
                    },
                    &rereads);
   if (rereads > 0) {
-    a.report += "; read " + std::to_string(rereads + 1) + " times (" +
-                (a.state == 2 ? "corrupt every time" : "corrupt at first: a save was in flight") +
-                ")";
+    a.report +=
+        "; read " + std::to_string(rereads + 1) + " times (" +
+        (a.state == calib::StoreStatus::kCorrupt ? "corrupt every time"
+                                                 : "corrupt at first: a save was in flight") +
+        ")";
   }
   auto k = Kinematics::create(a.params);
   if (!k) {
@@ -97,7 +75,11 @@ void CalibrationReloader::reload() {
   // One string per line so that the status thread's lines do not interleave with it.
   const std::string line = "odometryd: SIGHUP: " + a.report + "\n";
   log_ << line << std::flush;
-  handover_.offer(*k, a.state, done_);
+  // A full queue (a loop that stopped ticking) is waited for until stop().
+  while (!commands_.post(loop::SetKinematics{*k, a.state})) {
+    if (done_.load()) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
 }
 
 }  // namespace odo::fw

@@ -50,27 +50,6 @@ bool CanFrameRing::pop(CanFrame& out) noexcept {
 
 // ---- candump -L log ----
 
-std::size_t format_candump_line(char* buf, std::size_t size, std::int64_t wall_ns,
-                                const char* iface, const CanFrame& f) noexcept {
-  const long long sec = wall_ns / 1'000'000'000;
-  const long long usec = (wall_ns % 1'000'000'000) / 1000;
-  int n = f.extended ? std::snprintf(buf, size, "(%lld.%06lld) %s %08X#", sec, usec, iface,
-                                     static_cast<unsigned>(f.id & 0x1FFFFFFFu))
-                     : std::snprintf(buf, size, "(%lld.%06lld) %s %03X#", sec, usec, iface,
-                                     static_cast<unsigned>(f.id & 0x7FFu));
-  if (n < 0 || static_cast<std::size_t>(n) >= size) return 0;
-  static constexpr char kHex[] = "0123456789ABCDEF";
-  const std::size_t len = f.len > 8 ? 8 : f.len;
-  if (static_cast<std::size_t>(n) + 2 * len + 2 > size) return 0;
-  for (std::size_t i = 0; i < len; ++i) {
-    buf[n++] = kHex[f.data[i] >> 4];
-    buf[n++] = kHex[f.data[i] & 0xF];
-  }
-  buf[n++] = '\n';
-  buf[n] = '\0';
-  return static_cast<std::size_t>(n);
-}
-
 CanLogWriter::~CanLogWriter() {
   stop();
 }
@@ -102,7 +81,7 @@ void CanLogWriter::drain() noexcept {
   char line[96];
   while (ring_.pop(f)) {
     const std::size_t n =
-        format_candump_line(line, sizeof line, epoch_ns_ + f.stamp, iface_.c_str(), f);
+        protocol::format_candump_line(line, sizeof line, epoch_ns_ + f.stamp, iface_.c_str(), f);
     if (n > 0 && std::fwrite(line, 1, n, file_) == n) ++written_;
   }
 }
@@ -119,17 +98,16 @@ void CanLogWriter::stop() {
 
 // ---- CanBroadcaster ----
 
-CanBroadcaster::CanBroadcaster(const CanBroadcastOptions& o, CanBus& bus, OdometryLoop* loop,
-                               sim::SimCanPort* wire, CanFrameRing* log) noexcept
-    : o_(o), bus_(&bus), loop_(loop), wire_(wire), log_(log) {}
+CanBroadcaster::CanBroadcaster(const CanBroadcastOptions& o, CanBus& bus,
+                               loop::CommandQueue* commands, CanFrameRing* log) noexcept
+    : o_(o), bus_(&bus), commands_(commands), log_(log) {}
 
 void CanBroadcaster::send(const CanFrame& f, std::int64_t loop_time) noexcept {
   switch (bus_->send(f)) {
     case CanTx::kSent:
       ++c_.sent;
-      // A real bus: the frame is on its way, log it now. The simulated bus logs what its wire
-      // takes (drain_wire).
-      if (log_ != nullptr && wire_ == nullptr) {
+      // The frame is on its way: log it now, stamped with the loop time of its tick.
+      if (log_ != nullptr) {
         CanFrame l = f;
         l.stamp = loop_time;
         log_frame(l);
@@ -147,54 +125,47 @@ void CanBroadcaster::send(const CanFrame& f, std::int64_t loop_time) noexcept {
   }
 }
 
-void CanBroadcaster::drain_wire(std::int64_t loop_time) noexcept {
-  if (wire_ == nullptr) return;
-  CanFrame f;
-  while (wire_->drain_tx(f)) {
-    if (log_ != nullptr) {
-      f.stamp = loop_time;
-      log_frame(f);
-    }
-  }
-}
-
 void CanBroadcaster::take_commands(CanFrame& f) noexcept {
   for (std::size_t i = 0; i < o_.max_rx_per_tick; ++i) {
     if (i > 0 && !bus_->receive(f)) break;
     int node = 0;
-    can::Msg m{};
-    if (!can::split_id(o_.base_id, f, node, m) || node != o_.node_id || m != can::Msg::kSetPose)
+    protocol::Msg m{};
+    if (!protocol::split_id(o_.base_id, f, node, m) || node != o_.node_id ||
+        m != protocol::Msg::kSetPose)
       continue;  // not for us (a SocketCAN filter normally keeps these out)
-    can::SetPoseCmd cmd;
-    if (!can::decode_set_pose(f, cmd)) {
+    protocol::SetPoseCmd cmd;
+    if (!protocol::decode_set_pose(f, cmd)) {
       ++c_.set_pose_rejected;
       continue;
     }
-    if (loop_ != nullptr) loop_->request_pose(Pose2{cmd.x, cmd.y, cmd.theta});
+    if (commands_ != nullptr && !commands_->post(loop::SetPose{Pose2{cmd.x, cmd.y, cmd.theta}})) {
+      ++c_.set_pose_rejected;  // the loop's queue is full (it stopped taking commands)
+      continue;
+    }
     ++c_.set_pose_applied;
     ++pending_ack_;
   }
 }
 
-void CanBroadcaster::send_pose_group(const LoopSnapshot& s) noexcept {
+void CanBroadcaster::send_pose_group(const loop::LoopSnapshot& s) noexcept {
   if (sent_any_pose_) ++seq_;
   sent_any_pose_ = true;
-  const can::PoseMsg p{s.pose.x, s.pose.y, s.pose.theta, seq_};
+  const protocol::PoseMsg p{s.pose.x, s.pose.y, s.pose.theta, seq_};
   CanFrame f;
-  can::encode_pose_x(id(can::Msg::kPoseX), p, f);
+  protocol::encode_pose_x(id(protocol::Msg::kPoseX), p, f);
   send(f, s.loop_time);
-  can::encode_pose_y_theta(id(can::Msg::kPoseYTheta), p, f);
+  protocol::encode_pose_y_theta(id(protocol::Msg::kPoseYTheta), p, f);
   send(f, s.loop_time);
 }
 
-void CanBroadcaster::send_velocity(const LoopSnapshot& s) noexcept {
+void CanBroadcaster::send_velocity(const loop::LoopSnapshot& s) noexcept {
   CanFrame f;
-  can::encode_velocity(id(can::Msg::kVelocity), can::VelocityMsg{s.v, s.w, seq_}, f);
+  protocol::encode_velocity(id(protocol::Msg::kVelocity), protocol::VelocityMsg{s.v, s.w, seq_}, f);
   send(f, s.loop_time);
 }
 
-void CanBroadcaster::send_uncertainty(const LoopSnapshot& s) noexcept {
-  can::UncertaintyMsg u;
+void CanBroadcaster::send_uncertainty(const loop::LoopSnapshot& s) noexcept {
+  protocol::UncertaintyMsg u;
   u.seq = seq_;
   if (s.has_cov) {
     u.sigma_x = std::sqrt(std::max(0.0, s.cov[0]));
@@ -206,14 +177,14 @@ void CanBroadcaster::send_uncertainty(const LoopSnapshot& s) noexcept {
     u.sigma_x = u.sigma_y = u.sigma_theta = std::nan("");  // unknown: sent as the maximum
   }
   CanFrame f;
-  can::encode_uncertainty(id(can::Msg::kUncertainty), u, f);
+  protocol::encode_uncertainty(id(protocol::Msg::kUncertainty), u, f);
   send(f, s.loop_time);
 }
 
-void CanBroadcaster::send_status(const LoopSnapshot& s, bool stopping) noexcept {
-  can::StatusMsg m;
+void CanBroadcaster::send_status(const loop::LoopSnapshot& s, bool stopping) noexcept {
+  protocol::StatusMsg m;
   m.encoder_flags = static_cast<std::uint8_t>(s.encoder_flags & 0xFFu);
-  m.calibration_state = s.calibration_state;
+  m.calibration_state = static_cast<std::uint8_t>(s.calibration_state);
   m.stopping = stopping;
   m.set_pose_ack = ack_;
   m.missed_deadlines = s.stats.missed_deadlines > 0xFFFFFFFFu
@@ -221,23 +192,23 @@ void CanBroadcaster::send_status(const LoopSnapshot& s, bool stopping) noexcept 
                            : static_cast<std::uint32_t>(s.stats.missed_deadlines);
   m.uptime = to_seconds(s.loop_time);
   CanFrame f;
-  can::encode_status(id(can::Msg::kStatus), m, f);
+  protocol::encode_status(id(protocol::Msg::kStatus), m, f);
   send(f, s.loop_time);
 }
 
-void CanBroadcaster::send_timing(const LoopSnapshot& s) noexcept {
-  can::TimingMsg t;
+void CanBroadcaster::send_timing(const loop::LoopSnapshot& s) noexcept {
+  protocol::TimingMsg t;
   t.wakeup_p99 = to_seconds(s.stats.wakeup_latency.p99);
   t.wakeup_max = to_seconds(s.stats.wakeup_latency_max);
   t.compute_max = to_seconds(s.stats.compute_max);
   const std::uint64_t d = c_.dropped();
   t.tx_dropped = d > 0xFFFFFFFFu ? 0xFFFFFFFFu : static_cast<std::uint32_t>(d);
   CanFrame f;
-  can::encode_timing(id(can::Msg::kTiming), t, f);
+  protocol::encode_timing(id(protocol::Msg::kTiming), t, f);
   send(f, s.loop_time);
 }
 
-void CanBroadcaster::on_tick(LoopSnapshot& s) noexcept {
+void CanBroadcaster::on_tick(const loop::LoopSnapshot& s) noexcept {
   // Commands taken last tick were applied at the start of this one: acknowledge them now, so a
   // receiver that sees the ack also sees the new pose in the same or a later pose group.
   ack_ = static_cast<std::uint8_t>(ack_ + pending_ack_);
@@ -252,11 +223,9 @@ void CanBroadcaster::on_tick(LoopSnapshot& s) noexcept {
   // five divisions are saved. A tick number that went back, or repeated, wraps around and fails
   // it, so the result is always that of the modulo checks in send_due.
   if (s.tick - quiet_after_ - 1 >= quiet_span_) send_due(s);
-  // Tested here, not in drain_wire: the call alone costs more than the test on quiet ticks.
-  if (wire_ != nullptr && wire_->tx_queued() != 0) drain_wire(s.loop_time);
 }
 
-void CanBroadcaster::send_due(const LoopSnapshot& s) noexcept {
+void CanBroadcaster::send_due(const loop::LoopSnapshot& s) noexcept {
   const std::uint64_t t = s.tick;
   const CanDivisors& d = o_.div;
   if (d.pose != 0 && t % d.pose == 0) send_pose_group(s);
@@ -273,7 +242,7 @@ void CanBroadcaster::send_due(const LoopSnapshot& s) noexcept {
   quiet_span_ = next - t - 1;
 }
 
-void CanBroadcaster::send_final(const LoopSnapshot& s) noexcept {
+void CanBroadcaster::send_final(const loop::LoopSnapshot& s) noexcept {
   ack_ = static_cast<std::uint8_t>(ack_ + pending_ack_);
   pending_ack_ = 0;
   send_pose_group(s);
@@ -281,7 +250,6 @@ void CanBroadcaster::send_final(const LoopSnapshot& s) noexcept {
   send_uncertainty(s);
   send_timing(s);
   send_status(s, true);
-  drain_wire(s.loop_time);
 }
 
 // ---- CanLink ----
@@ -291,32 +259,32 @@ CanLink::~CanLink() {
 }
 
 Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loop_hz,
-                                                 OdometryLoop& loop, const std::string& can_log,
-                                                 bool virtual_time) {
+                                                 loop::OdometryLoop& loop,
+                                                 const std::string& can_log, bool virtual_time) {
   std::unique_ptr<CanLink> link(new CanLink());
-  if (s.bus == "none") {
+  if (s.bus == CanBusKind::kNone) {
     if (!can_log.empty())
       return make_error(Errc::kInvalidArgument, "--can-log needs a CAN bus: [can] bus is \"none\"");
     return std::unique_ptr<CanLink>();
   }
-  sim::SimCanPort* wire = nullptr;
   std::string iface;
-  if (s.bus == "socketcan") {
+  if (s.bus == CanBusKind::kSocketCan) {
     drivers::SocketCanOptions so;
     so.interface = s.interface;
     so.reopen_period = s.reopen_period;
     if (s.set_pose)
-      so.filters.push_back(drivers::CanFilter{
-          can::frame_id(static_cast<std::uint32_t>(s.base_id), s.node_id, can::Msg::kSetPose),
-          0x7FF, false});
+      so.filters.push_back(
+          drivers::CanFilter{protocol::frame_id(static_cast<std::uint32_t>(s.base_id), s.node_id,
+                                                protocol::Msg::kSetPose),
+                             0x7FF, false});
     auto bus = drivers::SocketCanBus::open(so);
     if (!bus) return std::move(bus).error();
     link->bus_ = std::move(bus).value();
     iface = s.interface;
   } else {
     auto port = std::make_unique<sim::SimCanPort>();
-    wire = port.get();
-    link->sim_port_ = wire;
+    port->connect_wire();  // an idle simulated bus: the wire takes every frame as it is sent
+    link->sim_port_ = port.get();
     link->bus_ = std::move(port);
     iface = "sim0";
   }
@@ -331,20 +299,20 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
   o.set_pose = s.set_pose;
   o.lossless_log = virtual_time;
   auto div = [&](double hz) {
-    const std::int64_t d = can::divisor_for(loop_hz, hz);
+    const std::int64_t d = protocol::divisor_for(loop_hz, hz);
     return d > 0 ? static_cast<std::uint32_t>(d) : 0u;
   };
   o.div = CanDivisors{div(s.pose_hz), div(s.velocity_hz), div(s.uncertainty_hz), div(s.status_hz),
                       div(s.timing_hz)};
-  link->bc_ = std::make_unique<CanBroadcaster>(o, *link->bus_, &loop, wire,
+  link->bc_ = std::make_unique<CanBroadcaster>(o, *link->bus_, &loop.commands(),
                                                link->log_ ? &link->log_->ring() : nullptr);
   if (!loop.add_observer(link->bc_.get()))
     return make_error(Errc::kInvalidArgument, "can: too many loop observers");
   char idtxt[16];
   std::snprintf(idtxt, sizeof idtxt, "0x%03X",
-                can::frame_id(o.base_id, o.node_id, can::Msg::kPoseX));
+                protocol::frame_id(o.base_id, o.node_id, protocol::Msg::kPoseX));
   link->describe_ =
-      (s.bus == "socketcan" ? "SocketCAN " + s.interface : std::string("simulated bus")) +
+      (s.bus == CanBusKind::kSocketCan ? "SocketCAN " + s.interface : std::string("simulated bus")) +
       ", node " + std::to_string(s.node_id) + ", ids from " + idtxt +
       (s.set_pose ? ", set-pose on" : ", set-pose off") +
       (can_log.empty() ? std::string() : ", log " + can_log);
@@ -359,7 +327,7 @@ void CanLink::close_log() {
   if (log_) log_->stop();
 }
 
-void CanLink::finish(const LoopSnapshot& snap) {
+void CanLink::finish(const loop::LoopSnapshot& snap) {
   send_final(snap);
   close_log();
 }

@@ -5,8 +5,8 @@
 #include <cstring>
 #include <sstream>
 
-#include "odo/firmware/can_protocol.hpp"
 #include "odo/firmware/toml_reader.hpp"
+#include "odo/protocol/can_protocol.hpp"
 
 namespace odo::fw {
 
@@ -41,13 +41,13 @@ void read_robot(TableReader t, KinematicParams& p) {
 }
 
 void read_encoder(TableReader t, EncoderSection& s) {
-  s.backend = t.choice("backend", s.backend, {"sim", "hctl1100", "gpio", "can"});
+  s.backend = t.choice("backend", s.backend);
   t.finish();
 }
 
 void read_sim(TableReader t, SimSection& s) {
-  s.robot = t.choice("robot", s.robot, {"labmate", "nominal"});
-  s.scenario = t.choice("scenario", s.scenario, {"square-ccw", "square-cw", "squares", "idle"});
+  s.robot = t.choice("robot", s.robot);
+  s.scenario = t.choice("scenario", s.scenario);
   s.side = t.number("side", s.side, 0.1, 100.0, "m");
   s.speed = t.number("speed", s.speed, 0.01, 5.0, "m/s");
   s.turn_rate = t.number("turn_rate", s.turn_rate, 0.05, 10.0, "rad/s");
@@ -67,12 +67,12 @@ void read_realtime(TableReader t, RealtimeSection& s) {
 
 void read_calibration(TableReader t, CalibrationSection& s) {
   s.store = t.string("store", s.store);
-  s.backend = t.choice("backend", s.backend, {"auto", "file", "nvmem", "mtd"});
+  s.backend = t.choice("backend", s.backend);
   t.finish();
 }
 
 void read_hctl1100(TableReader t, Hctl1100Section& s) {
-  s.bus = t.choice("bus", s.bus, {"gpio", "sim"});
+  s.bus = t.choice("bus", s.bus);
   s.chip = t.string("chip", s.chip);
   for (int i = 0; i < 8; ++i) {
     const std::string key = "ad" + std::to_string(i);
@@ -90,7 +90,7 @@ void read_hctl1100(TableReader t, Hctl1100Section& s) {
   s.max_attempts = static_cast<int>(t.integer("max_attempts", s.max_attempts, 2, 16));
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
   s.reverse_right = t.boolean("reverse_right", s.reverse_right);
-  s.latch = t.choice("latch", s.latch, {"none", "lsb"});
+  s.latch = t.choice("latch", s.latch);
   s.bus_cycle = t.number("bus_cycle", s.bus_cycle, 0.0, 1e-3, "s");
   t.finish();
 }
@@ -113,9 +113,9 @@ void read_gpio(TableReader t, GpioSection& s) {
 }
 
 void read_can_encoder(TableReader t, CanEncoderSection& s) {
-  s.bus = t.choice("bus", s.bus, {"socketcan", "sim"});
+  s.bus = t.choice("bus", s.bus);
   s.interface = t.string("interface", s.interface);
-  s.protocol = t.choice("protocol", s.protocol, {"odrive", "generic"});
+  s.protocol = t.choice("protocol", s.protocol);
   s.node_left = static_cast<int>(t.integer("node_left", s.node_left, 0, 63));
   s.node_right = static_cast<int>(t.integer("node_right", s.node_right, 0, 63));
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
@@ -137,12 +137,13 @@ void read_can_encoder(TableReader t, CanEncoderSection& s) {
   s.left_offset = static_cast<int>(t.integer("left_offset", s.left_offset, 0, 8 - bytes));
   s.right_offset = static_cast<int>(t.integer("right_offset", s.right_offset, 0, 8 - bytes));
   s.is_signed = t.boolean("signed", s.is_signed);
-  s.byte_order = t.choice("byte_order", s.byte_order, {"little", "big"});
-  if (s.protocol == "generic" && s.left_id == s.right_id && s.left_offset == s.right_offset)
+  s.byte_order = t.choice("byte_order", s.byte_order);
+  if (s.protocol == CanEncoderProtocol::kGeneric && s.left_id == s.right_id &&
+      s.left_offset == s.right_offset)
     t.reject("right_offset", "= " + std::to_string(s.right_offset) +
                                  ": both wheels would read the same bytes of frame " +
                                  std::to_string(s.left_id));
-  if (s.protocol == "odrive" && s.node_left == s.node_right)
+  if (s.protocol == CanEncoderProtocol::kOdrive && s.node_left == s.node_right)
     t.reject("node_right", "= " + std::to_string(s.node_right) +
                                " is the left wheel's node id too (they must differ)");
   s.sim_period = t.number("sim_period", s.sim_period, 0.001, 1.0, "s");
@@ -159,23 +160,24 @@ void read_error_model(TableReader t, ErrorModelParams& k) {
 
 // ---- [can] (CAN pose broadcast) ----
 void read_can(TableReader t, CanSection& s, double loop_hz) {
-  s.bus = t.choice("bus", s.bus, {"sim", "socketcan", "none"});
+  s.bus = t.choice("bus", s.bus);
   s.interface = t.string("interface", s.interface);
   if (s.interface.empty() || s.interface.size() > 15)
     t.reject("interface",
              "= \"" + s.interface + "\" must be 1..15 characters (a network interface)");
-  s.node_id = static_cast<int>(t.integer("node_id", s.node_id, 0, can::kMaxNodeId));
+  s.node_id = static_cast<int>(t.integer("node_id", s.node_id, 0, protocol::kMaxNodeId));
   s.base_id = static_cast<int>(t.integer("base_id", s.base_id, 0, 1024));
   if (s.base_id % 16 != 0)
     t.reject("base_id", "= " + std::to_string(s.base_id) + " must be a multiple of 16");
   // The ranges keep every node's block of 16 ids inside 11 bits.
-  static_assert(can::frame_id(1024, can::kMaxNodeId, can::Msg::kSetPose) + 7 <= 0x7FF);
+  static_assert(protocol::frame_id(1024, protocol::kMaxNodeId, protocol::Msg::kSetPose) + 7 <=
+                0x7FF);
   for (auto [key, rate] :
        {std::pair{"pose_hz", &s.pose_hz}, std::pair{"velocity_hz", &s.velocity_hz},
         std::pair{"uncertainty_hz", &s.uncertainty_hz}, std::pair{"status_hz", &s.status_hz},
         std::pair{"timing_hz", &s.timing_hz}}) {
     *rate = t.number(key, *rate, 0.0, 2000.0, "Hz");
-    if (t.ok() && can::divisor_for(loop_hz, *rate) < 0) {
+    if (t.ok() && protocol::divisor_for(loop_hz, *rate) < 0) {
       std::ostringstream o;
       o << "= " << *rate
         << " Hz must be 0 or loop.rate_hz / n for a whole n >= 1 (loop.rate_hz = " << loop_hz

@@ -14,15 +14,16 @@
 
 #include <nlohmann/json.hpp>
 
-#include "odo/firmware/calibration_io.hpp"
 #include "odo/firmware/calibration_reload.hpp"
+#include "odo/firmware/calibration_store.hpp"
 #include "odo/firmware/can_broadcast.hpp"
 #include "odo/firmware/config.hpp"
-#include "odo/firmware/loop.hpp"
 #include "odo/firmware/realtime_setup.hpp"
 #include "odo/firmware/rig.hpp"
 #include "odo/firmware/timing_report.hpp"
 #include "odo/firmware/watchdog.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/sim/truth.hpp"
 
 namespace odo::fw {
 namespace {
@@ -43,18 +44,29 @@ std::string flags_text(std::uint32_t f) {
   return s;
 }
 
-double position_error(const LoopSnapshot& s) {
-  return std::hypot(s.pose.x - s.truth.x, s.pose.y - s.truth.y);
+// counters_text: the cumulative encoder fault counters, once there is something to count (a
+// fault between two status lines would otherwise be invisible in the per-sample flags).
+std::string counters_text(const EncoderCounters& c) {
+  if (c.invalid_transitions + c.implausible_jumps + c.stale_events + c.read_errors == 0) return {};
+  char line[160];
+  std::snprintf(line, sizeof line, " (invalid=%llu jumps=%llu stale=%llu read_errors=%llu)",
+                static_cast<unsigned long long>(c.invalid_transitions),
+                static_cast<unsigned long long>(c.implausible_jumps),
+                static_cast<unsigned long long>(c.stale_events),
+                static_cast<unsigned long long>(c.read_errors));
+  return line;
 }
 
-void print_status(std::ostream& out, const LoopSnapshot& s, double rate_hz) {
+// print_status: one status line; `truth` is the simulation's newest sample (null: none).
+void print_status(std::ostream& out, const loop::LoopSnapshot& s, double rate_hz,
+                  const sim::TruthSample* truth) {
   char line[320];
   std::snprintf(line, sizeof line, "t=%7.2f s  x=%+8.4f m  y=%+8.4f m  th=%+8.2f deg  v=%+5.2f m/s",
                 to_seconds(s.loop_time), s.pose.x, s.pose.y, wrap_angle(s.pose.theta) * kRadToDeg,
                 s.v);
   out << line;
-  if (s.has_truth) {
-    std::snprintf(line, sizeof line, "  err=%6.2f mm", position_error(s) * 1e3);
+  if (truth != nullptr) {
+    std::snprintf(line, sizeof line, "  err=%6.2f mm", truth->position_error() * 1e3);
     out << line;
   }
   char timing[96];
@@ -62,208 +74,247 @@ void print_status(std::ostream& out, const LoopSnapshot& s, double rate_hz) {
                 format_timing_status(timing, sizeof timing, s.stats),
                 static_cast<unsigned long long>(s.stats.missed_deadlines),
                 flags_text(s.encoder_flags).c_str());
-  out << line;
-  // Cumulative encoder fault counters, once there is something to count (a fault between two
-  // status lines would otherwise be invisible in the per-sample flags).
-  const EncoderCounters& c = s.encoder_counters;
-  if (c.invalid_transitions + c.implausible_jumps + c.stale_events + c.read_errors > 0) {
-    std::snprintf(line, sizeof line, " (invalid=%llu jumps=%llu stale=%llu read_errors=%llu)",
-                  static_cast<unsigned long long>(c.invalid_transitions),
-                  static_cast<unsigned long long>(c.implausible_jumps),
-                  static_cast<unsigned long long>(c.stale_events),
-                  static_cast<unsigned long long>(c.read_errors));
-    out << line;
+  out << line << counters_text(s.encoder_counters) << std::endl;
+}
+
+nlohmann::json timing_json(const loop::TimingSummary& t) {
+  return {{"min", to_seconds(t.min)},
+          {"mean", to_seconds(t.mean)},
+          {"p99", to_seconds(t.p99)},
+          {"p999", to_seconds(t.p999)},
+          {"max", to_seconds(t.max)}};
+}
+
+nlohmann::json can_json(const CanLink& can) {
+  const CanBroadcastCounters& c = can.counters();
+  return {{"sent", c.sent},
+          {"dropped_queue_full", c.dropped_queue_full},
+          {"dropped_link_down", c.dropped_link_down},
+          {"dropped_error", c.dropped_error},
+          {"set_pose_applied", c.set_pose_applied},
+          {"set_pose_rejected", c.set_pose_rejected},
+          {"log_written", can.log_written()},
+          {"log_dropped", can.log_dropped()}};
+}
+
+// StatusPrinter: a thread that prints one status line every `period` [s] from the loop's newest
+// snapshot (and the simulation's truth, when there is one); the loop never waits for it.
+class StatusPrinter {
+ public:
+  StatusPrinter(std::ostream& log, double period, loop::OdometryLoop& loop,
+                sim::TruthRecorder* truth);
+  ~StatusPrinter();
+  StatusPrinter(const StatusPrinter&) = delete;
+  StatusPrinter& operator=(const StatusPrinter&) = delete;
+  // stop: ends and joins the thread (idempotent).
+  void stop();
+
+ private:
+  void run();
+  std::ostream& log_;
+  double period_;
+  loop::OdometryLoop& loop_;
+  sim::TruthRecorder* truth_;
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool done_ = false;
+  std::thread thread_;
+};
+
+// report_json: the --json object at exit.
+nlohmann::json report_json(const loop::LoopSnapshot& s, const loop::LoopStats& st,
+                           const sim::TruthSample* truth, const CanLink* can) {
+  nlohmann::json j;
+  j["x"] = s.pose.x;
+  j["y"] = s.pose.y;
+  j["theta"] = wrap_angle(s.pose.theta);
+  j["theta_cumulative"] = s.pose.theta;
+  j["distance"] = s.distance;
+  j["ticks"] = st.ticks;
+  j["loop_time"] = to_seconds(s.loop_time);
+  j["missed_deadlines"] = st.missed_deadlines;
+  j["wakeup_latency_max"] = to_seconds(st.wakeup_latency_max);
+  j["timing"]["wakeup_latency"] = timing_json(st.wakeup_latency);
+  j["timing"]["compute_time"] = timing_json(st.compute_time);
+  j["encoder_flags"] = s.encoder_flags;
+  j["invalid_transitions"] = s.encoder_counters.invalid_transitions;
+  j["implausible_jumps"] = s.encoder_counters.implausible_jumps;
+  j["stale_events"] = s.encoder_counters.stale_events;
+  j["read_errors"] = s.encoder_counters.read_errors;
+  j["calibration_state"] = static_cast<int>(s.calibration_state);
+  if (can != nullptr) j["can"] = can_json(*can);
+  if (truth != nullptr) {
+    j["truth"] = {
+        {"x", truth->truth.x}, {"y", truth->truth.y}, {"theta", wrap_angle(truth->truth.theta)}};
+    j["position_error"] = truth->position_error();
   }
-  out << std::endl;
+  return j;
 }
 
 }  // namespace
 
-int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& out,
-               std::ostream& err) {
-  // Human-readable progress goes to stderr when stdout carries JSON.
-  std::ostream& log = o.json ? err : out;
+// ---- StatusPrinter ----
+
+StatusPrinter::StatusPrinter(std::ostream& log, double period, loop::OdometryLoop& loop,
+                             sim::TruthRecorder* truth)
+    : log_(log), period_(period), loop_(loop), truth_(truth) {
+  thread_ = std::thread([this] { run(); });
+}
+
+StatusPrinter::~StatusPrinter() {
+  stop();
+}
+
+void StatusPrinter::stop() {
+  if (!thread_.joinable()) return;
+  {
+    std::lock_guard lk(m_);
+    done_ = true;
+  }
+  cv_.notify_all();
+  thread_.join();
+}
+
+void StatusPrinter::run() {
+  loop::LoopSnapshot s;
+  sim::TruthSample truth;
+  bool have_truth = false;
+  std::uint64_t last_tick = 0;
+  auto last = std::chrono::steady_clock::now();
+  std::unique_lock lk(m_);
+  const auto period = std::chrono::duration<double>(period_);
+  while (!cv_.wait_for(lk, period, [&] { return done_; })) {
+    if (!loop_.snapshots().latest(s)) continue;
+    if (truth_ != nullptr && truth_->latest(truth)) have_truth = true;
+    const auto now = std::chrono::steady_clock::now();
+    const double dt = std::chrono::duration<double>(now - last).count();
+    const double rate = dt > 0 ? static_cast<double>(s.tick - last_tick) / dt : 0.0;
+    last = now;
+    last_tick = s.tick;
+    print_status(log_, s, rate, have_truth ? &truth : nullptr);
+  }
+}
+
+// ---- Daemon ----
+
+Daemon::Daemon(const DaemonOptions& o, std::ostream& out, std::ostream& err)
+    : o_(o), out_(out), err_(err), log_(o.json ? err : out) {}
+
+Daemon::~Daemon() = default;
+
+int Daemon::fail(const std::string& message, int code) {
+  err_ << "odometryd: " << message << "\n";
+  return code;
+}
+
+int Daemon::configure() {
   Result<Config> cfg =
-      o.config_path.empty() ? Result<Config>(default_config()) : load_config(o.config_path);
-  if (!cfg) {
-    err << "odometryd: " << cfg.error().message << "\n";
-    return 2;
-  }
-  auto kin = Kinematics::create(cfg->robot);
-  if (!kin) {
-    err << "odometryd: " << cfg->source << ": robot: " << kin.error().message << "\n";
-    return 2;
-  }
+      o_.config_path.empty() ? Result<Config>(default_config()) : load_config(o_.config_path);
+  if (!cfg) return fail(cfg.error().message);
+  cfg_ = std::make_unique<Config>(std::move(cfg).value());
+  auto kin = Kinematics::create(cfg_->robot);
+  if (!kin) return fail(cfg_->source + ": robot: " + kin.error().message);
   // The store's corrections on top of the nominal robot (the rig keeps the nominal one).
-  const AppliedCalibration cal =
-      read_and_apply(cfg->robot, cfg->calibration.store, cfg->calibration.backend);
-  (cal.state == 2 ? err : log) << "odometryd: " << cal.report << "\n";
-  auto calibrated = Kinematics::create(cal.params);
+  cal_ = std::make_unique<AppliedCalibration>(
+      read_and_apply(cfg_->robot, cfg_->calibration.store, cfg_->calibration.backend));
+  (cal_->state == calib::StoreStatus::kCorrupt ? err_ : log_)
+      << "odometryd: " << cal_->report << "\n";
+  auto calibrated = Kinematics::create(cal_->params);
   if (!calibrated) calibrated = *kin;
-  auto rig = Rig::create(*cfg, *kin, o.virtual_time);
-  if (!rig) {
-    err << "odometryd: " << rig.error().message << "\n";
-    return 2;
-  }
-  LoopConfig lc;
-  lc.rate_hz = cfg->loop.rate_hz;
-  lc.error_model = cfg->error_model;
-  auto created = OdometryLoop::create(lc, *calibrated, rig->encoder(), rig->clock());
-  if (!created) {
-    err << "odometryd: " << cfg->source << ": " << created.error().message << "\n";
-    return 2;
-  }
-  std::unique_ptr<OdometryLoop> loop = std::move(created).value();
-  if (TickObserver* t = rig->truth_observer()) loop->add_observer(t);
-  CalibrationHandover cal_handover(cal.state);
-  cal_handover.attach(loop.get());
-  loop->add_observer(&cal_handover);
-  // CAN pose broadcast ([can], --can-log): an observer after the calibration hand-over, so the
-  // status frame carries this tick's calibration state.
-  auto can_link = CanLink::create(cfg->can, cfg->loop.rate_hz, *loop, o.can_log, o.virtual_time);
-  if (!can_link) {
-    err << "odometryd: " << cfg->source << ": " << can_link.error().message << "\n";
-    return 2;
-  }
-  std::unique_ptr<CanLink> can = std::move(can_link).value();
-  CalibrationReloader reloader(cal_handover, cfg->robot, cfg->calibration.store,
-                               cfg->calibration.backend, log);
-  if (o.reload != nullptr) reloader.start(*o.reload);
+  auto rig = Rig::create(*cfg_, *kin, o_.virtual_time);
+  if (!rig) return fail(rig.error().message);
+  rig_ = std::make_unique<Rig>(std::move(rig).value());
+  loop::LoopConfig lc;
+  lc.rate_hz = cfg_->loop.rate_hz;
+  lc.error_model = cfg_->error_model;
+  lc.calibration = cal_->state;
+  auto created = loop::OdometryLoop::create(lc, *calibrated, rig_->encoder(), rig_->clock());
+  if (!created) return fail(cfg_->source + ": " + created.error().message);
+  loop_ = std::move(created).value();
+  if (sim::TruthRecorder* t = rig_->truth()) loop_->add_observer(t);
+  // CAN pose broadcast ([can], --can-log).
+  auto can = CanLink::create(cfg_->can, cfg_->loop.rate_hz, *loop_, o_.can_log, o_.virtual_time);
+  if (!can) return fail(cfg_->source + ": " + can.error().message);
+  can_ = std::move(can).value();
+  reloader_ = std::make_unique<CalibrationReloader>(
+      loop_->commands(), cfg_->robot, cfg_->calibration.store, cfg_->calibration.backend, log_);
+  if (o_.reload != nullptr) reloader_->start(*o_.reload);
+  report_start(calibrated->params());
+  return 0;
+}
 
-  const KinematicParams& p = calibrated->params();
-  log << "odometryd: config " << cfg->source << "\n"
-      << "odometryd: encoders: " << rig->describe() << "\n"
-      << "odometryd: kinematics: Dn=" << p.wheel_diameter << " m, Ce=" << p.counts_per_rev
-      << ", n=" << p.gear_ratio << ", b=" << p.wheelbase << " m, c_l=" << p.c_l << ", c_r=" << p.c_r
-      << (cal.state == 1 ? " (calibrated)\n" : " (nominal values from the config)\n")
-      << "odometryd: can: " << (can ? can->describe() : std::string("off")) << "\n"
-      << "odometryd: loop " << cfg->loop.rate_hz << " Hz on "
-      << (o.virtual_time ? "virtual time" : "CLOCK_MONOTONIC") << std::endl;
+void Daemon::report_start(const KinematicParams& p) {
+  log_ << "odometryd: config " << cfg_->source << "\n"
+       << "odometryd: encoders: " << rig_->describe() << "\n"
+       << "odometryd: kinematics: Dn=" << p.wheel_diameter << " m, Ce=" << p.counts_per_rev
+       << ", n=" << p.gear_ratio << ", b=" << p.wheelbase << " m, c_l=" << p.c_l
+       << ", c_r=" << p.c_r
+       << (cal_->state == calib::StoreStatus::kOk ? " (calibrated)\n"
+                                                  : " (nominal values from the config)\n")
+       << "odometryd: can: " << (can_ ? can_->describe() : std::string("off")) << "\n"
+       << "odometryd: loop " << cfg_->loop.rate_hz << " Hz on "
+       << (o_.virtual_time ? "virtual time" : "CLOCK_MONOTONIC") << std::endl;
+}
 
-  double duration = o.duration;
-  if (duration <= 0.0 && o.virtual_time) duration = rig->scenario_duration() + 1.0;
-
+int Daemon::run(std::atomic<bool>& stop) {
+  double duration = o_.duration;
+  if (duration <= 0.0 && o_.virtual_time) duration = rig_->scenario_duration() + 1.0;
   // Status printer: its own thread, so the loop never blocks on a terminal or pipe.
-  std::mutex m;
-  std::condition_variable cv;
-  bool done = false;
-  std::thread status;
-  const bool want_status = !o.quiet && cfg->loop.status_period > 0.0 && !o.virtual_time;
-  if (want_status) {
-    status = std::thread([&] {
-      LoopSnapshot s;
-      std::uint64_t last_tick = 0;
-      auto last = std::chrono::steady_clock::now();
-      std::unique_lock lk(m);
-      const auto period = std::chrono::duration<double>(cfg->loop.status_period);
-      while (!cv.wait_for(lk, period, [&] { return done; })) {
-        if (!loop->snapshots().latest(s)) continue;
-        const auto now = std::chrono::steady_clock::now();
-        const double dt = std::chrono::duration<double>(now - last).count();
-        const double rate = dt > 0 ? static_cast<double>(s.tick - last_tick) / dt : 0.0;
-        last = now;
-        last_tick = s.tick;
-        print_status(log, s, rate);
-      }
-    });
-  }
-
-  auto stop_status = [&] {
-    if (!status.joinable()) return;
-    {
-      std::lock_guard lk(m);
-      done = true;
-    }
-    cv.notify_all();
-    status.join();
-  };
-
+  std::unique_ptr<StatusPrinter> status;
+  if (!o_.quiet && cfg_->loop.status_period > 0.0 && !o_.virtual_time)
+    status = std::make_unique<StatusPrinter>(log_, cfg_->loop.status_period, *loop_, rig_->truth());
   // systemd: READY=1 after the first tick, WATCHDOG=1 only while the tick counter advances.
-  auto watchdog = LoopWatchdog::from_environment([&l = *loop] { return l.heartbeat(); });
+  auto watchdog = LoopWatchdog::from_environment([&l = *loop_] { return l.heartbeat(); });
   if (watchdog->enabled()) {
-    log << "odometryd: systemd notify: on, watchdog "
-        << (watchdog->interval() > 0 ? std::to_string(to_seconds(watchdog->interval())) + " s"
-                                     : std::string("off"))
-        << std::endl;
+    log_ << "odometryd: systemd notify: on, watchdog "
+         << (watchdog->interval() > 0 ? std::to_string(to_seconds(watchdog->interval())) + " s"
+                                      : std::string("off"))
+         << std::endl;
   }
   // The loop runs on this thread: real-time set-up after the status thread started, so that
   // thread keeps normal scheduling.
-  if (!setup_realtime(cfg->realtime, o.virtual_time, log, err)) {
-    stop_status();
-    return 1;
-  }
+  if (!setup_realtime(cfg_->realtime, o_.virtual_time, log_, err_)) return 1;
   watchdog->start();
-  if (can) {
+  if (can_) {
     timespec wall{};
     clock_gettime(CLOCK_REALTIME, &wall);
-    can->start(static_cast<std::int64_t>(wall.tv_sec) * kNsPerSecond + wall.tv_nsec);
+    can_->start(static_cast<std::int64_t>(wall.tv_sec) * kNsPerSecond + wall.tv_nsec);
   }
-  loop->run(from_seconds(duration), stop);
+  loop_->run(from_seconds(duration), stop);
   // Clean stop (signal or end of --duration): the final pose and a status frame that says so.
-  if (can) can->finish(loop->snapshot());
+  if (can_) can_->finish(loop_->snapshot());
   watchdog->stop();
-  reloader.stop();
-  stop_status();
+  reloader_->stop();
+  return 0;
+}
 
-  const LoopSnapshot& s = loop->snapshot();
-  const LoopStats& st = loop->stats();
+void Daemon::report() {
+  const loop::LoopSnapshot& s = loop_->snapshot();
+  const loop::LoopStats& st = loop_->stats();
+  const sim::TruthSample* truth = rig_->truth() ? &rig_->truth()->newest() : nullptr;
   const double loop_s = to_seconds(s.loop_time);
   const double mean_rate = loop_s > 0 ? static_cast<double>(st.ticks) / loop_s : 0.0;
-  log << "odometryd: stopped after " << st.ticks << " ticks (" << loop_s << " s of loop time, "
-      << std::fixed << std::setprecision(1) << mean_rate << " Hz), missed deadlines "
-      << st.missed_deadlines << "\n"
-      << std::setprecision(4) << "odometryd: final pose x=" << s.pose.x << " m y=" << s.pose.y
-      << " m theta=" << wrap_angle(s.pose.theta) * kRadToDeg << " deg";
-  if (s.has_truth) {
-    log << "; ground truth x=" << s.truth.x << " m y=" << s.truth.y
-        << " m theta=" << wrap_angle(s.truth.theta) * kRadToDeg << " deg; position error "
-        << std::setprecision(2) << position_error(s) * 1e3 << " mm";
+  log_ << "odometryd: stopped after " << st.ticks << " ticks (" << loop_s << " s of loop time, "
+       << std::fixed << std::setprecision(1) << mean_rate << " Hz), missed deadlines "
+       << st.missed_deadlines << "\n"
+       << std::setprecision(4) << "odometryd: final pose x=" << s.pose.x << " m y=" << s.pose.y
+       << " m theta=" << wrap_angle(s.pose.theta) * kRadToDeg << " deg";
+  if (truth != nullptr) {
+    log_ << "; ground truth x=" << truth->truth.x << " m y=" << truth->truth.y
+         << " m theta=" << wrap_angle(truth->truth.theta) * kRadToDeg << " deg; position error "
+         << std::setprecision(2) << truth->position_error() * 1e3 << " mm";
   }
-  log << std::defaultfloat << std::setprecision(6) << std::endl;
-  if (o.stats) print_timing_stats(log, st, loop->period());
+  log_ << std::defaultfloat << std::setprecision(6) << std::endl;
+  if (o_.stats) print_timing_stats(log_, st, loop_->period());
+  if (o_.json) out_ << report_json(s, st, truth, can_.get()).dump() << std::endl;
+}
 
-  if (o.json) {
-    nlohmann::json j;
-    j["x"] = s.pose.x;
-    j["y"] = s.pose.y;
-    j["theta"] = wrap_angle(s.pose.theta);
-    j["theta_cumulative"] = s.pose.theta;
-    j["distance"] = s.distance;
-    j["ticks"] = st.ticks;
-    j["loop_time"] = loop_s;
-    j["missed_deadlines"] = st.missed_deadlines;
-    j["wakeup_latency_max"] = to_seconds(st.wakeup_latency_max);
-    for (const auto& [name, t] : {std::pair{"wakeup_latency", &st.wakeup_latency},
-                                  std::pair{"compute_time", &st.compute_time}}) {
-      j["timing"][name] = {{"min", to_seconds(t->min)},
-                           {"mean", to_seconds(t->mean)},
-                           {"p99", to_seconds(t->p99)},
-                           {"p999", to_seconds(t->p999)},
-                           {"max", to_seconds(t->max)}};
-    }
-    j["encoder_flags"] = s.encoder_flags;
-    j["invalid_transitions"] = s.encoder_counters.invalid_transitions;
-    j["implausible_jumps"] = s.encoder_counters.implausible_jumps;
-    j["stale_events"] = s.encoder_counters.stale_events;
-    j["read_errors"] = s.encoder_counters.read_errors;
-    j["calibration_state"] = s.calibration_state;
-    if (can) {
-      const CanBroadcastCounters& c = can->counters();
-      j["can"] = {{"sent", c.sent},
-                  {"dropped_queue_full", c.dropped_queue_full},
-                  {"dropped_link_down", c.dropped_link_down},
-                  {"dropped_error", c.dropped_error},
-                  {"set_pose_applied", c.set_pose_applied},
-                  {"set_pose_rejected", c.set_pose_rejected},
-                  {"log_written", can->log_written()},
-                  {"log_dropped", can->log_dropped()}};
-    }
-    if (s.has_truth) {
-      j["truth"] = {{"x", s.truth.x}, {"y", s.truth.y}, {"theta", wrap_angle(s.truth.theta)}};
-      j["position_error"] = position_error(s);
-    }
-    out << j.dump() << std::endl;
-  }
+int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& out,
+               std::ostream& err) {
+  Daemon d(o, out, err);
+  if (const int rc = d.configure(); rc != 0) return rc;
+  if (const int rc = d.run(stop); rc != 0) return rc;
+  d.report();
   return 0;
 }
 

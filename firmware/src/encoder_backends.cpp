@@ -64,8 +64,8 @@ class HctlGpioBackend final : public EncoderBackend {
 class HctlSimBackend final : public EncoderBackend, public sim::BusCycleHook {
  public:
   HctlSimBackend(const Hctl1100Section& s, sim::SimRobot& robot, Clock& clock, TimeNs epoch)
-      : left_(s.latch == "lsb" ? sim::Hctl1100Model::Latch::kLsbLatch
-                               : sim::Hctl1100Model::Latch::kNone),
+      : left_(s.latch == HctlLatch::kLsb ? sim::Hctl1100Model::Latch::kLsbLatch
+                                         : sim::Hctl1100Model::Latch::kNone),
         right_(left_),
         bus_(&left_, &right_),
         robot_(robot),
@@ -179,7 +179,7 @@ std::string layout_text(const drivers::CanCountLayout& l) {
 
 std::string can_text(const CanEncoderSection& s, const drivers::CanEncoderConfig& c) {
   std::ostringstream d;
-  if (s.protocol == "odrive")
+  if (s.protocol == CanEncoderProtocol::kOdrive)
     d << "ODrive CAN Simple encoder counts (nodes " << s.node_left << "/" << s.node_right << ", ";
   else
     d << "generic CAN counts (";
@@ -195,7 +195,7 @@ std::string can_text(const CanEncoderSection& s, const drivers::CanEncoderConfig
 
 drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const KinematicParams& p) {
   drivers::CanEncoderConfig c;
-  if (s.protocol == "odrive") {
+  if (s.protocol == CanEncoderProtocol::kOdrive) {
     c.left = drivers::odrive_count_layout(static_cast<std::uint32_t>(s.node_left));
     c.right = drivers::odrive_count_layout(static_cast<std::uint32_t>(s.node_right));
   } else {
@@ -206,15 +206,13 @@ drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const K
       l.byte_offset = i == 0 ? s.left_offset : s.right_offset;
       l.width_bits = s.width;
       l.is_signed = s.is_signed;
-      l.big_endian = s.byte_order == "big";
+      l.big_endian = s.byte_order == ByteOrder::kBig;
     }
   }
   c.reverse_left = s.reverse_left;
   c.reverse_right = s.reverse_right;
   c.timeout = from_seconds(s.timeout);
-  // Counts per metre of wheel travel: Ce * n / (pi * Dn).
-  c.max_counts_per_s =
-      s.max_speed * p.counts_per_rev * p.gear_ratio / (std::numbers::pi * p.wheel_diameter);
+  c.max_counts_per_s = s.max_speed * counts_per_metre(p);
   c.max_frames_per_read = s.max_frames_per_read;
   c.request_period = s.request_rate > 0 ? from_seconds(1.0 / s.request_rate) : 0;
   return c;
@@ -243,7 +241,7 @@ Result<std::unique_ptr<EncoderBackend>> make_can_socketcan_backend(const Config&
 Result<std::unique_ptr<EncoderBackend>> make_can_sim_backend(const Config& cfg, const Kinematics& k,
                                                              sim::SimRobot& robot, TimeNs epoch) {
   const CanEncoderSection& s = cfg.can_encoder;
-  if (s.protocol != "odrive")
+  if (s.protocol != CanEncoderProtocol::kOdrive)
     return make_error(Errc::kInvalidArgument,
                       cfg.source +
                           ": [can_encoder] bus = \"sim\" simulates ODrive controllers: "
@@ -260,8 +258,7 @@ Result<std::unique_ptr<EncoderBackend>> make_can_sim_backend(const Config& cfg, 
 }
 
 double max_counts_per_s(const Hctl1100Section& s, const KinematicParams& p) {
-  // Counts per metre of wheel travel: Ce * n / (pi * Dn).
-  return s.max_speed * p.counts_per_rev * p.gear_ratio / (std::numbers::pi * p.wheel_diameter);
+  return s.max_speed * counts_per_metre(p);
 }
 
 Result<std::unique_ptr<EncoderBackend>> make_gpio_backend(const Config& cfg) {
@@ -316,7 +313,7 @@ Result<std::unique_ptr<EncoderBackend>> make_hctl_sim_backend(const Config& cfg,
   auto enc = drivers::Hctl1100Encoder::create(b->bus(), driver_config(s, k));
   if (!enc) return in_file(cfg, "hctl1100", std::move(enc).error());
   std::ostringstream d;
-  d << "2 x HCTL-1100 register model (24-bit, latch " << s.latch << ", bus cycle "
+  d << "2 x HCTL-1100 register model (24-bit, latch " << name_of(s.latch) << ", bus cycle "
     << s.bus_cycle * 1e6 << " us) following the simulated robot";
   b->set_encoder(std::move(enc).value(), d.str());
   return std::unique_ptr<EncoderBackend>(std::move(b));

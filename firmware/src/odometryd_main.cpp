@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "odo/firmware/cli_parse.hpp"
 #include "odo/firmware/daemon.hpp"
 #include "odo/firmware/version.hpp"
 
@@ -36,18 +37,7 @@ int main(int argc, char** argv) {
                "print wake-up latency and compute time statistics (min, mean, p99, p99.9, max) "
                "and missed deadlines at exit");
   app.set_version_flag("--version", std::string("odometryd ") + odo::fw::kVersion);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "odometryd: " << e.what() << "\n";
-    return 2;
-  }
+  if (auto rc = odo::fw::parse_command_line(app, argc, argv, "odometryd")) return *rc;
   struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
   sigemptyset(&sa.sa_mask);

@@ -6,47 +6,12 @@
 #include "odo/drivers/monotonic_clock.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_encoder.hpp"
+#include "odo/sim/truth.hpp"
 #include "odo/sim/virtual_clock.hpp"
 
 namespace odo::fw {
 
 namespace {
-
-// TruthObserver: copies the simulator's exact pose into every snapshot.
-class TruthObserver final : public TickObserver {
- public:
-  explicit TruthObserver(const sim::SimRobot& robot) : robot_(robot) {}
-  void on_tick(LoopSnapshot& snap) noexcept override {
-    snap.has_truth = true;
-    snap.truth = robot_.true_pose();
-  }
-
- private:
-  const sim::SimRobot& robot_;
-};
-
-// EpochEncoder: the simulated encoders on a real clock, with the robot's time zero at the first
-// read (the loop's reference reading), so the robot does not drive off during start-up while
-// the odometry is not yet counting (seen as a 36 mm error after a 0.18 s start in the VM).
-class EpochEncoder final : public EncoderSource {
- public:
-  explicit EpochEncoder(sim::SimEncoderSource& inner) : inner_(inner) {}
-  EncoderSample read(TimeNs now) noexcept override {
-    if (!started_) {
-      epoch_ = now;
-      started_ = true;
-    }
-    EncoderSample s = inner_.read(now - epoch_);
-    s.stamp = now;
-    return s;
-  }
-  int counter_bits() const noexcept override { return inner_.counter_bits(); }
-
- private:
-  sim::SimEncoderSource& inner_;
-  TimeNs epoch_ = 0;
-  bool started_ = false;
-};
 
 sim::Scenario make_scenario(const SimSection& s, const Kinematics& k) {
   sim::SquareOptions o;
@@ -60,8 +25,9 @@ sim::Scenario make_scenario(const SimSection& s, const Kinematics& k) {
     const sim::Scenario sq = sim::square_scenario(k, o);
     out.insert(out.end(), sq.begin(), sq.end());
   };
-  if (s.scenario == "square-ccw" || s.scenario == "squares") add(sim::Turn::kCounterClockwise);
-  if (s.scenario == "square-cw" || s.scenario == "squares") add(sim::Turn::kClockwise);
+  const bool both = s.scenario == SimScenario::kSquares;
+  if (both || s.scenario == SimScenario::kSquareCcw) add(sim::Turn::kCounterClockwise);
+  if (both || s.scenario == SimScenario::kSquareCw) add(sim::Turn::kClockwise);
   return out;
 }
 
@@ -73,7 +39,7 @@ struct Rig::Impl {
   std::unique_ptr<sim::SimEncoderSource> sim_encoder;
   std::unique_ptr<EncoderSource> encoder_wrapper;
   EncoderSource* encoder = nullptr;
-  std::unique_ptr<TruthObserver> truth;
+  std::unique_ptr<sim::TruthRecorder> truth;
   std::unique_ptr<EncoderBackend> backend;  // hctl1100 / gpio (encoder_backends.hpp)
   std::string description;
   double scenario_duration = 0.0;
@@ -90,7 +56,7 @@ Clock& Rig::clock() noexcept {
 EncoderSource& Rig::encoder() noexcept {
   return *impl_->encoder;
 }
-TickObserver* Rig::truth_observer() noexcept {
+sim::TruthRecorder* Rig::truth() noexcept {
   return impl_->truth.get();
 }
 const std::string& Rig::describe() const noexcept {
@@ -102,18 +68,18 @@ double Rig::scenario_duration() const noexcept {
 
 Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_time) {
   auto impl = std::make_unique<Impl>();
-  const std::string& be = cfg.encoder.backend;
-  const bool hctl_sim = be == "hctl1100" && cfg.hctl1100.bus == "sim";
-  const bool can_sim = be == "can" && cfg.can_encoder.bus == "sim";
-  if (be == "gpio" || (be == "hctl1100" && !hctl_sim) || (be == "can" && !can_sim)) {
+  const EncoderKind be = cfg.encoder.backend;
+  const bool hctl_sim = be == EncoderKind::kHctl1100 && cfg.hctl1100.bus == HctlBus::kSim;
+  const bool can_sim = be == EncoderKind::kCan && cfg.can_encoder.bus == CanEncoderBus::kSim;
+  if (be != EncoderKind::kSim && !hctl_sim && !can_sim) {
     if (virtual_time)
       return make_error(Errc::kInvalidArgument,
                         "--virtual-time needs a simulated encoder "
                         "backend (encoder.backend = \"" +
-                            be + "\")");
-    auto b = be == "gpio"       ? make_gpio_backend(cfg)
-             : be == "hctl1100" ? make_hctl_gpio_backend(cfg, k)
-                                : make_can_socketcan_backend(cfg, k);
+                            std::string(name_of(be)) + "\")");
+    auto b = be == EncoderKind::kGpio       ? make_gpio_backend(cfg)
+             : be == EncoderKind::kHctl1100 ? make_hctl_gpio_backend(cfg, k)
+                                            : make_can_socketcan_backend(cfg, k);
     if (!b) return std::move(b).error();
     impl->backend = std::move(b).value();
     impl->clock = std::make_unique<drivers::MonotonicClock>();
@@ -121,16 +87,11 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     impl->description = impl->backend->describe() + ", real time (CLOCK_MONOTONIC)";
     return Rig(std::move(impl));
   }
-  if (be != "sim" && !hctl_sim && !can_sim) {
-    return make_error(Errc::kUnsupported, cfg.source + ": encoder.backend = \"" +
-                                              cfg.encoder.backend +
-                                              "\" is not available in this build yet");
-  }
   const KinematicParams& p = k.params();
   sim::RobotGeometry g;
   g.counts_per_rev = p.counts_per_rev;
   g.gear_ratio = p.gear_ratio;
-  if (cfg.sim.robot == "labmate") {
+  if (cfg.sim.robot == SimRobotKind::kLabmate) {
     const sim::RobotGeometry lm = sim::labmate_geometry(p.wheel_diameter);
     g.wheel_diameter_left = lm.wheel_diameter_left;
     g.wheel_diameter_right = lm.wheel_diameter_right;
@@ -150,7 +111,7 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     impl->encoder = impl->sim_encoder.get();
   } else {
     impl->clock = std::make_unique<drivers::MonotonicClock>();
-    impl->encoder_wrapper = std::make_unique<EpochEncoder>(*impl->sim_encoder);
+    impl->encoder_wrapper = std::make_unique<sim::EpochEncoder>(*impl->sim_encoder);
     impl->encoder = impl->encoder_wrapper.get();
   }
   if (hctl_sim) {
@@ -167,12 +128,13 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     impl->backend = std::move(b).value();
     impl->encoder = &impl->backend->encoder();
   }
-  impl->truth = std::make_unique<TruthObserver>(*impl->robot);
+  impl->truth = std::make_unique<sim::TruthRecorder>(*impl->robot);
   std::ostringstream d;
-  d << "simulated robot '" << cfg.sim.robot << "' (true wheelbase " << g.wheelbase * 1e3
+  d << "simulated robot '" << name_of(cfg.sim.robot) << "' (true wheelbase " << g.wheelbase * 1e3
     << " mm, D_R/D_L " << g.wheel_diameter_right / g.wheel_diameter_left << "), scenario '"
-    << cfg.sim.scenario << "' (" << impl->scenario_duration << " s), " << cfg.sim.counter_bits
-    << "-bit counters, " << (hctl_sim || can_sim ? impl->backend->describe() + ", " : std::string())
+    << name_of(cfg.sim.scenario) << "' (" << impl->scenario_duration << " s), "
+    << cfg.sim.counter_bits << "-bit counters, "
+    << (hctl_sim || can_sim ? impl->backend->describe() + ", " : std::string())
     << (virtual_time ? "virtual time" : "real time (CLOCK_MONOTONIC)");
   impl->description = d.str();
   return Rig(std::move(impl));

@@ -10,7 +10,7 @@ double us(TimeNs ns) {
   return static_cast<double>(ns) * 1e-3;
 }
 
-void row(std::ostream& out, const char* name, const TimingSummary& s) {
+void row(std::ostream& out, const char* name, const loop::TimingSummary& s) {
   char line[160];
   std::snprintf(line, sizeof line, "  %-16s %10.1f %10.1f %10.1f %10.1f %10.1f\n", name, us(s.min),
                 us(s.mean), us(s.p99), us(s.p999), us(s.max));
@@ -19,7 +19,7 @@ void row(std::ostream& out, const char* name, const TimingSummary& s) {
 
 }  // namespace
 
-void print_timing_stats(std::ostream& out, const LoopStats& st, TimeNs period) {
+void print_timing_stats(std::ostream& out, const loop::LoopStats& st, TimeNs period) {
   char head[200];
   std::snprintf(head, sizeof head,
                 "odometryd: timing over %llu ticks (period %.3f ms), missed deadlines %llu\n"
@@ -33,7 +33,7 @@ void print_timing_stats(std::ostream& out, const LoopStats& st, TimeNs period) {
   out.flush();
 }
 
-const char* format_timing_status(char* buf, std::size_t size, const LoopStats& st) noexcept {
+const char* format_timing_status(char* buf, std::size_t size, const loop::LoopStats& st) noexcept {
   std::snprintf(buf, size, "lat p99/max=%.0f/%.0f us  cmp p99=%.1f us", us(st.wakeup_latency.p99),
                 us(st.wakeup_latency_max), us(st.compute_time.p99));
   return buf;

@@ -1,5 +1,7 @@
 #include "odo/firmware/toml_reader.hpp"
 
+#include "odo/hal/field_range.hpp"
+
 #include <cmath>
 #include <sstream>
 
@@ -48,10 +50,7 @@ double TableReader::number(std::string_view key, double def, double lo, double h
     return def;
   }
   if (!std::isfinite(v) || v < lo || v > hi) {
-    std::ostringstream o;
-    o << "= " << v << " is outside the allowed range [" << lo << ", " << hi << "]"
-      << (unit.empty() ? "" : " ") << unit;
-    fail(n, key, o.str());
+    fail(n, key, range_text({std::string(key), v, lo, hi, std::string(unit), false}));
     return def;
   }
   return v;
@@ -97,17 +96,10 @@ std::string TableReader::string(std::string_view key, std::string def) {
   return *s;
 }
 
-std::string TableReader::choice(std::string_view key, std::string def,
-                                std::initializer_list<std::string_view> allowed) {
+void TableReader::reject_choice(std::string_view key, const std::string& v,
+                                const std::string& list) {
   const toml::node* n = table_ != nullptr ? table_->get(key) : nullptr;
-  std::string v = string(key, def);
-  for (std::string_view a : allowed) {
-    if (v == a) return v;
-  }
-  std::string list;
-  for (std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
   fail(n, key, "= \"" + v + "\" is not one of: " + list);
-  return def;
 }
 
 TableReader TableReader::sub(std::string_view key) {

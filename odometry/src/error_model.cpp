@@ -154,16 +154,17 @@ inline BasicFunctions closed_form(double phi) noexcept {
 
 }  // namespace
 
+std::optional<FieldRange> error_model_range(const ErrorModelParams& k) {
+  for (const auto& [field, v] : {std::pair{"k_left", k.k_left}, std::pair{"k_right", k.k_right}}) {
+    if (!(std::isfinite(v) && v >= 0.0 && v <= kErrorModelKMax))
+      return FieldRange{field, v, 0.0, kErrorModelKMax, "m^(1/2)"};
+  }
+  return std::nullopt;
+}
+
 Status check_error_model(const ErrorModelParams& k) {
-  auto check = [](const char* field, double v) -> Status {
-    if (std::isfinite(v) && v >= 0.0 && v <= kErrorModelKMax) return Ok{};
-    std::ostringstream m;
-    m << field << " = " << v << " m^(1/2) is outside the allowed range [0, " << kErrorModelKMax
-      << "] m^(1/2)";
-    return make_error(Errc::kInvalidArgument, m.str());
-  };
-  if (auto s = check("k_left", k.k_left); !s) return s;
-  return check("k_right", k.k_right);
+  if (auto r = error_model_range(k)) return make_error(Errc::kInvalidArgument, range_message(*r));
+  return Ok{};
 }
 
 ArcTerms arc_terms(double phi) noexcept {

@@ -1,5 +1,7 @@
 #include "odo/odometry/kinematics.hpp"
 
+#include "odo/hal/field_range.hpp"
+
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -11,8 +13,7 @@ namespace {
 bool check_range(std::ostringstream& msg, const char* field, const char* unit, double v, double lo,
                  double hi) {
   if (std::isfinite(v) && v >= lo && v <= hi) return true;
-  msg << field << " = " << v << (unit[0] ? " " : "") << unit << " is outside the allowed range ["
-      << lo << ", " << hi << "]" << (unit[0] ? " " : "") << unit;
+  msg << range_message({field, v, lo, hi, unit});
   return false;
 }
 
@@ -31,6 +32,10 @@ Result<Kinematics> Kinematics::create(const KinematicParams& p) {
                   check_range(msg, "c_r", "", p.c_r, 0.5, 1.5);
   if (!ok) return make_error(Errc::kInvalidArgument, msg.str());
   return Kinematics(p);
+}
+
+double counts_per_metre(const KinematicParams& p) noexcept {
+  return p.counts_per_rev * p.gear_ratio / (std::numbers::pi * p.wheel_diameter);
 }
 
 Kinematics::Kinematics(const KinematicParams& p) : p_(p) {

@@ -27,7 +27,7 @@ CanTx SimCanPort::send(const CanFrame& f) noexcept {
     ++counters_.tx_down;
     return CanTx::kLinkDown;
   }
-  if (!tx_.push(f)) {
+  if (!wire_ && !tx_.push(f)) {
     ++counters_.tx_full;
     return CanTx::kQueueFull;
   }

@@ -6,7 +6,7 @@
 #include <cstdint>
 
 #include "odo/drivers/quad_tracker.hpp"
-#include "odo/firmware/can_protocol.hpp"
+#include "odo/protocol/can_protocol.hpp"
 #include "odo/hal/can_bus.hpp"
 #include "odo/hal/quadrature.hpp"
 
@@ -42,12 +42,12 @@ BENCHMARK(BM_QuadTrackerEdge);
 
 // The pose group of one tick: PoseX + PoseYTheta (the two frames sent together).
 void BM_CanEncodePoseGroup(benchmark::State& state) {
-  odo::fw::can::PoseMsg p{1234.5678, -87.6543, 7.25, 0};
+  odo::protocol::PoseMsg p{1234.5678, -87.6543, 7.25, 0};
   odo::CanFrame a, b;
   for (auto _ : state) {
     ++p.seq;
-    odo::fw::can::encode_pose_x(0x410, p, a);
-    odo::fw::can::encode_pose_y_theta(0x411, p, b);
+    odo::protocol::encode_pose_x(0x410, p, a);
+    odo::protocol::encode_pose_y_theta(0x411, p, b);
     benchmark::DoNotOptimize(a);
     benchmark::DoNotOptimize(b);
   }
@@ -56,20 +56,20 @@ BENCHMARK(BM_CanEncodePoseGroup);
 
 // Every broadcast frame of one tick: pose group, velocity, uncertainty, status, timing.
 void BM_CanEncodeAllFrames(benchmark::State& state) {
-  odo::fw::can::PoseMsg p{1234.5678, -87.6543, 7.25, 0};
-  const odo::fw::can::VelocityMsg v{0.2, -0.1, 0};
-  const odo::fw::can::UncertaintyMsg u{0.012, 0.034, 0.0021, 0.3, 0};
-  const odo::fw::can::StatusMsg s{0, 1, false, 3, 12, 3600.0};
-  const odo::fw::can::TimingMsg t{25e-6, 80e-6, 4e-6, 0};
+  odo::protocol::PoseMsg p{1234.5678, -87.6543, 7.25, 0};
+  const odo::protocol::VelocityMsg v{0.2, -0.1, 0};
+  const odo::protocol::UncertaintyMsg u{0.012, 0.034, 0.0021, 0.3, 0};
+  const odo::protocol::StatusMsg s{0, 1, false, 3, 12, 3600.0};
+  const odo::protocol::TimingMsg t{25e-6, 80e-6, 4e-6, 0};
   std::array<odo::CanFrame, 6> f;
   for (auto _ : state) {
     ++p.seq;
-    odo::fw::can::encode_pose_x(0x410, p, f[0]);
-    odo::fw::can::encode_pose_y_theta(0x411, p, f[1]);
-    odo::fw::can::encode_velocity(0x412, v, f[2]);
-    odo::fw::can::encode_uncertainty(0x413, u, f[3]);
-    odo::fw::can::encode_status(0x414, s, f[4]);
-    odo::fw::can::encode_timing(0x415, t, f[5]);
+    odo::protocol::encode_pose_x(0x410, p, f[0]);
+    odo::protocol::encode_pose_y_theta(0x411, p, f[1]);
+    odo::protocol::encode_velocity(0x412, v, f[2]);
+    odo::protocol::encode_uncertainty(0x413, u, f[3]);
+    odo::protocol::encode_status(0x414, s, f[4]);
+    odo::protocol::encode_timing(0x415, t, f[5]);
     benchmark::DoNotOptimize(f);
   }
 }

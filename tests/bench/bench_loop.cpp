@@ -3,7 +3,7 @@
 
 #include <atomic>
 
-#include "odo/firmware/loop.hpp"
+#include "odo/loop/loop.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_encoder.hpp"
 #include "odo/sim/virtual_clock.hpp"
@@ -22,7 +22,7 @@ void BM_LoopTick(benchmark::State& state) {
   auto robot = *odo::sim::SimRobot::create(odo::sim::RobotGeometry{}, {{1e7, 3.0, 3.3}});
   odo::sim::SimEncoderSource enc(robot, 32);
   odo::sim::VirtualClock clock;
-  auto loop = odo::fw::OdometryLoop::create(odo::fw::LoopConfig{1000.0}, k, enc, clock).value();
+  auto loop = odo::loop::OdometryLoop::create(odo::loop::LoopConfig{1000.0}, k, enc, clock).value();
   loop->start();
   for (auto _ : state) loop->tick();
   benchmark::DoNotOptimize(loop->odometry().pose());

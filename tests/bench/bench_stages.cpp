@@ -4,9 +4,9 @@
 #include <cstdint>
 
 #include "counting_encoder.hpp"
-#include "odo/firmware/latency_histogram.hpp"
-#include "odo/firmware/loop.hpp"
-#include "odo/firmware/triple_buffer.hpp"
+#include "odo/loop/latency_histogram.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/loop/triple_buffer.hpp"
 #include "odo/odometry/count_delta.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_encoder.hpp"
@@ -24,7 +24,7 @@ void BM_LoopTickFirmwareOnly(benchmark::State& state) {
   const auto k = *odo::Kinematics::create(labmate());
   odo::bench::CountingEncoder enc(52, 57);
   odo::sim::VirtualClock clock;
-  auto loop = odo::fw::OdometryLoop::create(odo::fw::LoopConfig{1000.0}, k, enc, clock).value();
+  auto loop = odo::loop::OdometryLoop::create(odo::loop::LoopConfig{1000.0}, k, enc, clock).value();
   loop->start();
   for (auto _ : state) loop->tick();
   benchmark::DoNotOptimize(loop->odometry().pose());
@@ -57,7 +57,7 @@ BENCHMARK(BM_StageWrapDelta);
 
 // Stage: statistics: one wake-up latency and one compute time into their histograms.
 void BM_StageHistogramRecord(benchmark::State& state) {
-  odo::fw::LatencyHistogram lat, cmp;
+  odo::loop::LatencyHistogram lat, cmp;
   odo::TimeNs v = 12'345;
   for (auto _ : state) {
     benchmark::DoNotOptimize(v);
@@ -71,7 +71,7 @@ BENCHMARK(BM_StageHistogramRecord);
 
 // Stage (every 256th tick): min, mean, p99, p99.9, max of a histogram of 10^5 latencies.
 void BM_StageHistogramSummary(benchmark::State& state) {
-  odo::fw::LatencyHistogram h;
+  odo::loop::LatencyHistogram h;
   odo::TimeNs v = 1;
   for (int i = 0; i < 100'000; ++i) {
     h.record(10'000 + (v % 40'000));
@@ -85,7 +85,7 @@ BENCHMARK(BM_StageHistogramSummary);
 // Stage: publishing the tick's snapshot to the status thread (triple buffer, wait-free). The
 // loop fills the back slot in place, so publishing is the hand-over alone.
 void BM_StageSnapshotPublish(benchmark::State& state) {
-  odo::fw::TripleBuffer<odo::fw::LoopSnapshot> tb;
+  odo::loop::TripleBuffer<odo::loop::LoopSnapshot> tb;
   std::uint64_t tick = 0;
   for (auto _ : state) {
     tb.back().tick = ++tick;

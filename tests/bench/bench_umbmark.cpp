@@ -3,8 +3,8 @@
 
 #include <vector>
 
+#include "odo/analysis/umbmark_tools.hpp"
 #include "odo/calibration/umbmark.hpp"
-#include "odo/firmware/umbmark_tools.hpp"
 
 namespace {
 
@@ -27,13 +27,13 @@ void BM_UmbmarkCompute(benchmark::State& state) {
 BENCHMARK(BM_UmbmarkCompute)->Arg(5)->Arg(1000);
 
 // One whole simulated pass with N = 1: 2 squares before and 2 after, 4 m sides, virtual time,
-// each through the firmware's OdometryLoop at 100 Hz (about 9 700 ticks a square).
+// each through the firmware's odo::loop::OdometryLoop at 100 Hz (about 9 700 ticks a square).
 void BM_UmbmarkSimulatePass(benchmark::State& state) {
-  odo::fw::UmbmarkSimOptions o;
+  odo::analysis::UmbmarkSimOptions o;
   o.runs = 1;
   o.noise = state.range(0) != 0 ? "paper" : "none";
   for (auto _ : state) {
-    auto r = odo::fw::run_umbmark_simulation(o);
+    auto r = odo::analysis::run_umbmark_simulation(o);
     benchmark::DoNotOptimize(r);
   }
   state.SetItemsProcessed(state.iterations() * 4);  // squares

@@ -12,7 +12,7 @@
 
 #include "counting_encoder.hpp"
 #include "odo/firmware/can_broadcast.hpp"
-#include "odo/firmware/loop.hpp"
+#include "odo/loop/loop.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_can_bus.hpp"
 #include "odo/sim/sim_encoder.hpp"
@@ -36,12 +36,13 @@ int main(int argc, char** argv) {
   odo::EncoderSource& enc = argv[1][0] == 's' ? static_cast<odo::EncoderSource&>(sim_enc)
                                               : static_cast<odo::EncoderSource&>(count_enc);
   odo::sim::VirtualClock clock;
-  auto loop = odo::fw::OdometryLoop::create(odo::fw::LoopConfig{1000.0}, k, enc, clock).value();
+  auto loop = odo::loop::OdometryLoop::create(odo::loop::LoopConfig{1000.0}, k, enc, clock).value();
   odo::sim::SimCanPort port;
   odo::fw::CanBroadcastOptions co;
   co.div = argc == 4 ? odo::fw::CanDivisors{1, 1, 1, 1, 1}
                      : odo::fw::CanDivisors{20, 20, 100, 100, 1000};
-  odo::fw::CanBroadcaster can(co, port, loop.get(), &port, nullptr);
+  port.connect_wire();
+  odo::fw::CanBroadcaster can(co, port, &loop->commands(), nullptr);
   loop->add_observer(&can);
   loop->start();
   for (long i = 0; i < n; ++i) loop->tick();

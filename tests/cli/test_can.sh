@@ -8,7 +8,7 @@ set -u
 src=$1
 . "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
 py=/usr/bin/python3; [ -x "$py" ] || py=python3
-dbc="$src/firmware/can/odometry.dbc"
+dbc="$src/protocol/odometry.dbc"
 
 # 1. The whole demo square (97 s of virtual time), theta passing through +-pi on the way.
 run "$ODOMETRYD" --virtual-time --json --can-log "$tmp/can.log" >"$tmp/out.json" 2>"$tmp/err"
@@ -39,6 +39,20 @@ assert abs(last["theta"]) <= 3.1416 and abs(j["theta"]) <= 3.141592653589794, (l
 assert last["sigma_x"] > 0 and last["sigma_y"] > 0 and last["sigma_theta"] > 0, last
 PY
 check "log content: all messages, no loss, stopping status equals --json counters" $?
+
+# 1b. The same log through a second independent client: the npm DBC library candied 2.2.0
+# (installed by tools/setup.sh --tests into tools/node). It silently dropped signals whose DBC
+# factor was written 1e-05; every signal must decode and the final frames equal --json.
+candied="$src/tools/node/node_modules"
+if command -v node >/dev/null && [ -f "$candied/candied/package.json" ]; then
+  node "$src/tests/tools/dbc_candied.cjs" "$candied" "$dbc" "$tmp/can.log" "$tmp/out.json" \
+    >"$tmp/candied.json"
+  check "DBC read by candied: every signal decoded, final frames equal --json" $?
+elif [ "${CI:-}" = true ]; then
+  check "candied installed (tools/setup.sh --tests) for the DBC check" 1
+else
+  echo "note: node or candied missing (tools/setup.sh --tests): DBC check with candied skipped"
+fi
 
 # 2. odomctl decode: table with a summary, CSV with one row per signal.
 run "$ODOMCTL" decode "$tmp/can.log" >"$tmp/table" 2>"$tmp/err2"

@@ -28,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
               in(c->sim.turn_rate, 0.05, 10.0) && in(c->sim.pause, 0.0, 60.0),
           "sim motion parameter out of range");
   require(c->sim.counter_bits >= 16 && c->sim.counter_bits <= 64, "sim.counter_bits out of range");
-  const std::string& b = c->encoder.backend;
+  const std::string b(odo::fw::name_of(c->encoder.backend));
   require(b == "sim" || b == "hctl1100" || b == "gpio" || b == "can", "unknown backend", b);
   // [can_encoder]: an accepted generic layout fits a classic frame and its id length.
   const auto& e = c->can_encoder;

@@ -11,9 +11,10 @@
 #include <span>
 
 #include "fuzz_check.hpp"
+#include "odo/analysis/calibration_json.hpp"
 #include "odo/calibration/record.hpp"
 #include "odo/calibration/store.hpp"
-#include "odo/firmware/calibration_io.hpp"
+#include "odo/firmware/calibration_store.hpp"
 #include "odo/odometry/kinematics.hpp"
 #include "odo/sim/sim_nv_storage.hpp"
 
@@ -42,18 +43,21 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const odo::KinematicParams nominal{0.15, 2048, 16, 0.34, 0.34, 1.0, 1.0};
   const odo::fw::AppliedCalibration a = odo::fw::apply_calibration(nominal, loaded, "fuzz");
   require(odo::Kinematics::create(a.params).ok(), "odometryd would run on invalid kinematics");
-  require(a.state != 1 || loaded->status == odo::calib::StoreStatus::kOk,
+  require(a.state != odo::calib::StoreStatus::kOk || loaded->status == odo::calib::StoreStatus::kOk,
           "calibrated state from a store that did not load as ok");
   // The error state (2): always for a corrupt store and for a stored record outside its limits
   // (Kinematics may reject a few more), never for an uncalibrated store.
   const bool ok = loaded->status == odo::calib::StoreStatus::kOk;
-  require(loaded->status != odo::calib::StoreStatus::kCorrupt || a.state == 2,
+  require(loaded->status != odo::calib::StoreStatus::kCorrupt ||
+              a.state == odo::calib::StoreStatus::kCorrupt,
           "corrupt store not reported as an error");
-  require(!ok || odo::calib::validate_record(*loaded->record).ok() || a.state == 2,
+  require(!ok || odo::calib::validate_record(*loaded->record).ok() ||
+              a.state == odo::calib::StoreStatus::kCorrupt,
           "out-of-range record not reported as an error");
-  require(loaded->status != odo::calib::StoreStatus::kUncalibrated || a.state == 0,
+  require(loaded->status != odo::calib::StoreStatus::kUncalibrated ||
+              a.state == odo::calib::StoreStatus::kUncalibrated,
           "uncalibrated store not reported as uncalibrated");
-  require(a.state != 1 || a.params.c_l == loaded->record->c_l,
+  require(a.state != odo::calib::StoreStatus::kOk || a.params.c_l == loaded->record->c_l,
           "calibrated state without the stored factors");
   return 0;
 }

@@ -1,8 +1,8 @@
-// Fuzz target: the replay CSV reader (odo::fw::replay_ticks on top of odo::fw::CsvReader).
-// Input: the first byte chooses the counter width (16..64 bits), the rest is the CSV text.
-// Properties: never crashes, hangs or overflows (ASan, UBSan); a rejected file has a message
-// "fuzz.csv:<line>: ..."; an accepted one has a finite pose and distance (and with fewer than two
-// data rows, nothing to integrate, the start pose).
+// Fuzz target: the replay CSV reader (odo::analysis::replay_ticks on top of
+// odo::analysis::CsvReader). Input: the first byte chooses the counter width (16..64 bits), the
+// rest is the CSV text. Properties: never crashes, hangs or overflows (ASan, UBSan); a rejected
+// file has a message "fuzz.csv:<line>: ..."; an accepted one has a finite pose and distance (and
+// with fewer than two data rows, nothing to integrate, the start pose).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -10,7 +10,7 @@
 #include <string>
 
 #include "fuzz_check.hpp"
-#include "odo/firmware/replay.hpp"
+#include "odo/analysis/replay.hpp"
 #include "odo/odometry/kinematics.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -21,7 +21,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // The reference robot: 0.15 m wheels, 2048 counts, 16:1 gear, 0.34 m wheelbase.
   static const odo::Kinematics k =
       odo::Kinematics::create(odo::KinematicParams{0.15, 2048, 16, 0.34, 0.34, 1.0, 1.0}).value();
-  auto r = odo::fw::replay_ticks(in, "fuzz.csv", k, bits);
+  auto r = odo::analysis::replay_ticks(in, "fuzz.csv", k, bits);
   if (!r) {
     require(odo::fuzz::starts_with_location(r.error().message, "fuzz.csv"),
             "error message does not name file and line:", r.error().message);

@@ -1,4 +1,4 @@
-// Fuzz target: set-pose command frames received from the bus (odo::fw::can::decode_set_pose and
+// Fuzz target: set-pose command frames received from the bus (odo::protocol::decode_set_pose and
 // the broadcaster's receive path). Input: byte 0 = DLC (0..15, only 0..8 exist on the wire, the
 // rest must be refused), byte 1 = node offset, bytes 2..9 = data.
 // Properties: an accepted command is DLC 0 (reset to zero) or DLC 8 with every value finite and
@@ -12,21 +12,21 @@
 
 #include "fuzz_check.hpp"
 #include "odo/firmware/can_broadcast.hpp"
-#include "odo/firmware/can_protocol.hpp"
+#include "odo/protocol/can_protocol.hpp"
 #include "odo/sim/sim_can_bus.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using odo::fuzz::require;
-  namespace can = odo::fw::can;
+  namespace can = odo::protocol;
   if (size < 2) return 0;
   odo::CanFrame f;
   f.len = static_cast<std::uint8_t>(data[0] & 0x0F);
   const int node = data[1] % 4;  // our node is 1
-  f.id = can::frame_id(can::kDefaultBaseId, node, can::Msg::kSetPose);
+  f.id = odo::protocol::frame_id(odo::protocol::kDefaultBaseId, node, odo::protocol::Msg::kSetPose);
   std::memcpy(f.data.data(), data + 2, std::min<std::size_t>(8, size - 2));
 
-  can::SetPoseCmd c;
-  const bool ok = can::decode_set_pose(f, c);
+  odo::protocol::SetPoseCmd c;
+  const bool ok = odo::protocol::decode_set_pose(f, c);
   if (f.len != 0 && f.len != 8)
     require(!ok, "accepted a set-pose frame of a length other than 0/8");
   if (ok) {
@@ -38,7 +38,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     require(c.reset == (f.len == 0), "reset flag does not match DLC 0");
     if (c.reset) require(c.x == 0 && c.y == 0 && c.theta == 0, "reset is not (0, 0, 0)");
     odo::CanFrame g;
-    can::encode_set_pose(f.id, c, g);
+    odo::protocol::encode_set_pose(f.id, c, g);
     require(g.len == f.len, "re-encoded length differs");
     // Raw theta -31416 decodes to -pi-ish and re-encodes as +31416 (the wire's +pi): the only
     // byte pattern that does not survive unchanged.
@@ -50,13 +50,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // The receive path: one frame per tick through a simulated port, no loop attached.
   static odo::sim::SimCanPort port(8, 8);
   odo::fw::CanBroadcastOptions o;  // node 1, nothing sent (all rates 0)
-  static odo::fw::CanBroadcaster bc(o, port, nullptr, &port, nullptr);
+  static odo::fw::CanBroadcaster bc(o, port, nullptr, nullptr);
   const auto before = bc.counters();
   require(port.inject(f), "inject refused");
-  odo::fw::LoopSnapshot snap;
+  odo::loop::LoopSnapshot snap;
   bc.on_tick(snap);
   const auto& after = bc.counters();
-  const bool ours = node == can::kDefaultNodeId;
+  const bool ours = node == odo::protocol::kDefaultNodeId;
   require(after.set_pose_applied - before.set_pose_applied == (ours && ok ? 1u : 0u),
           "applied count does not match the decoder");
   require(after.set_pose_rejected - before.set_pose_rejected == (ours && !ok ? 1u : 0u),

@@ -1,8 +1,8 @@
-// Fuzz target: the UMBmark CSV reader (odo::fw::read_umbmark_runs on top of odo::fw::CsvReader)
-// and the computation it feeds (odo::calib::umbmark_compute, 4 m square, 0.34 m wheelbase).
-// Properties: never crashes, hangs or overflows (ASan, UBSan); a rejected file has a message
-// "fuzz.csv:<line>: ..."; an accepted file either computes finite results or is refused with a
-// message naming the field.
+// Fuzz target: the UMBmark CSV reader (odo::analysis::read_umbmark_runs on top of
+// odo::analysis::CsvReader) and the computation it feeds (odo::calib::umbmark_compute, 4 m square,
+// 0.34 m wheelbase). Properties: never crashes, hangs or overflows (ASan, UBSan); a rejected file
+// has a message "fuzz.csv:<line>: ..."; an accepted file either computes finite results or is
+// refused with a message naming the field.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -10,12 +10,12 @@
 #include <string>
 
 #include "fuzz_check.hpp"
-#include "odo/firmware/umbmark_tools.hpp"
+#include "odo/analysis/umbmark_tools.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using odo::fuzz::require;
   std::istringstream in(std::string(reinterpret_cast<const char*>(data), size));
-  auto runs = odo::fw::read_umbmark_runs(in, "fuzz.csv");
+  auto runs = odo::analysis::read_umbmark_runs(in, "fuzz.csv");
   if (!runs) {
     require(odo::fuzz::starts_with_location(runs.error().message, "fuzz.csv"),
             "error message does not name file and line:", runs.error().message);

@@ -71,12 +71,12 @@ std::string capture(const std::string& cmd, int& rc) {
 }
 
 std::unique_ptr<NvStorage> open_mtd(const std::string& p) {
-  auto m = drv::MtdStorage::open(p);
+  auto m = drivers::MtdStorage::open(p);
   if (!m) _exit(5);
   return std::move(m).value();
 }
 std::unique_ptr<NvStorage> open_nvmem(const std::string& p) {
-  auto m = drv::NvmemStorage::open(p);
+  auto m = drivers::NvmemStorage::open(p);
   if (!m) _exit(5);
   return std::move(m).value();
 }
@@ -120,13 +120,13 @@ TEST(CalibMtd, GeometryFromMemgetinfo) {
   ODO_REQUIRE_VM();
   const std::string dev = mtd_device();
   ASSERT_FALSE(dev.empty()) << "mtdram did not load";
-  auto m = drv::MtdStorage::open(dev);
+  auto m = drivers::MtdStorage::open(dev);
   ASSERT_TRUE(m) << m.error().message;
   const NvGeometry g = (*m)->geometry();
   EXPECT_EQ(g.size, 256U * 1024U);
   EXPECT_EQ(g.erase_block, 16U * 1024U);
   EXPECT_EQ(g.write_unit, 1U);
-  auto bad = drv::MtdStorage::open("/dev/null");
+  auto bad = drivers::MtdStorage::open("/dev/null");
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("MEMGETINFO"), std::string::npos);
 }
@@ -135,7 +135,7 @@ TEST(CalibMtd, EraseSaveAlternateCorrupt) {
   ODO_REQUIRE_VM();
   const std::string dev = mtd_device();
   ASSERT_FALSE(dev.empty());
-  auto m = drv::MtdStorage::open(dev);
+  auto m = drivers::MtdStorage::open(dev);
   ASSERT_TRUE(m);
   NvStorage& medium = **m;
   ASSERT_TRUE(medium.erase(0, medium.geometry().size));  // MEMERASE of all 16 blocks
@@ -177,7 +177,7 @@ TEST(CalibMtd, SigkilledWriterOnTheDevice) {
   const std::string dev = mtd_device();
   ASSERT_FALSE(dev.empty());
   {
-    auto m = drv::MtdStorage::open(dev);
+    auto m = drivers::MtdStorage::open(dev);
     ASSERT_TRUE(m);
     ASSERT_TRUE((*m)->erase(0, 2 * 16384));
   }
@@ -212,7 +212,7 @@ TEST(CalibAt24, RealEepromThroughNvmem) {
   ODO_REQUIRE_VM();
   const std::string path = at24_nvmem();
   ASSERT_FALSE(path.empty()) << "i2c-stub / at24 did not give an nvmem device";
-  auto m = drv::NvmemStorage::open(path);
+  auto m = drivers::NvmemStorage::open(path);
   ASSERT_TRUE(m) << m.error().message;
   NvStorage& medium = **m;
   EXPECT_EQ(medium.geometry().size, 256U);

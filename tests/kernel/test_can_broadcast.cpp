@@ -1,6 +1,6 @@
 // Kernel tier, end to end on vcan (VM harness): odometryd with the simulated robot broadcasts on
 // a SocketCAN interface; can-utils `candump -L` (an independent receiver) captures the frames;
-// tests/tools/dbc_decode.py decodes them with firmware/can/odometry.dbc and must find the
+// tests/tools/dbc_decode.py decodes them with protocol/odometry.dbc and must find the
 // daemon's final pose (--json) within the DBC resolution. During the run a set-pose frame sent
 // with `cansend` takes effect, and the interface goes down for half a second: frames are lost
 // (sequence gaps, drops counted), the loop keeps its rate and broadcasting resumes by itself.
@@ -110,7 +110,7 @@ TEST(CanBroadcastVcan, CandumpDecodesTheDaemonsPoseSetPoseAndLinkDownUp) {
   // The independent decoder: DBC + candump log, compared with --json.
   const std::string dec = std::string("/usr/bin/python3 ") + ODO_SOURCE_DIR +
                           "/tests/tools/dbc_decode.py " + ODO_SOURCE_DIR +
-                          "/firmware/can/odometry.dbc " + dir + "/capture.log --expect " + dir +
+                          "/protocol/odometry.dbc " + dir + "/capture.log --expect " + dir +
                           "/out.json --series " + dir + "/series.csv > " + dir + "/dbc.json";
   EXPECT_EQ(run(dec), 0) << slurp(dir + "/dbc.json");
   const auto d = nlohmann::json::parse(slurp(dir + "/dbc.json"));

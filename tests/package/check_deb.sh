@@ -43,10 +43,10 @@ check "Package: diffodom" '[ "$(dpkg-deb -f "$deb" Package)" = diffodom ]'
 check "Architecture: $arch" '[ "$(dpkg-deb -f "$deb" Architecture)" = "$arch" ]'
 dpkg-deb -c "$deb" | awk '{print $6}' | sed 's|^\./|/|; s|/$||' >"$tmp/files"
 want=(/usr/bin/odometryd /usr/bin/odomctl /etc/odometryd/odometryd.toml /var/lib/odometryd)
-if [ -f "$src/firmware/can/odometry.dbc" ]; then
+if [ -f "$src/protocol/odometry.dbc" ]; then
   want+=(/usr/share/odometryd/odometry.dbc)
 else
-  echo "note: firmware/can/odometry.dbc is not in the source tree yet; not expected in the package"
+  echo "note: protocol/odometry.dbc is not in the source tree yet; not expected in the package"
 fi
 if [ -f "$src/firmware/systemd/odometryd.service" ]; then
   want+=(/lib/systemd/system/odometryd.service)

@@ -11,16 +11,16 @@
 #include <vector>
 
 #include "odo/firmware/can_broadcast.hpp"
-#include "odo/firmware/can_protocol.hpp"
 #include "odo/firmware/config.hpp"
-#include "odo/firmware/loop.hpp"
 #include "odo/firmware/rig.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/protocol/can_protocol.hpp"
 #include "odo/sim/sim_can_bus.hpp"
 
 namespace odo::test {
 namespace {
 
-using fw::can::Msg;
+using protocol::Msg;
 
 // Bench: the daemon's simulated rig and loop at 100 Hz with a broadcaster on a SimCanPort.
 struct Bench {
@@ -29,17 +29,18 @@ struct Bench {
       : cfg(make_cfg(scenario)),
         kin(*Kinematics::create(cfg.robot)),
         rig(std::move(fw::Rig::create(cfg, kin, true).value())),
-        loop(fw::OdometryLoop::create(fw::LoopConfig{100.0}, kin, rig.encoder(), rig.clock())
+        loop(loop::OdometryLoop::create(loop::LoopConfig{100.0}, kin, rig.encoder(), rig.clock())
                  .value()),
         port(tx_cap, 16),
-        bc(opts(), port, loop.get(), drain ? &port : nullptr, &ring) {
+        bc(opts(), port, &loop->commands(), &ring) {
+    if (drain) port.connect_wire();
     loop->add_observer(&bc);
     loop->start();
   }
   static fw::Config make_cfg(const std::string& scenario) {
     fw::Config c = fw::default_config();
-    c.sim.scenario = scenario;
-    c.sim.robot = "nominal";
+    c.sim.scenario = *fw::parse_choice<fw::SimScenario>(scenario);
+    c.sim.robot = fw::SimRobotKind::kNominal;
     return c;
   }
   static fw::CanBroadcastOptions opts() {
@@ -61,14 +62,14 @@ struct Bench {
   fw::Config cfg;
   Kinematics kin;
   fw::Rig rig;
-  std::unique_ptr<fw::OdometryLoop> loop;
+  std::unique_ptr<loop::OdometryLoop> loop;
   sim::SimCanPort port;
   fw::CanFrameRing ring{1 << 14};
   fw::CanBroadcaster bc;
 };
 
 std::uint32_t id(Msg m) {
-  return fw::can::frame_id(0x400, 1, m);
+  return protocol::frame_id(0x400, 1, m);
 }
 
 std::vector<std::uint8_t> pose_seqs(const std::vector<CanFrame>& fs) {
@@ -111,14 +112,15 @@ TEST(CanBroadcast, RatesFollowTheTickNumberWhenItRepeatsJumpsOrGoesBack) {
   fw::CanFrameRing ring{1 << 10};
   fw::CanBroadcastOptions o;
   o.div = fw::CanDivisors{3, 4, 10, 0, 7};  // status off
-  fw::CanBroadcaster bc(o, port, nullptr, &port, &ring);
+  port.connect_wire();
+  fw::CanBroadcaster bc(o, port, nullptr, &ring);
   std::vector<std::uint64_t> ticks;
   for (std::uint64_t t = 0; t <= 50; ++t) ticks.push_back(t);
   for (std::uint64_t t : {50, 50, 21, 22, 23, 24, 1000, 1001, 1004, 1008, 5, 6, 0, 0, 70, 69})
     ticks.push_back(t);
   std::size_t frames = 0;
   for (const std::uint64_t t : ticks) {
-    fw::LoopSnapshot s;
+    loop::LoopSnapshot s;
     s.tick = t;
     bc.on_tick(s);
     std::vector<std::uint32_t> want;
@@ -161,8 +163,8 @@ TEST(CanBroadcast, LinkDownDropsCountsKeepsTheLoopAndResumes) {
   bool timing_seen = false;
   for (const auto& f : after) {
     if (f.id != id(Msg::kTiming)) continue;
-    fw::can::TimingMsg t;
-    ASSERT_TRUE(fw::can::decode_timing(f, t));
+    protocol::TimingMsg t;
+    ASSERT_TRUE(protocol::decode_timing(f, t));
     EXPECT_EQ(t.tx_dropped, c.dropped_link_down);
     timing_seen = true;
   }
@@ -189,16 +191,16 @@ TEST(CanBroadcast, FullTransmitQueueDropsCountsAndNeverBlocks) {
 
 CanFrame set_pose_frame(int node, double x, double y, double th, bool reset = false) {
   CanFrame f;
-  fw::can::encode_set_pose(fw::can::frame_id(0x400, node, Msg::kSetPose),
-                           fw::can::SetPoseCmd{reset, x, y, th}, f);
+  protocol::encode_set_pose(protocol::frame_id(0x400, node, Msg::kSetPose),
+                            protocol::SetPoseCmd{reset, x, y, th}, f);
   return f;
 }
 
 std::uint8_t last_ack(const std::vector<CanFrame>& fs) {
   std::uint8_t ack = 0;
   for (const auto& f : fs) {
-    fw::can::StatusMsg s;
-    if (f.id == id(Msg::kStatus) && fw::can::decode_status(f, s)) ack = s.set_pose_ack;
+    protocol::StatusMsg s;
+    if (f.id == id(Msg::kStatus) && protocol::decode_status(f, s)) ack = s.set_pose_ack;
   }
   return ack;
 }
@@ -220,8 +222,8 @@ TEST(CanBroadcast, SetPoseAppliesAtTheNextTickAndIsAcknowledged) {
   // The broadcast pose follows.
   double x = 0;
   std::uint8_t seq = 0;
-  ASSERT_TRUE(fw::can::decode_pose_x(fs[0], x, seq));
-  EXPECT_NEAR(x, 1.5, fw::can::kPosScale / 2);
+  ASSERT_TRUE(protocol::decode_pose_x(fs[0], x, seq));
+  EXPECT_NEAR(x, 1.5, protocol::kPosScale / 2);
   // Reset (DLC 0), then a malformed command (DLC 3): rejected and counted.
   ASSERT_TRUE(b.port.inject(set_pose_frame(1, 0, 0, 0, true)));
   CanFrame bad = set_pose_frame(1, 1, 1, 1);
@@ -281,7 +283,8 @@ TEST(CanBroadcast, ReceiveFloodIsReadAtMostMaxRxPerTickAndSetPoseStillApplies) {
   fw::CanBroadcastOptions o = Bench::opts();
   const std::size_t cap = o.max_rx_per_tick;
   ASSERT_GT(cap, 0u);
-  fw::CanBroadcaster bc(o, bus, b.loop.get(), &port, nullptr);
+  port.connect_wire();
+  fw::CanBroadcaster bc(o, bus, &b.loop->commands(), nullptr);
   b.loop->add_observer(&bc);
   constexpr int kTicks = 500, kBurst = 100;
   constexpr double kStep = 1e-3;  // x of command k: k mm, exact at the protocol's resolution
@@ -344,23 +347,23 @@ TEST(CanBroadcast, CleanStopSendsFinalPoseThenStoppingStatus) {
   ASSERT_EQ(fs.size(), 6u);
   EXPECT_EQ(fs.front().id, id(Msg::kPoseX));
   EXPECT_EQ(fs.back().id, id(Msg::kStatus));
-  fw::can::StatusMsg st;
-  ASSERT_TRUE(fw::can::decode_status(fs.back(), st));
+  protocol::StatusMsg st;
+  ASSERT_TRUE(protocol::decode_status(fs.back(), st));
   EXPECT_TRUE(st.stopping);
   EXPECT_DOUBLE_EQ(st.uptime, 1.0);  // 1.37 s of loop time, whole seconds
   double x = 0, y = 0, th = 0;
   std::uint8_t s1 = 0, s2 = 0;
-  ASSERT_TRUE(fw::can::decode_pose_x(fs[0], x, s1));
-  ASSERT_TRUE(fw::can::decode_pose_y_theta(fs[1], y, th, s2));
+  ASSERT_TRUE(protocol::decode_pose_x(fs[0], x, s1));
+  ASSERT_TRUE(protocol::decode_pose_y_theta(fs[1], y, th, s2));
   EXPECT_EQ(s1, s2);
-  EXPECT_NEAR(x, b.loop->snapshot().pose.x, fw::can::kPosScale / 2 + 1e-12);
-  EXPECT_NEAR(y, b.loop->snapshot().pose.y, fw::can::kPosScale / 2 + 1e-12);
+  EXPECT_NEAR(x, b.loop->snapshot().pose.x, protocol::kPosScale / 2 + 1e-12);
+  EXPECT_NEAR(y, b.loop->snapshot().pose.y, protocol::kPosScale / 2 + 1e-12);
   // The uncertainty frame carries the error model's standard deviations.
-  fw::can::UncertaintyMsg u;
-  ASSERT_TRUE(fw::can::decode_uncertainty(fs[3], u));
+  protocol::UncertaintyMsg u;
+  ASSERT_TRUE(protocol::decode_uncertainty(fs[3], u));
   ASSERT_TRUE(b.loop->snapshot().has_cov);
-  EXPECT_NEAR(u.sigma_x, std::sqrt(b.loop->snapshot().cov[0]), fw::can::kSigmaPosScale / 2);
-  EXPECT_NEAR(u.sigma_theta, std::sqrt(b.loop->snapshot().cov[8]), fw::can::kSigmaThetaScale / 2);
+  EXPECT_NEAR(u.sigma_x, std::sqrt(b.loop->snapshot().cov[0]), protocol::kSigmaPosScale / 2);
+  EXPECT_NEAR(u.sigma_theta, std::sqrt(b.loop->snapshot().cov[8]), protocol::kSigmaThetaScale / 2);
 }
 
 }  // namespace

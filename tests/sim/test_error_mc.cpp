@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "../unit/loglog_slope.hpp"
-#include "odo/firmware/error_model_tools.hpp"
+#include "odo/analysis/error_model_tools.hpp"
 #include "odo/sim/wheel_noise.hpp"
 #include "sim_fixture.hpp"
 
@@ -20,7 +20,7 @@ namespace {
 // Seed 1 is the command's default, not a chosen one.
 constexpr int kRuns = 4000;
 
-void expect_within_10_percent(const fw::McResult& r, const char* path) {
+void expect_within_10_percent(const analysis::McResult& r, const char* path) {
   for (int i = 0; i < 3; ++i) {
     EXPECT_LT(r.rel_error[i], 0.10) << path << " variance " << i << ": predicted "
                                     << r.predicted[4 * i] << " sample " << r.sample[4 * i];
@@ -30,15 +30,15 @@ void expect_within_10_percent(const fw::McResult& r, const char* path) {
 }
 
 TEST(ErrorMonteCarlo, OutbackVariancesWithin10PercentOfSample) {
-  fw::McOptions o;
+  analysis::McOptions o;
   o.runs = kRuns;
   o.path = "outback";
-  auto r = fw::run_error_monte_carlo(o);
+  auto r = analysis::run_error_monte_carlo(o);
   ASSERT_TRUE(r.ok()) << r.error().message;
   expect_within_10_percent(*r, "outback");
   // The loop's covariance at the end equals the two-segment closed form (consistency through the
   // loop's 4000 ticks; quantised counts make the ticks slightly uneven).
-  const Cov3 closed = fw::outback_covariance(10.0, 0.34, o.k);
+  const Cov3 closed = analysis::outback_covariance(10.0, 0.34, o.k);
   for (int i = 0; i < 9; ++i) {
     const double scale = std::sqrt(closed[4 * (i / 3)] * closed[4 * (i % 3)]);
     EXPECT_NEAR(r->predicted[i], closed[i], 1e-4 * scale) << "entry " << i;
@@ -46,20 +46,20 @@ TEST(ErrorMonteCarlo, OutbackVariancesWithin10PercentOfSample) {
 }
 
 TEST(ErrorMonteCarlo, ArcVariancesWithin10PercentOfSample) {
-  fw::McOptions o;
+  analysis::McOptions o;
   o.runs = kRuns;
   o.path = "arc";
-  auto r = fw::run_error_monte_carlo(o);
+  auto r = analysis::run_error_monte_carlo(o);
   ASSERT_TRUE(r.ok()) << r.error().message;
   expect_within_10_percent(*r, "arc");
 }
 
 TEST(ErrorMonteCarlo, NoNoiseNoSpread) {
   // k = 0: every run is identical, both covariances vanish and agree.
-  fw::McOptions o;
+  analysis::McOptions o;
   o.runs = 3;
   o.k = {0.0, 0.0};
-  auto r = fw::run_error_monte_carlo(o);
+  auto r = analysis::run_error_monte_carlo(o);
   ASSERT_TRUE(r.ok()) << r.error().message;
   for (double v : r->predicted) EXPECT_EQ(v, 0.0);
   for (double v : r->sample) EXPECT_NEAR(v, 0.0, 1e-24);
@@ -67,7 +67,7 @@ TEST(ErrorMonteCarlo, NoNoiseNoSpread) {
 }
 
 TEST(ErrorMonteCarlo, RejectsBadOptions) {
-  const std::pair<fw::McOptions, const char*> cases[] = {
+  const std::pair<analysis::McOptions, const char*> cases[] = {
       {{.runs = 1}, "--runs = 1 is outside the allowed range [2, 1000000]"},
       {{.path = "square"}, "--path = 'square' must be outback or arc"},
       {{.k = {-1e-4, 0.00058}}, "--k-left = -0.0001 m^(1/2) is outside the allowed range"},
@@ -75,7 +75,7 @@ TEST(ErrorMonteCarlo, RejectsBadOptions) {
       {{.wheelbase = 0.0}, "--wheelbase = 0 m is outside the allowed range [0.05, 5] m"},
   };
   for (const auto& [o, expect] : cases) {
-    auto r = fw::run_error_monte_carlo(o);
+    auto r = analysis::run_error_monte_carlo(o);
     ASSERT_FALSE(r.ok()) << expect;
     EXPECT_NE(r.error().message.find(expect), std::string::npos) << r.error().message;
   }
@@ -83,18 +83,18 @@ TEST(ErrorMonteCarlo, RejectsBadOptions) {
 
 // StraightLineSlopes: sample variances of the along-track (x) and lateral (y) error of a straight
 // run at 0.5, 1, 2, 4 and 8 m; Sec. 4.1 predicts ~ d and ~ d^3.
-class ErrorAt final : public fw::TickObserver {
+class ErrorAt final : public loop::TickObserver {
  public:
   ErrorAt(const sim::SimRobot& robot, std::vector<std::uint64_t> ticks)
       : robot_(robot), ticks_(std::move(ticks)) {}
-  void on_tick(fw::LoopSnapshot& s) noexcept override {
+  void on_tick(const loop::LoopSnapshot& s) noexcept override {
     if (next_ < ticks_.size() && s.tick == ticks_[next_]) {
       errors[next_] = {robot_.true_pose().x - s.pose.x, robot_.true_pose().y - s.pose.y,
                        robot_.true_pose().theta - s.pose.theta};
       ++next_;
     }
   }
-  std::array<fw::PoseError, 5> errors{};
+  std::array<analysis::PoseError, 5> errors{};
 
  private:
   const sim::SimRobot& robot_;
@@ -112,7 +112,7 @@ TEST(ErrorMonteCarlo, StraightLineLateralCubicAlongTrackLinear) {
   const auto k = *Kinematics::create(nominal_labmate());
   const double w = 0.5 / 0.075;
   sim::WheelNoise noise(0.00040, 0.00058, 0);
-  std::vector<std::vector<fw::PoseError>> per_dist(dist.size());
+  std::vector<std::vector<analysis::PoseError>> per_dist(dist.size());
   for (int run = 0; run < kRuns; ++run) {
     SimRun sim(sim::RobotGeometry{}, k, {{8.0 / 0.5 + 0.1, w, w}});
     noise.reseed(1000 + static_cast<std::uint64_t>(run));
@@ -125,7 +125,7 @@ TEST(ErrorMonteCarlo, StraightLineLateralCubicAlongTrackLinear) {
   }
   std::vector<double> along, lateral;
   for (const auto& e : per_dist) {
-    const Cov3 c = fw::sample_covariance(e);
+    const Cov3 c = analysis::sample_covariance(e);
     along.push_back(c[0]);
     lateral.push_back(c[4]);
   }
@@ -141,17 +141,17 @@ TEST(ErrorModelFit, RecoversCoefficientsFromSimulatedRuns) {
   // 2000 simulated out-and-back runs with k_L = 0.0004, k_R = 0.00058, written in the CSV format
   // of `errormodel fit` and read back: the maximum-likelihood fit recovers both within 5%
   // (k^2 has a relative standard error of about sqrt(2/2000) = 3%, so k about 1.6%).
-  fw::McOptions o;
+  analysis::McOptions o;
   o.runs = 2000;
   o.seed = 5;
-  auto r = fw::run_error_monte_carlo(o);
+  auto r = analysis::run_error_monte_carlo(o);
   ASSERT_TRUE(r.ok()) << r.error().message;
   std::stringstream csv;
-  fw::write_run_errors(csv, r->errors);
-  auto read = fw::read_run_errors(csv, "runs.csv");
+  analysis::write_run_errors(csv, r->errors);
+  auto read = analysis::read_run_errors(csv, "runs.csv");
   ASSERT_TRUE(read.ok()) << read.error().message;
   ASSERT_EQ(read->size(), 2000u);
-  auto fit = fw::fit_error_model(*read, 10.0, 0.34);
+  auto fit = analysis::fit_error_model(*read, 10.0, 0.34);
   ASSERT_TRUE(fit.ok()) << fit.error().message;
   EXPECT_NEAR(fit->k.k_left, 0.00040, 0.05 * 0.00040);
   EXPECT_NEAR(fit->k.k_right, 0.00058, 0.05 * 0.00058);
@@ -161,7 +161,7 @@ TEST(ErrorModelFit, RecoversExactCovariance) {
   // Errors built so that their sample covariance is exactly the model's for k_L = 0.0003,
   // k_R = 0.0007 (points mean +- sqrt(3) L e_i with L the Cholesky factor, n = 6: the sample
   // covariance with divisor n is L L^T): the maximum-likelihood fit must return those k.
-  const Cov3 c = fw::outback_covariance(10.0, 0.34, {0.0003, 0.0007});
+  const Cov3 c = analysis::outback_covariance(10.0, 0.34, {0.0003, 0.0007});
   // Cholesky of c by hand (3 x 3).
   const double l00 = std::sqrt(c[0]);
   const double l10 = c[3] / l00, l20 = c[6] / l00;
@@ -169,13 +169,13 @@ TEST(ErrorModelFit, RecoversExactCovariance) {
   const double l21 = (c[7] - l20 * l10) / l11;
   const double l22 = std::sqrt(c[8] - l20 * l20 - l21 * l21);
   const double cols[3][3] = {{l00, l10, l20}, {0, l11, l21}, {0, 0, l22}};
-  std::vector<fw::PoseError> e;
+  std::vector<analysis::PoseError> e;
   const double s = std::sqrt(3.0);
   for (const auto& col : cols) {
     e.push_back({s * col[0], s * col[1], s * col[2]});
     e.push_back({-s * col[0], -s * col[1], -s * col[2]});
   }
-  auto fit = fw::fit_error_model(e, 10.0, 0.34);
+  auto fit = analysis::fit_error_model(e, 10.0, 0.34);
   ASSERT_TRUE(fit.ok()) << fit.error().message;
   EXPECT_NEAR(fit->k.k_left, 0.0003, 1e-8);
   EXPECT_NEAR(fit->k.k_right, 0.0007, 1e-8);
@@ -194,13 +194,13 @@ TEST(ErrorModelFit, BadInputNamesFileLineAndField) {
   };
   for (const auto& [text, expect] : cases) {
     std::stringstream in(text);
-    auto r = fw::read_run_errors(in, "runs.csv");
+    auto r = analysis::read_run_errors(in, "runs.csv");
     ASSERT_FALSE(r.ok()) << text;
     EXPECT_NE(r.error().message.find(expect), std::string::npos) << r.error().message;
   }
   // Identical runs: a singular sample covariance, nothing to fit.
-  std::vector<fw::PoseError> same(6, fw::PoseError{0.01, 0.02, 0.003});
-  auto f = fw::fit_error_model(same, 10.0, 0.34);
+  std::vector<analysis::PoseError> same(6, analysis::PoseError{0.01, 0.02, 0.003});
+  auto f = analysis::fit_error_model(same, 10.0, 0.34);
   ASSERT_FALSE(f.ok());
   EXPECT_NE(f.error().message.find("singular"), std::string::npos) << f.error().message;
 }

@@ -7,7 +7,7 @@
 #include <cstdlib>
 
 #include "odo/drivers/hctl1100_encoder.hpp"
-#include "odo/firmware/loop.hpp"
+#include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
 #include "odo/sim/hctl1100_model.hpp"
 #include "odo/sim/virtual_clock.hpp"
@@ -314,13 +314,13 @@ TEST(Hctl1100Driver, LoopIntegratesAndReportsJumps) {
   // c_m = pi * 0.15 / (16 * 2048) = 1.438e-5 m per count.
   const auto k = Kinematics::create(KinematicParams{0.15, 2048, 16, 0.34, 0.34, 1.0, 1.0});
   ASSERT_TRUE(k.ok());
-  auto loop = fw::OdometryLoop::create(fw::LoopConfig{100.0}, *k, *enc, world.clock);
+  auto loop = loop::OdometryLoop::create(loop::LoopConfig{100.0}, *k, *enc, world.clock);
   ASSERT_TRUE(loop.ok());
   (*loop)->start();
   for (int i = 0; i < 100; ++i) (*loop)->tick();  // 1 s
   world.l.inject_jump(100000);
   for (int i = 0; i < 100; ++i) (*loop)->tick();  // 2 s
-  const fw::LoopSnapshot& s = (*loop)->snapshot();
+  const loop::LoopSnapshot& s = (*loop)->snapshot();
   EXPECT_EQ(s.encoder_counters.implausible_jumps, 1u);
   // 2 s * 1000 counts/s * 1.438e-5 m = 0.02876 m, straight ahead; the jump would have added
   // 100000 counts (1.4 m) to the left wheel. One tick of the left wheel (10 counts) is given

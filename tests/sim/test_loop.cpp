@@ -32,15 +32,15 @@ TEST(Loop, SixteenBitCountersWrapWithoutLoss) {
 
 // Records what each tick integrated: the sample time and the count deltas (wheel travel divided
 // by metres per count, which is an integer count up to rounding).
-struct TickRecorder final : fw::TickObserver {
-  explicit TickRecorder(const fw::OdometryLoop*& l) : loop(l) { stamps.reserve(4096); }
-  void on_tick(fw::LoopSnapshot& s) noexcept override {
+struct TickRecorder final : loop::TickObserver {
+  explicit TickRecorder(const loop::OdometryLoop*& l) : loop(l) { stamps.reserve(4096); }
+  void on_tick(const loop::LoopSnapshot& s) noexcept override {
     const Odometry& o = loop->odometry();
     stamps.push_back(s.stamp);
     counts_left += std::llround(o.last_d_left() / o.kinematics().metres_per_count_left());
     counts_right += std::llround(o.last_d_right() / o.kinematics().metres_per_count_right());
   }
-  const fw::OdometryLoop*& loop;
+  const loop::OdometryLoop*& loop;
   std::vector<TimeNs> stamps;
   std::int64_t counts_left = 0;
   std::int64_t counts_right = 0;
@@ -56,7 +56,7 @@ TEST(Loop, OverrunsSkipPeriodsAndLoseNoCount) {
   SimRun slow(g, k, wiggle(), 16, 32767 - 50);
   SimRun fast(g, k, wiggle());
   slow.encoder.set_read_delay(&slow.clock, 25'000'000);
-  const fw::OdometryLoop* slow_loop = slow.loop.get();
+  const loop::OdometryLoop* slow_loop = slow.loop;
   TickRecorder rec(slow_loop);
   slow.loop->add_observer(&rec);
   slow.drive();
@@ -116,7 +116,7 @@ TEST(Loop, SetPoseTakesEffectAtNextTick) {
   SimRun run(g, k, {{1.0, 0.0, 0.0}});
   run.loop->start();
   run.loop->tick();
-  run.loop->request_pose({1.5, -2.0, 0.25});
+  run.loop->post(loop::SetPose{{1.5, -2.0, 0.25}});
   EXPECT_DOUBLE_EQ(run.loop->odometry().pose().x, 0.0);  // not before the next tick
   run.loop->tick();
   EXPECT_DOUBLE_EQ(run.loop->odometry().pose().x, 1.5);
@@ -130,7 +130,7 @@ TEST(Loop, RejectsRateOutsideRange) {
   auto robot = *sim::SimRobot::create(g, {});
   sim::SimEncoderSource enc(robot);
   sim::VirtualClock clock;
-  auto l = fw::OdometryLoop::create(fw::LoopConfig{10.0}, k, enc, clock);
+  auto l = loop::OdometryLoop::create(loop::LoopConfig{10.0}, k, enc, clock);
   ASSERT_FALSE(l.ok());
   EXPECT_NE(l.error().message.find("[50, 2000] Hz"), std::string::npos);
 }
@@ -140,7 +140,7 @@ TEST(Loop, PublishesSnapshotsWithStats) {
   sim::RobotGeometry g;
   SimRun run(g, k, {{1.0, 2.0, 2.0}});
   run.drive(0.0);
-  fw::LoopSnapshot s;
+  loop::LoopSnapshot s;
   ASSERT_TRUE(run.loop->snapshots().latest(s));
   EXPECT_EQ(s.tick, run.loop->stats().ticks);
   EXPECT_EQ(s.tick, 100u);  // 1 s at 100 Hz
@@ -158,7 +158,7 @@ TEST(Loop, SnapshotCarriesTimingHistogramSummaries) {
   ticked.encoder.set_read_delay(&ticked.clock, 2'000'000);
   ticked.loop->start();
   for (int i = 0; i < 300; ++i) ticked.loop->tick();
-  fw::LoopSnapshot s;
+  loop::LoopSnapshot s;
   ASSERT_TRUE(ticked.loop->snapshots().latest(s));
   EXPECT_EQ(s.tick, 300u);
   EXPECT_EQ(s.stats.wakeup_latency.count, 256u);

@@ -21,7 +21,7 @@ TEST(LoopCovariance, StraightRunMatchesClosedForm) {
   const double omega = 0.5 / 0.075;
   SimRun run(g, k, {{20.0, omega, omega}});
   run.drive(0.5);
-  const fw::LoopSnapshot& s = run.loop->snapshot();
+  const loop::LoopSnapshot& s = run.loop->snapshot();
   ASSERT_TRUE(s.has_cov);
   const double d = s.distance;
   EXPECT_NEAR(d, 10.0, 1e-3);
@@ -41,10 +41,10 @@ TEST(LoopCovariance, SetPoseResetsCovarianceToZero) {
   run.loop->run(from_seconds(2.0), stop);
   const double before = run.loop->snapshot().cov[8];
   EXPECT_GT(before, 0.0);
-  run.loop->request_pose({1.0, 2.0, 0.5});
+  run.loop->post(loop::SetPose{{1.0, 2.0, 0.5}});
   run.loop->tick();
   // One tick of motion after the reset: the covariance is that of the tick alone.
-  const fw::LoopSnapshot& s = run.loop->snapshot();
+  const loop::LoopSnapshot& s = run.loop->snapshot();
   Cov3 one{};
   propagate_arc(one, 0.5, run.loop->odometry().last_d_left(), run.loop->odometry().last_d_right(),
                 0.34, ErrorModelParams{});
@@ -56,9 +56,9 @@ TEST(LoopCovariance, RejectsBadCoefficients) {
   sim::VirtualClock clock;
   auto robot = *sim::SimRobot::create(sim::RobotGeometry{}, {});
   sim::SimEncoderSource enc(robot);
-  fw::LoopConfig cfg;
+  loop::LoopConfig cfg;
   cfg.error_model.k_right = -1.0;
-  auto r = fw::OdometryLoop::create(cfg, *Kinematics::create(nominal_labmate()), enc, clock);
+  auto r = loop::OdometryLoop::create(cfg, *Kinematics::create(nominal_labmate()), enc, clock);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().message.find("error_model.k_right = -1"), std::string::npos)
       << r.error().message;

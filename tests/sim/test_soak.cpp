@@ -120,7 +120,7 @@ TEST(Soak, ODO_SOAK_NAME) {
   auto robot = *sim::SimRobot::create(g, prof.scenario);
   sim::SimEncoderSource counters(robot, bits, 32767 - 1000);
   sim::FaultyEncoderSource enc(counters, &clock);
-  auto loop = fw::OdometryLoop::create(fw::LoopConfig{100.0}, k, enc, clock).value();
+  auto loop = loop::OdometryLoop::create(loop::LoopConfig{100.0}, k, enc, clock).value();
   const TimeNs period = loop->period();
   const double c_m = k.metres_per_count(), b = k.wheelbase();
   const double r = 0.5 * g.wheel_diameter_left;
@@ -188,8 +188,8 @@ TEST(Soak, ODO_SOAK_NAME) {
     const bool slow = after.slow_reads > before.slow_reads;
     window_faulty = window_faulty || frozen || glitched;
 
-    const fw::LoopSnapshot& s = loop->snapshot();
-    const fw::LoopStats& st = loop->stats();
+    const loop::LoopSnapshot& s = loop->snapshot();
+    const loop::LoopStats& st = loop->stats();
     ASSERT_TRUE(std::isfinite(s.pose.x) && std::isfinite(s.pose.y) && std::isfinite(s.pose.theta) &&
                 std::isfinite(s.v) && std::isfinite(s.w) && std::isfinite(s.distance))
         << "tick " << s.tick;
@@ -263,7 +263,7 @@ TEST(Soak, ODO_SOAK_NAME) {
       }
       ASSERT_LE(perr, budget) << "tick " << s.tick << " at " << to_seconds(s.stamp) << " s";
       if (perr > 0.0) {
-        loop->request_pose({t.x, t.y, s.pose.theta});
+        loop->post(loop::SetPose{{t.x, t.y, s.pose.theta}});
         ++anchors;
       }
       budget = 0.0;
@@ -277,7 +277,7 @@ TEST(Soak, ODO_SOAK_NAME) {
   const std::uint64_t loop_allocations = g_allocations.load() - allocations_at_start;
   rss.push_back(rss_pages());
 
-  const fw::LoopStats& st = loop->stats();
+  const loop::LoopStats& st = loop->stats();
   const sim::InjectedFaults& inj = enc.injected();
   long rss_hourly_max = 0;
   for (std::size_t i = 1; i < rss.size(); ++i) rss_hourly_max = std::max(rss_hourly_max, rss[i]);

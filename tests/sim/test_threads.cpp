@@ -26,7 +26,7 @@ TEST(Threads, SetPoseRequestsAreNeverTorn) {
   SimRun run(g, k, {});
   std::atomic<bool> stop{false};
   std::thread loop([&] { run.loop->run(0, stop); });
-  fw::LoopSnapshot s;
+  loop::LoopSnapshot s;
   std::uint64_t changes = 0;  // snapshots showing a newly applied request
   double last_x = 0.0;
   int i = 0;
@@ -43,7 +43,7 @@ TEST(Threads, SetPoseRequestsAreNeverTorn) {
       std::this_thread::yield();
     }
     const double v = i;
-    run.loop->request_pose({v, -v, v / 1000.0});
+    run.loop->post(loop::SetPose{{v, -v, v / 1000.0}});
     if (run.loop->snapshots().latest(s)) {
       ASSERT_EQ(s.pose.x, -s.pose.y) << "torn set-pose at request " << i;
       ASSERT_EQ(s.pose.theta, s.pose.x / 1000.0) << "torn set-pose at request " << i;

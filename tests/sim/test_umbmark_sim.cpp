@@ -6,7 +6,7 @@
 #include <numbers>
 #include <sstream>
 
-#include "odo/firmware/umbmark_tools.hpp"
+#include "odo/analysis/umbmark_tools.hpp"
 #include "odo/sim/floor.hpp"
 
 namespace odo::test {
@@ -14,10 +14,10 @@ namespace {
 
 using calib::Direction;
 
-fw::UmbmarkSimResult simulate(const fw::UmbmarkSimOptions& o) {
-  auto r = fw::run_umbmark_simulation(o);
+analysis::UmbmarkSimResult simulate(const analysis::UmbmarkSimOptions& o) {
+  auto r = analysis::run_umbmark_simulation(o);
   EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
-  return r.ok() ? std::move(r).value() : fw::UmbmarkSimResult{};
+  return r.ok() ? std::move(r).value() : analysis::UmbmarkSimResult{};
 }
 
 TEST(UmbmarkSim, UncalibratedLabmateHasTheSignsOfTheReport) {
@@ -25,7 +25,7 @@ TEST(UmbmarkSim, UncalibratedLabmateHasTheSignsOfTheReport) {
   // 90 * 340/337 deg, i.e. alpha = (pi/2)(1 - 340/337) = -0.01398 rad (turns too far).
   // D_R/D_L = 0.9985: over a 4 m leg the right wheel lags 0.0015 * 4 m = 6 mm, the leg curves
   // right by beta = -0.006/0.337 = -0.0178 rad. The small-angle model recovers both to ~3 %.
-  fw::UmbmarkSimOptions o;
+  analysis::UmbmarkSimOptions o;
   const auto r = simulate(o);
   ASSERT_EQ(r.passes.size(), 1U);
   const calib::UmbmarkResult& u = r.passes[0].result;
@@ -37,7 +37,7 @@ TEST(UmbmarkSim, UncalibratedLabmateHasTheSignsOfTheReport) {
 }
 
 TEST(UmbmarkSim, OnePassNoiselessImprovesAtLeastFiftyFold) {
-  fw::UmbmarkSimOptions o;  // N = 5, one pass, no noise
+  analysis::UmbmarkSimOptions o;  // N = 5, one pass, no noise
   const auto r = simulate(o);
   ASSERT_EQ(r.passes.size(), 1U);
   const double before = r.passes[0].before.e_max_syst, after = r.passes[0].after.e_max_syst;
@@ -50,7 +50,7 @@ TEST(UmbmarkSim, OnePassNoiselessImprovesAtLeastFiftyFold) {
 }
 
 TEST(UmbmarkSim, TwoPassesBringEmaxBelowHalfAMillimetre) {
-  fw::UmbmarkSimOptions o;
+  analysis::UmbmarkSimOptions o;
   o.runs = 1;  // noiseless runs are identical: one a direction is enough
   o.passes = 2;
   const auto r = simulate(o);
@@ -64,7 +64,7 @@ TEST(UmbmarkSim, TwoPassesBringEmaxBelowHalfAMillimetre) {
 TEST(UmbmarkSim, ChongKleemanEq9LeavesHalfTheWheelbaseError) {
   // C&K Eq. 9, c_b = pi/(pi - alpha), corrects b by half of what Eq. 6.29 does: b goes from
   // 340 mm only to about 338.5 mm and the improvement stays far below that of Eq. 6.29.
-  fw::UmbmarkSimOptions o;
+  analysis::UmbmarkSimOptions o;
   o.runs = 1;
   const auto r629 = simulate(o);
   o.formula = calib::WheelbaseFormula::kChongKleeman9;
@@ -77,7 +77,7 @@ TEST(UmbmarkSim, ChongKleemanEq9LeavesHalfTheWheelbaseError) {
 TEST(UmbmarkSim, ExtendedUmbmarkSeesTheTenBumps) {
   // Ten bumps of 0.44 deg each under the inside wheel: every bump run's orientation differs from
   // the plain runs' bias by about 4.4 deg; Eq. 3.5 sums the cw and ccw means: about 8.8 deg.
-  fw::UmbmarkSimOptions o;
+  analysis::UmbmarkSimOptions o;
   o.runs = 1;
   o.bumps = true;
   const auto r = simulate(o);
@@ -93,7 +93,7 @@ TEST(UmbmarkSim, ExtendedUmbmarkSeesTheTenBumps) {
 TEST(UmbmarkSim, PaperNoiseSpreadsTheReturnPositions) {
   // --noise paper is tuned to the report's sigma of about 25 mm (20 seeds: mean 24 mm, README);
   // one seed of 5 + 5 runs lands within a factor of two of it, and one pass still helps >= 5x.
-  fw::UmbmarkSimOptions o;
+  analysis::UmbmarkSimOptions o;
   o.noise = "paper";
   o.seed = 1;
   const auto r = simulate(o);
@@ -105,7 +105,7 @@ TEST(UmbmarkSim, PaperNoiseSpreadsTheReturnPositions) {
 }
 
 TEST(UmbmarkSim, SameSeedSameResult) {
-  fw::UmbmarkSimOptions o;
+  analysis::UmbmarkSimOptions o;
   o.noise = "paper";
   o.runs = 1;
   o.seed = 7;
@@ -117,17 +117,17 @@ TEST(UmbmarkSim, SameSeedSameResult) {
 }
 
 TEST(UmbmarkSim, RejectsBadOptionsNamingThem) {
-  fw::UmbmarkSimOptions o;
+  analysis::UmbmarkSimOptions o;
   o.runs = 0;
-  auto s = fw::check_umbmark_sim_options(o);
+  auto s = analysis::check_umbmark_sim_options(o);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message.find("--runs"), std::string::npos);
   o = {};
   o.noise = "loud";
-  EXPECT_NE(fw::check_umbmark_sim_options(o).error().message.find("--noise"), std::string::npos);
+  EXPECT_NE(analysis::check_umbmark_sim_options(o).error().message.find("--noise"), std::string::npos);
   o = {};
   o.robot = "r2d2";
-  EXPECT_NE(fw::check_umbmark_sim_options(o).error().message.find("--robot"), std::string::npos);
+  EXPECT_NE(analysis::check_umbmark_sim_options(o).error().message.find("--robot"), std::string::npos);
 }
 
 TEST(UmbmarkFloor, RigidWheelBumpLoss) {
@@ -163,11 +163,11 @@ TEST(UmbmarkFloor, BumpsOnlyOnTheFirstLegUnderTheChosenWheel) {
 }
 
 TEST(UmbmarkSvg, PlotHasEveryRunAndCentreOfGravity) {
-  fw::UmbmarkSimOptions o;
+  analysis::UmbmarkSimOptions o;
   o.runs = 2;
   o.passes = 2;
   const auto r = simulate(o);
-  const std::string svg = fw::umbmark_svg(r, "t & t");
+  const std::string svg = analysis::umbmark_svg(r, "t & t");
   std::size_t circles = 0, crosses = 0;
   for (std::size_t p = svg.find("<circle"); p != std::string::npos; p = svg.find("<circle", p + 1))
     ++circles;

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "odo/firmware/umbmark_tools.hpp"
+#include "odo/analysis/umbmark_tools.hpp"
 
 namespace odo::test {
 namespace {
@@ -20,11 +20,11 @@ double median(std::vector<double> v) {
 TEST(UmbmarkStudy, PaperNoiseTwentySeeds) {
   std::vector<double> improve, sigma, gain_asked, gain_not_asked;
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
-    fw::UmbmarkSimOptions o;
+    analysis::UmbmarkSimOptions o;
     o.noise = "paper";
     o.passes = 2;
     o.seed = seed;
-    auto r = fw::run_umbmark_simulation(o);
+    auto r = analysis::run_umbmark_simulation(o);
     ASSERT_TRUE(r.ok()) << r.error().message;
     const auto& p1 = r->passes[0];
     const auto& p2 = r->passes[1];

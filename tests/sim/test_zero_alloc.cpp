@@ -9,11 +9,12 @@
 #include <new>
 
 #include "odo/firmware/can_broadcast.hpp"
-#include "odo/firmware/can_protocol.hpp"
 #include "odo/firmware/config.hpp"
-#include "odo/firmware/loop.hpp"
 #include "odo/firmware/rig.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/protocol/can_protocol.hpp"
 #include "odo/sim/sim_can_bus.hpp"
+#include "odo/sim/truth.hpp"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 #define ODO_COUNT_MALLOC 0
@@ -262,8 +263,8 @@ TEST(ZeroAlloc, CountersSeeEveryKindOfAllocation) {
 }
 
 // An observer that breaks the rule: allocates on every tick.
-struct AllocatingObserver final : fw::TickObserver {
-  void on_tick(fw::LoopSnapshot& s) noexcept override {
+struct AllocatingObserver final : loop::TickObserver {
+  void on_tick(const loop::LoopSnapshot& s) noexcept override {
     auto* p = new std::uint64_t(s.tick);
     escape(p);
     delete p;
@@ -277,7 +278,7 @@ TEST(ZeroAlloc, AnAllocationInsideATickIsCaught) {
   auto rig = fw::Rig::create(cfg, *kin, true);
   ASSERT_TRUE(rig.ok());
   auto loop =
-      fw::OdometryLoop::create(fw::LoopConfig{}, *kin, rig->encoder(), rig->clock()).value();
+      loop::OdometryLoop::create(loop::LoopConfig{}, *kin, rig->encoder(), rig->clock()).value();
   AllocatingObserver bad;
   loop->add_observer(&bad);
   loop->start();
@@ -293,16 +294,16 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   // the virtual clock, ground-truth observer attached. Start-up may allocate; ticks may not.
   fw::Config cfg = fw::default_config();
   cfg.loop.rate_hz = 1000.0;
-  cfg.sim.scenario = "squares";
+  cfg.sim.scenario = fw::SimScenario::kSquares;
   auto kin = Kinematics::create(cfg.robot);
   ASSERT_TRUE(kin.ok());
   auto rig = fw::Rig::create(cfg, *kin, /*virtual_time=*/true);
   ASSERT_TRUE(rig.ok()) << rig.error().message;
-  fw::LoopConfig lc;
+  loop::LoopConfig lc;
   lc.rate_hz = cfg.loop.rate_hz;
-  auto loop = fw::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
-  ASSERT_NE(rig->truth_observer(), nullptr);
-  loop->add_observer(rig->truth_observer());
+  auto loop = loop::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
+  ASSERT_NE(rig->truth(), nullptr);
+  loop->add_observer(rig->truth());
   // The CAN broadcast at the default rates on the simulated bus, with the candump log (its
   // writer thread formats and writes frames while the window is open) and set-pose commands.
   const std::string can_log = ::testing::TempDir() + "zero_alloc_can.log";
@@ -313,7 +314,7 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   loop->start();
 
   constexpr std::uint64_t kTicks = 200'000;  // 200 s at 1 kHz: both squares, then standstill
-  fw::LoopSnapshot reader;
+  loop::LoopSnapshot reader;
   std::uint64_t published = 0;
   {
     AllocWindow w;
@@ -321,11 +322,13 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
       loop->tick();
       // The status thread's side of the hand-over too, now and then.
       if ((i & 1023) == 0 && loop->snapshots().latest(reader)) ++published;
+      if (i == 100'000)  // new calibration from the reloader thread: the other producer
+        ASSERT_TRUE(loop->post(loop::SetKinematics{*kin, calib::StoreStatus::kOk}));
       if (i == 150'000) {  // a set-pose command (reset to zero) arrives on the bus
         CanFrame cmd;
-        fw::can::encode_set_pose(
-            fw::can::frame_id(fw::can::kDefaultBaseId, cfg.can.node_id, fw::can::Msg::kSetPose),
-            fw::can::SetPoseCmd{true, 0, 0, 0}, cmd);
+        protocol::encode_set_pose(
+            protocol::frame_id(protocol::kDefaultBaseId, cfg.can.node_id, protocol::Msg::kSetPose),
+            protocol::SetPoseCmd{true, 0, 0, 0}, cmd);
         (*can)->sim_port()->inject(cmd);
       }
     }
@@ -341,6 +344,8 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   EXPECT_EQ((*can)->counters().sent, 171u * (kTicks / 1000) + 6u);
   EXPECT_EQ((*can)->counters().dropped(), 0u);
   EXPECT_EQ((*can)->counters().set_pose_applied, 1u);
+  EXPECT_EQ(loop->commands_applied(), 2u);  // the calibration and the set-pose command
+  EXPECT_EQ(loop->snapshot().calibration_state, calib::StoreStatus::kOk);
   // The writer runs on wall time and the loop here is faster than real time: what the ring
   // could not hold is counted, never waited for.
   EXPECT_EQ((*can)->log_written() + (*can)->log_dropped(), (*can)->counters().sent);
@@ -349,7 +354,8 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   ASSERT_LT(rig->scenario_duration(), 199.0);
   EXPECT_NEAR(loop->odometry().distance(), 32.0, 0.2);  // two 4 m squares: 32 m of legs
   EXPECT_EQ(loop->wakeup_histogram().count(), kTicks);
-  EXPECT_EQ(loop->stats().wakeup_latency.count, kTicks - kTicks % fw::OdometryLoop::kSummaryTicks);
+  EXPECT_EQ(loop->stats().wakeup_latency.count,
+            kTicks - kTicks % loop::OdometryLoop::kSummaryTicks);
 }
 
 TEST(ZeroAlloc, CanReceiveFloodWithoutAllocating) {
@@ -358,24 +364,24 @@ TEST(ZeroAlloc, CanReceiveFloodWithoutAllocating) {
   // set-pose command for this node), far more than the broadcaster reads per tick.
   fw::Config cfg = fw::default_config();
   cfg.loop.rate_hz = 1000.0;
-  cfg.sim.scenario = "idle";
+  cfg.sim.scenario = fw::SimScenario::kIdle;
   ASSERT_TRUE(cfg.can.set_pose);
   auto kin = Kinematics::create(cfg.robot);
   ASSERT_TRUE(kin.ok());
   auto rig = fw::Rig::create(cfg, *kin, /*virtual_time=*/true);
   ASSERT_TRUE(rig.ok()) << rig.error().message;
-  fw::LoopConfig lc;
+  loop::LoopConfig lc;
   lc.rate_hz = cfg.loop.rate_hz;
-  auto loop = fw::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
+  auto loop = loop::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
   auto can = fw::CanLink::create(cfg.can, cfg.loop.rate_hz, *loop, "");
   ASSERT_TRUE(can.ok()) << can.error().message;
   sim::SimCanPort* port = (*can)->sim_port();
   ASSERT_NE(port, nullptr);
   loop->start();
   CanFrame ours;
-  fw::can::encode_set_pose(
-      fw::can::frame_id(fw::can::kDefaultBaseId, cfg.can.node_id, fw::can::Msg::kSetPose),
-      fw::can::SetPoseCmd{false, 1.0, 2.0, 0.5}, ours);
+  protocol::encode_set_pose(
+      protocol::frame_id(protocol::kDefaultBaseId, cfg.can.node_id, protocol::Msg::kSetPose),
+      protocol::SetPoseCmd{false, 1.0, 2.0, 0.5}, ours);
   CanFrame foreign;
   foreign.len = 8;
   constexpr std::uint64_t kTicks = 20'000;
@@ -414,16 +420,16 @@ TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
   // sending at 20 s; none of it may allocate.
   fw::Config cfg = fw::default_config();
   cfg.loop.rate_hz = 1000.0;
-  cfg.encoder.backend = "can";
-  cfg.can_encoder.bus = "sim";
+  cfg.encoder.backend = fw::EncoderKind::kCan;
+  cfg.can_encoder.bus = fw::CanEncoderBus::kSim;
   cfg.can_encoder.sim_stop_left_after = 20.0;
   auto kin = Kinematics::create(cfg.robot);
   ASSERT_TRUE(kin.ok());
   auto rig = fw::Rig::create(cfg, *kin, /*virtual_time=*/true);
   ASSERT_TRUE(rig.ok()) << rig.error().message;
-  fw::LoopConfig lc;
+  loop::LoopConfig lc;
   lc.rate_hz = cfg.loop.rate_hz;
-  auto loop = fw::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
+  auto loop = loop::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
   loop->start();
   constexpr std::uint64_t kTicks = 40'000;  // 40 s at 1 kHz
   {
@@ -433,7 +439,7 @@ TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
     EXPECT_EQ(g_allocs.load(), 0u) << "heap allocations during " << kTicks << " ticks";
     EXPECT_EQ(g_frees.load(), 0u) << "heap deallocations during " << kTicks << " ticks";
   }
-  fw::LoopSnapshot snap;
+  loop::LoopSnapshot snap;
   ASSERT_TRUE(loop->snapshots().latest(snap));
   EXPECT_EQ(snap.encoder_flags, static_cast<std::uint32_t>(kEncoderStaleLeft));
   EXPECT_EQ(snap.encoder_counters.stale_events, 1u);

@@ -25,7 +25,7 @@ TEST(CalibKill, FileBackendSurvivesSigkill) {
   std::filesystem::remove(path);
   kill_loop(
       [](const std::string& p) -> std::unique_ptr<NvStorage> {
-        return std::make_unique<drv::FileNvStorage>(p);
+        return std::make_unique<drivers::FileNvStorage>(p);
       },
       path, 250, 42);
   std::filesystem::remove_all(std::filesystem::path(path).parent_path());
@@ -41,7 +41,7 @@ TEST(CalibKill, NvmemStyleFileSurvivesSigkill) {
   }
   kill_loop(
       [](const std::string& p) -> std::unique_ptr<NvStorage> {
-        auto m = drv::NvmemStorage::open(p);
+        auto m = drivers::NvmemStorage::open(p);
         if (!m) _exit(5);
         return std::move(m).value();
       },

@@ -20,9 +20,10 @@
 #include <vector>
 
 #include "calib_kill_loop.hpp"
+#include "odo/analysis/calibration_json.hpp"
 #include "odo/drivers/nv_storage.hpp"
-#include "odo/firmware/calibration_io.hpp"
 #include "odo/firmware/calibration_reload.hpp"
+#include "odo/firmware/calibration_store.hpp"
 #include "odo/firmware/config.hpp"
 
 namespace odo::calib {
@@ -57,7 +58,7 @@ class PausingFileStorage final : public NvStorage {
   Status erase(std::size_t off, std::size_t len) override { return file_.erase(off, len); }
 
  private:
-  drv::FileNvStorage file_;
+  drivers::FileNvStorage file_;
   std::size_t split_;
   std::chrono::milliseconds pause_;
 };
@@ -66,7 +67,7 @@ class PausingFileStorage final : public NvStorage {
 void check_applied(const fw::AppliedCalibration& a, const KinematicParams& nominal,
                    std::uint64_t seq) {
   const CalibrationRecord r = record_for(seq);
-  EXPECT_EQ(a.state, 1) << a.report;
+  EXPECT_EQ(a.state, calib::StoreStatus::kOk) << a.report;
   EXPECT_EQ(a.sequence, seq) << a.report;
   EXPECT_EQ(a.params.c_l, r.c_l);
   EXPECT_EQ(a.params.c_r, r.c_r);
@@ -86,7 +87,7 @@ std::filesystem::path scratch_dir(const std::string& name) {
 
 // save_records: records of sequence 1, 2, ..., n saved in turn to the file store at `path`.
 void save_records(const std::string& path, std::uint64_t n) {
-  drv::FileNvStorage m(path);
+  drivers::FileNvStorage m(path);
   auto store = CalibrationStore::create(m);
   ASSERT_TRUE(store);
   for (std::uint64_t seq = 1; seq <= n; ++seq) ASSERT_TRUE(store->save(record_for(seq)));
@@ -125,14 +126,15 @@ TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while (!g_reload.exchange(false) && std::chrono::steady_clock::now() < deadline)
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    const fw::AppliedCalibration during = fw::read_and_apply(nominal, path, "file");
+    const fw::AppliedCalibration during =
+        fw::read_and_apply(nominal, path, fw::StoreBackend::kFile);
     // The writer had written part of the record and had not finished when we read.
     int status = 0;
     const pid_t w = waitpid(pid, &status, WNOHANG);
     ASSERT_GE(w, 0);
     if (w == 0) ++mid_write;
     // The store as it stood: the slot being written half old, half new (not valid, not blank)?
-    drv::FileNvStorage probe(path);
+    drivers::FileNvStorage probe(path);
     auto ps = CalibrationStore::create(probe);
     ASSERT_TRUE(ps);
     auto l = ps->load();
@@ -144,7 +146,7 @@ TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
       ++torn_seen;
       check_applied(during, nominal, seq);  // the half-written record is never used
     } else {
-      EXPECT_EQ(during.state, 1) << during.report;
+      EXPECT_EQ(during.state, calib::StoreStatus::kOk) << during.report;
       EXPECT_TRUE(during.sequence == seq || during.sequence == seq + 1) << during.report;
       check_applied(during, nominal, during.sequence);
     }
@@ -152,7 +154,7 @@ TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
     ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "writer status " << status;
     ++seq;
     // A SIGHUP after the save: the new record.
-    check_applied(fw::read_and_apply(nominal, path, "file"), nominal, seq);
+    check_applied(fw::read_and_apply(nominal, path, fw::StoreBackend::kFile), nominal, seq);
     ++rounds;
   }
   sigaction(SIGHUP, &old, nullptr);
@@ -187,8 +189,8 @@ TEST(CalibReloadRace, BothSlotsInFlightIsReadAgainUntilTheSaveSettles) {
   const std::vector<char> settled = file_bytes(path);
   const std::vector<char> in_flight(settled.size(), '\x5a');  // neither valid nor blank
   put_file_bytes(path, in_flight);
-  auto read = [&] { return fw::read_and_apply(nominal, path, "file"); };
-  ASSERT_EQ(read().state, 2) << "precondition: both slots unreadable";
+  auto read = [&] { return fw::read_and_apply(nominal, path, fw::StoreBackend::kFile); };
+  ASSERT_EQ(read().state, calib::StoreStatus::kCorrupt) << "precondition: both slots unreadable";
 
   int pauses = 0, rereads = -1;
   fw::AppliedCalibration a = fw::read_settled(
@@ -207,13 +209,13 @@ TEST(CalibReloadRace, BothSlotsInFlightIsReadAgainUntilTheSaveSettles) {
   pauses = 0;
   a = fw::read_settled(
       read, 4, [&] { return ++pauses > 0; }, &rereads);
-  EXPECT_EQ(a.state, 2) << a.report;
+  EXPECT_EQ(a.state, calib::StoreStatus::kCorrupt) << a.report;
   EXPECT_EQ(pauses, 3);
   EXPECT_EQ(rereads, 3);
   // Stopping during the pause: no re-read.
   a = fw::read_settled(
       read, 4, [] { return false; }, &rereads);
-  EXPECT_EQ(a.state, 2);
+  EXPECT_EQ(a.state, calib::StoreStatus::kCorrupt);
   EXPECT_EQ(rereads, 0);
   // A good store is read once.
   put_file_bytes(path, settled);
@@ -225,20 +227,23 @@ TEST(CalibReloadRace, BothSlotsInFlightIsReadAgainUntilTheSaveSettles) {
 
   // The reloader thread itself on a corrupt store: four reads, said in its log line, state 2.
   put_file_bytes(path, in_flight);
-  fw::CalibrationHandover handover(1);
+  loop::CommandQueue commands;
   std::ostringstream log;
-  fw::CalibrationReloader reloader(handover, nominal, path, "file", log);
+  fw::CalibrationReloader reloader(commands, nominal, path, fw::StoreBackend::kFile, log);
   std::atomic<bool> request{true};
   reloader.start(request);
-  fw::LoopSnapshot snap;
+  calib::StoreStatus state = calib::StoreStatus::kOk;
+  std::size_t applied = 0;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-  while (handover.applied() == 0 && std::chrono::steady_clock::now() < deadline) {
-    handover.on_tick(snap);  // takes the offer, as the loop does between ticks
+  while (applied == 0 && std::chrono::steady_clock::now() < deadline) {
+    // Takes the command, as the loop does at the top of a tick.
+    applied += commands.drain(
+        [&](const loop::Command& c) { state = std::get<loop::SetKinematics>(c).calibration; });
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   reloader.stop();
-  ASSERT_EQ(handover.applied(), 1u);
-  EXPECT_EQ(snap.calibration_state, 2);
+  ASSERT_EQ(applied, 1u);
+  EXPECT_EQ(state, calib::StoreStatus::kCorrupt);
   EXPECT_NE(log.str().find("read 4 times (corrupt every time)"), std::string::npos) << log.str();
   std::filesystem::remove_all(dir);
 }
@@ -267,10 +272,13 @@ TEST(CalibReloadRace, StopReturnsWhileAReloadWaitsForALoopThatNoLongerTicks) {
   const std::string path = (dir / "calibration.bin").string();
   const KinematicParams nominal = fw::default_config().robot;
   ASSERT_NO_FATAL_FAILURE(save_records(path, 1));
-  fw::CalibrationHandover handover(0);  // no loop: nobody takes the offers
+  // No loop: nobody takes the commands, and the queue has room for one more.
+  loop::CommandQueue commands;
+  for (std::size_t i = 1; i < loop::CommandQueue::kCapacity; ++i)
+    ASSERT_TRUE(commands.post(loop::SetPose{}));
   LineCounter sink;
   std::ostream log(&sink);
-  fw::CalibrationReloader reloader(handover, nominal, path, "file", log);
+  fw::CalibrationReloader reloader(commands, nominal, path, fw::StoreBackend::kFile, log);
   std::atomic<bool> request{true};
   reloader.start(request);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
@@ -297,7 +305,8 @@ TEST(CalibReloadRace, StopReturnsWhileAReloadWaitsForALoopThatNoLongerTicks) {
     std::_Exit(1);
   }
   stopper.join();
-  EXPECT_EQ(handover.applied(), 0u);
+  // Nobody took a command: the queue holds the first reload's and no more.
+  EXPECT_EQ(commands.drain([](const loop::Command&) {}), loop::CommandQueue::kCapacity);
   std::filesystem::remove_all(dir);
 }
 

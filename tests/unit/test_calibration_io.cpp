@@ -4,10 +4,13 @@
 #include <atomic>
 #include <nlohmann/json.hpp>
 
+#include "odo/analysis/calibration_json.hpp"
 #include "odo/calibration/store.hpp"
-#include "odo/firmware/calibration_io.hpp"
 #include "odo/firmware/calibration_reload.hpp"
+#include "odo/firmware/calibration_store.hpp"
 #include "odo/firmware/config.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/sim/sim_run.hpp"
 
 namespace odo::fw {
 namespace {
@@ -30,7 +33,7 @@ TEST(CalibrationIo, ImportsUmbmarkComputeOutput) {
   const char* text =
       R"({"c_l":0.99925,"c_r":1.00075,"b_new":0.33702,"e_max_syst":0.232,"n_cw":5,"n_ccw":5,
           "alpha":0.0012,"beta":-0.0004,"e_d":1.0015,"e_b":0.9912})";
-  auto r = parse_calibration_json(text, "u.json", 1795000000);
+  auto r = analysis::parse_calibration_json(text, "u.json", 1795000000);
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_DOUBLE_EQ(r->c_l, 0.99925);
   EXPECT_DOUBLE_EQ(r->c_r, 1.00075);
@@ -57,30 +60,31 @@ TEST(CalibrationIo, ExportImportRoundTrip) {
   r.e_max_before = 0.3;
   r.e_max_after = 0.02;
   r.runs = 10;
-  auto back = parse_calibration_json(export_json(r), "e.json", 0);
+  auto back = analysis::parse_calibration_json(analysis::export_json(r), "e.json", 0);
   ASSERT_TRUE(back) << back.error().message;
   r.sequence = 0;  // the store assigns sequence numbers; import does not carry them
   EXPECT_EQ(*back, r);
 }
 
 TEST(CalibrationIo, BadInputNamesTheField) {
-  auto r = parse_calibration_json(R"({"c_l":1.3,"c_r":1.0})", "x.json", 0);
+  auto r = analysis::parse_calibration_json(R"({"c_l":1.3,"c_r":1.0})", "x.json", 0);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("x.json"), std::string::npos);
   EXPECT_NE(r.error().message.find("c_l"), std::string::npos);
   EXPECT_NE(r.error().message.find("[0.9, 1.1]"), std::string::npos);
-  r = parse_calibration_json(R"({"c_l":"one","c_r":1.0})", "x.json", 0);
+  r = analysis::parse_calibration_json(R"({"c_l":"one","c_r":1.0})", "x.json", 0);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("field c_l: expected a number"), std::string::npos);
-  r = parse_calibration_json(R"({"c_l":1.0})", "x.json", 0);
+  r = analysis::parse_calibration_json(R"({"c_l":1.0})", "x.json", 0);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("c_r is missing"), std::string::npos);
-  r = parse_calibration_json(R"({"c_l":1.0,"c_r":1.0,"b_new":-0.3})", "x.json", 0);
+  r = analysis::parse_calibration_json(R"({"c_l":1.0,"c_r":1.0,"b_new":-0.3})", "x.json", 0);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("wheelbase"), std::string::npos);
-  EXPECT_FALSE(parse_calibration_json("{not json", "x.json", 0));
-  EXPECT_FALSE(parse_calibration_json("[1,2]", "x.json", 0));
-  r = parse_calibration_json(R"({"status":"corrupt","c_l":null,"c_r":null})", "s.json", 0);
+  EXPECT_FALSE(analysis::parse_calibration_json("{not json", "x.json", 0));
+  EXPECT_FALSE(analysis::parse_calibration_json("[1,2]", "x.json", 0));
+  r = analysis::parse_calibration_json(R"({"status":"corrupt","c_l":null,"c_r":null})", "s.json",
+                                       0);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("corrupt"), std::string::npos);
 }
@@ -95,7 +99,7 @@ TEST(CalibrationIo, ShowJsonHasTheRequiredKeys) {
   r.wheelbase = 0.337;
   l.record = r;
   l.slot = 1;
-  auto j = nlohmann::json::parse(show_json(l));
+  auto j = nlohmann::json::parse(analysis::show_json(l));
   EXPECT_EQ(j["status"], "ok");
   EXPECT_EQ(j["sequence"], 4);
   EXPECT_EQ(j["c_l"], 0.999);
@@ -104,7 +108,7 @@ TEST(CalibrationIo, ShowJsonHasTheRequiredKeys) {
   EXPECT_TRUE(j["wheel_diameter"].is_null());
   LoadResult bad;
   bad.status = StoreStatus::kCorrupt;
-  j = nlohmann::json::parse(show_json(bad));
+  j = nlohmann::json::parse(analysis::show_json(bad));
   EXPECT_EQ(j["status"], "corrupt");
   EXPECT_TRUE(j["c_l"].is_null());  // no made-up values for a corrupt store
 }
@@ -119,7 +123,7 @@ TEST(CalibrationIo, ApplyUsesStoredValuesOnlyWhenOk) {
   r.wheelbase = 0.337;
   l.record = r;
   AppliedCalibration a = apply_calibration(nominal(), Result<LoadResult>(l), "test");
-  EXPECT_EQ(a.state, 1);
+  EXPECT_EQ(a.state, calib::StoreStatus::kOk);
   EXPECT_EQ(a.sequence, 2U);
   EXPECT_DOUBLE_EQ(a.params.c_l, 0.999);
   EXPECT_DOUBLE_EQ(a.params.wheelbase, 0.337);
@@ -129,40 +133,43 @@ TEST(CalibrationIo, ApplyUsesStoredValuesOnlyWhenOk) {
   l.status = StoreStatus::kCorrupt;
   l.record.reset();
   a = apply_calibration(nominal(), Result<LoadResult>(l), "test");
-  EXPECT_EQ(a.state, 2);
+  EXPECT_EQ(a.state, calib::StoreStatus::kCorrupt);
   EXPECT_DOUBLE_EQ(a.params.c_l, 1.0);
   EXPECT_NE(a.report.find("ERROR"), std::string::npos);
   EXPECT_NE(a.report.find("NOMINAL"), std::string::npos);
 
   a = apply_calibration(nominal(), Result<LoadResult>(make_error(Errc::kIo, "EACCES")), "test");
-  EXPECT_EQ(a.state, 2);
+  EXPECT_EQ(a.state, calib::StoreStatus::kCorrupt);
 
   l.status = StoreStatus::kUncalibrated;
   a = apply_calibration(nominal(), Result<LoadResult>(l), "test");
-  EXPECT_EQ(a.state, 0);
+  EXPECT_EQ(a.state, calib::StoreStatus::kUncalibrated);
   EXPECT_NE(a.report.find("nominal values"), std::string::npos);
 }
 
 TEST(CalibrationHandover, AppliedOnTheLoopThreadBetweenTicks) {
-  // Without a loop attached the observer only stamps the state; an offer is taken on the next
-  // tick and the state changes with it.
-  CalibrationHandover h(0);
-  LoopSnapshot snap;
-  h.on_tick(snap);
-  EXPECT_EQ(snap.calibration_state, 0);
-  std::atomic<bool> stop{false};
+  // The loop stamps the store's status of its kinematics on every snapshot; kinematics posted
+  // as a command are taken at the top of the next tick and the state changes with them.
   auto k = Kinematics::create(nominal());
   ASSERT_TRUE(k);
-  ASSERT_TRUE(h.offer(*k, 1, stop));
-  EXPECT_EQ(h.applied(), 0U);
-  h.on_tick(snap);
-  EXPECT_EQ(snap.calibration_state, 1);
-  EXPECT_EQ(h.applied(), 1U);
-  ASSERT_TRUE(h.offer(*k, 2, stop));
-  stop = true;
-  EXPECT_FALSE(h.offer(*k, 1, stop));  // previous offer not yet taken, and stopping
-  h.on_tick(snap);
-  EXPECT_EQ(snap.calibration_state, 2);
+  auto run = sim::SimRun::create(sim::labmate_geometry(), *k, {{10.0, 1.0, 1.0}});
+  ASSERT_TRUE(run);
+  loop::OdometryLoop& l = (*run)->loop();
+  l.start();
+  l.tick();
+  EXPECT_EQ(l.snapshot().calibration_state, StoreStatus::kUncalibrated);
+  ASSERT_TRUE(l.post(loop::SetKinematics{*k, StoreStatus::kOk}));
+  EXPECT_EQ(l.commands_applied(), 0U);
+  l.tick();
+  EXPECT_EQ(l.snapshot().calibration_state, StoreStatus::kOk);
+  EXPECT_EQ(l.commands_applied(), 1U);
+  ASSERT_TRUE(l.post(loop::SetKinematics{*k, StoreStatus::kCorrupt}));
+  for (std::size_t i = 1; i < loop::CommandQueue::kCapacity; ++i)
+    ASSERT_TRUE(l.post(loop::SetPose{l.snapshot().pose}));
+  EXPECT_FALSE(l.post(loop::SetPose{}));  // queue full: the loop has not ticked
+  l.tick();
+  EXPECT_EQ(l.snapshot().calibration_state, StoreStatus::kCorrupt);
+  EXPECT_EQ(l.commands_applied(), 1U + loop::CommandQueue::kCapacity);
 }
 
 }  // namespace
@@ -175,7 +182,7 @@ TEST(CalibrationConfig, SectionKeysAndErrors) {
   auto c = parse_config("[calibration]\nstore = \"/dev/mtd3\"\nbackend = \"mtd\"\n", "t.toml");
   ASSERT_TRUE(c) << c.error().message;
   EXPECT_EQ(c->calibration.store, "/dev/mtd3");
-  EXPECT_EQ(c->calibration.backend, "mtd");
+  EXPECT_EQ(c->calibration.backend, StoreBackend::kMtd);
   EXPECT_EQ(default_config().calibration.store, kDefaultCalibrationStore);
   auto bad = parse_config("[calibration]\nbackend = \"eeprom\"\n", "t.toml");
   ASSERT_FALSE(bad);
@@ -188,8 +195,8 @@ TEST(CalibrationConfig, NoStoreConfiguredMeansNominal) {
   p.wheel_diameter = 0.15;
   p.counts_per_rev = 2048;
   p.wheelbase_nominal = p.wheelbase = 0.34;
-  AppliedCalibration a = read_and_apply(p, "", "auto");
-  EXPECT_EQ(a.state, 0);
+  AppliedCalibration a = read_and_apply(p, "", StoreBackend::kAuto);
+  EXPECT_EQ(a.state, calib::StoreStatus::kUncalibrated);
   EXPECT_NE(a.report.find("no store configured"), std::string::npos);
 }
 

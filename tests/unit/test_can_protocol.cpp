@@ -4,14 +4,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <numbers>
 #include <string>
+#include <vector>
 
-#include "odo/firmware/can_protocol.hpp"
-#include "odo/firmware/candump_log.hpp"
+#include "odo/protocol/can_protocol.hpp"
+#include "odo/protocol/candump_log.hpp"
+#include "odo/protocol/signals.hpp"
 
-namespace odo::fw::can {
+namespace odo::protocol {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -247,13 +250,13 @@ TEST(CandumpLog, InterfaceNamesMustBePrintable) {
   // character, a non-ASCII byte or a '/' cannot be a Linux interface name and would not survive
   // being printed back; a name of 15 printable characters is the longest there is.
   using namespace std::string_literals;
-  EXPECT_TRUE(fw::parse_candump_line("(1.000000) can-bus_0.1 410#00").ok());
-  EXPECT_TRUE(fw::parse_candump_line("(1.000000) abcdefghijklmno 410#00").ok());
+  EXPECT_TRUE(parse_candump_line("(1.000000) can-bus_0.1 410#00").ok());
+  EXPECT_TRUE(parse_candump_line("(1.000000) abcdefghijklmno 410#00").ok());
   for (const std::string& line : {"(1.000000) \0\0\0.sim0 410#00"s, "(1.000000) ca\tn0 410#00"s,
                                   "(1.000000) can\xc3\xa9"
                                   "0 410#00"s,
                                   "(1.000000) a/b 410#00"s}) {
-    auto bad = fw::parse_candump_line(line);
+    auto bad = parse_candump_line(line);
     ASSERT_FALSE(bad.ok()) << line;
     EXPECT_NE(bad.error().message.find("interface name"), std::string::npos) << bad.error().message;
   }
@@ -262,18 +265,44 @@ TEST(CandumpLog, InterfaceNamesMustBePrintable) {
 TEST(CandumpLog, TimeStampsBeyondTheNanosecondClockAreRefused) {
   // 9223372035 s is the last whole second whose nanoseconds (plus 999999 us) fit an int64:
   // 9223372035 * 1e9 + 999999000 = 9223372035999999000 < 2^63 - 1 = 9223372036854775807.
-  auto ok = fw::parse_candump_line("(9223372035.999999) vcan0 410#00");
+  auto ok = parse_candump_line("(9223372035.999999) vcan0 410#00");
   ASSERT_TRUE(ok.ok()) << ok.error().message;
   EXPECT_EQ(ok->sec, 9223372035);
   // One second later the nanoseconds would overflow (found by fuzz_candump: 179535382837 s).
   for (const char* line :
        {"(9223372036.000000) vcan0 410#00", "(179535382837.303618) sim0 410#00"}) {
-    auto bad = fw::parse_candump_line(line);
+    auto bad = parse_candump_line(line);
     ASSERT_FALSE(bad.ok()) << line;
     EXPECT_NE(bad.error().message.find("beyond the range"), std::string::npos)
         << bad.error().message;
   }
 }
 
+// The DBC file is the signal table written out: its BO_ and SG_ lines are exactly those derived
+// from protocol/signals.hpp (ids for node 1 at base 0x400), factors and limits as plain decimals.
+TEST(CanProtocolDbc, FileMatchesTheSignalTable) {
+  std::ifstream in(std::string(ODO_SOURCE_DIR) + "/protocol/odometry.dbc");
+  ASSERT_TRUE(in) << "protocol/odometry.dbc not found";
+  std::vector<std::string> got;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("BO_ ", 0) == 0 || line.rfind(" SG_ ", 0) == 0) got.push_back(line);
+  }
+  std::vector<std::string> want;
+  for (const MessageSpec& m : kMessages) {
+    want.push_back(dbc_message_line(m));
+    for (const Signal* s : m.signals) want.push_back(dbc_signal_line(m, *s));
+  }
+  EXPECT_EQ(got, want);
+  for (const std::string& l : got) EXPECT_EQ(l.find("e-"), std::string::npos) << l;
+}
+
+TEST(CanProtocolDbc, DecimalsArePlain) {
+  EXPECT_EQ(dbc_decimal(1e-5), "0.00001");
+  EXPECT_EQ(dbc_decimal(1e-6), "0.000001");
+  EXPECT_EQ(dbc_decimal(1.0), "1");
+  EXPECT_EQ(dbc_decimal(-2147483648 * 1e-4), "-214748.3648");
+  EXPECT_EQ(dbc_decimal(65535 * 1e-5), "0.65535");
+}
+
 }  // namespace
-}  // namespace odo::fw::can
+}  // namespace odo::protocol

@@ -9,7 +9,7 @@ TEST(Config, EmptyTextGivesDefaults) {
   auto c = parse_config("", "empty.toml");
   ASSERT_TRUE(c.ok()) << c.error().message;
   EXPECT_DOUBLE_EQ(c->loop.rate_hz, 100.0);
-  EXPECT_EQ(c->encoder.backend, "sim");
+  EXPECT_EQ(c->encoder.backend, EncoderKind::kSim);
   EXPECT_DOUBLE_EQ(c->robot.wheelbase, 0.34);
 }
 
@@ -32,7 +32,7 @@ counter_bits = 16
   EXPECT_DOUBLE_EQ(c->robot.counts_per_rev, 4096);
   EXPECT_DOUBLE_EQ(c->robot.wheelbase, 0.25);
   EXPECT_DOUBLE_EQ(c->robot.wheelbase_nominal, 0.25);
-  EXPECT_EQ(c->sim.scenario, "square-cw");
+  EXPECT_EQ(c->sim.scenario, SimScenario::kSquareCw);
   EXPECT_EQ(c->sim.counter_bits, 16);
 }
 

@@ -28,9 +28,9 @@ reverse_right = true
 )",
                         "h.toml");
   ASSERT_TRUE(c.ok()) << c.error().message;
-  EXPECT_EQ(c->encoder.backend, "hctl1100");
+  EXPECT_EQ(c->encoder.backend, EncoderKind::kHctl1100);
   const Hctl1100Section& h = c->hctl1100;
-  EXPECT_EQ(h.bus, "gpio");
+  EXPECT_EQ(h.bus, HctlBus::kGpio);
   EXPECT_EQ(h.chip, "/dev/gpiochip2");
   EXPECT_EQ(h.ad[0], 5);
   EXPECT_EQ(h.ad[1], 1);  // default kept
@@ -88,9 +88,9 @@ TEST(ConfigEncoders, CanEncoderDefaults) {
   auto c = parse_config("[encoder]\nbackend = \"can\"\n", "c.toml");
   ASSERT_TRUE(c.ok()) << c.error().message;
   const CanEncoderSection& e = c->can_encoder;
-  EXPECT_EQ(e.bus, "socketcan");
+  EXPECT_EQ(e.bus, CanEncoderBus::kSocketCan);
   EXPECT_EQ(e.interface, "can0");
-  EXPECT_EQ(e.protocol, "odrive");
+  EXPECT_EQ(e.protocol, CanEncoderProtocol::kOdrive);
   EXPECT_EQ(e.node_left, 0);
   EXPECT_EQ(e.node_right, 1);
   EXPECT_DOUBLE_EQ(e.timeout, 0.1);
@@ -124,7 +124,7 @@ reverse_left = true
   ASSERT_TRUE(c.ok()) << c.error().message;
   const CanEncoderSection& e = c->can_encoder;
   EXPECT_EQ(e.interface, "vcan0");
-  EXPECT_EQ(e.protocol, "generic");
+  EXPECT_EQ(e.protocol, CanEncoderProtocol::kGeneric);
   EXPECT_TRUE(e.extended);
   EXPECT_EQ(e.left_id, 0x18FF0010);
   EXPECT_EQ(e.right_id, 0x18FF0010);
@@ -132,7 +132,7 @@ reverse_left = true
   EXPECT_EQ(e.right_offset, 4);
   EXPECT_EQ(e.width, 32);
   EXPECT_FALSE(e.is_signed);
-  EXPECT_EQ(e.byte_order, "big");
+  EXPECT_EQ(e.byte_order, ByteOrder::kBig);
   EXPECT_DOUBLE_EQ(e.timeout, 0.25);
   EXPECT_DOUBLE_EQ(e.max_speed, 1.5);
   EXPECT_DOUBLE_EQ(e.request_rate, 50.0);

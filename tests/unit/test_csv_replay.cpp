@@ -4,7 +4,7 @@
 #include <numbers>
 #include <sstream>
 
-#include "odo/firmware/replay.hpp"
+#include "odo/analysis/replay.hpp"
 
 namespace odo::fw {
 namespace {
@@ -18,7 +18,7 @@ Kinematics kin(double c_l = 1.0, double c_r = 1.0) {
 TEST(Replay, StraightRun) {
   // 1000 counts on both wheels = one wheel turn = pi * 0.1 m forward.
   std::istringstream in("t,left,right\n0,0,0\n0.5,500,500\n1.0,1000,1000\n");
-  auto r = replay_ticks(in, "run.csv", kin(), 64);
+  auto r = analysis::replay_ticks(in, "run.csv", kin(), 64);
   ASSERT_TRUE(r.ok()) << r.error().message;
   EXPECT_NEAR(r->pose.x, std::numbers::pi * 0.1, 1e-14);
   EXPECT_NEAR(r->pose.y, 0.0, 1e-15);
@@ -30,8 +30,8 @@ TEST(Replay, SixteenBitWrapSignedAndUnsignedAgree) {
   // 65500 -> 100 (unsigned) is +136 counts; signed form: -36 -> 100 is also +136.
   std::istringstream u("t,left,right\n0,65500,65500\n1,100,100\n");
   std::istringstream s("t,left,right\n0,-36,-36\n1,100,100\n");
-  auto ru = replay_ticks(u, "u.csv", kin(), 16);
-  auto rs = replay_ticks(s, "s.csv", kin(), 16);
+  auto ru = analysis::replay_ticks(u, "u.csv", kin(), 16);
+  auto rs = analysis::replay_ticks(s, "s.csv", kin(), 16);
   ASSERT_TRUE(ru.ok() && rs.ok());
   EXPECT_NEAR(ru->pose.x, 136 * std::numbers::pi * 0.1 / 1000, 1e-15);
   EXPECT_DOUBLE_EQ(ru->pose.x, rs->pose.x);
@@ -41,7 +41,7 @@ TEST(Replay, OnTheSpotTurnIsCumulative) {
   // Each wheel 3000 counts in opposite senses: d = 3000 * pi * 1e-4 = 0.942478 m,
   // dtheta = 2 d / b = 2 * 0.942478 / 0.3 = 2 pi: one full turn, theta stays 2 pi.
   std::istringstream in("t,left,right\n0,0,0\n1,-3000,3000\n");
-  auto r = replay_ticks(in, "turn.csv", kin(), 32);
+  auto r = analysis::replay_ticks(in, "turn.csv", kin(), 32);
   ASSERT_TRUE(r.ok());
   EXPECT_NEAR(r->pose.theta, 2 * std::numbers::pi, 1e-12);
   EXPECT_NEAR(r->distance, 0.0, 1e-15);
@@ -55,7 +55,7 @@ class ReplayRejects : public ::testing::TestWithParam<Bad> {};
 
 TEST_P(ReplayRejects, NamesLineAndField) {
   std::istringstream in(GetParam().text);
-  auto r = replay_ticks(in, "f.csv", kin(), 16);
+  auto r = analysis::replay_ticks(in, "f.csv", kin(), 16);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().message.find(GetParam().expect), std::string::npos) << r.error().message;
 }

@@ -1,6 +1,8 @@
 // The 4x quadrature table and the event tracker of the GPIO backend.
 #include <gtest/gtest.h>
 
+#include "odo/drivers/gpio_quadrature.hpp"
+
 #include "odo/drivers/quad_tracker.hpp"
 #include "odo/hal/quadrature.hpp"
 
@@ -146,4 +148,16 @@ TEST(QuadTracker, LateEdgeIsAdoptedAsInvalid) {
 }
 
 }  // namespace
+// The GPIO decoder's pending buffer: a batch of events larger than the free room keeps what
+// fits and reports the rest as dropped (counted in GpioWheelStats::dropped, never lost silently).
+TEST(GpioBatch, EventsBeyondTheFreeRoomAreCountedAsDropped) {
+  // 64 events into 100 free slots: all taken. 64 into 10: 10 taken, 54 dropped. Into 0: 64 dropped.
+  EXPECT_EQ(drivers::split_batch(64, 100).taken, 64u);
+  EXPECT_EQ(drivers::split_batch(64, 100).dropped, 0u);
+  EXPECT_EQ(drivers::split_batch(64, 10).taken, 10u);
+  EXPECT_EQ(drivers::split_batch(64, 10).dropped, 54u);
+  EXPECT_EQ(drivers::split_batch(64, 0).taken, 0u);
+  EXPECT_EQ(drivers::split_batch(64, 0).dropped, 64u);
+}
+
 }  // namespace odo

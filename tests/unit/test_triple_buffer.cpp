@@ -3,7 +3,7 @@
 #include <atomic>
 #include <thread>
 
-#include "odo/firmware/triple_buffer.hpp"
+#include "odo/loop/triple_buffer.hpp"
 
 namespace odo::fw {
 namespace {
@@ -14,7 +14,7 @@ struct Pair {
 };
 
 TEST(TripleBuffer, EmptyThenNewest) {
-  TripleBuffer<Pair> tb;
+  loop::TripleBuffer<Pair> tb;
   Pair p;
   EXPECT_FALSE(tb.latest(p));
   tb.publish({1, -1});
@@ -31,7 +31,7 @@ constexpr long kWrites = 200000;
 // reads; every value read must be untorn and no older than the one before, the last one the
 // newest.
 template <class Write>
-void read_while_writing(TripleBuffer<Pair>& tb, Write write) {
+void read_while_writing(loop::TripleBuffer<Pair>& tb, Write write) {
   std::atomic<bool> done{false};
   std::thread writer([&] {
     for (long i = 1; i <= kWrites; ++i) write(i);
@@ -54,12 +54,12 @@ void read_while_writing(TripleBuffer<Pair>& tb, Write write) {
 }
 
 TEST(TripleBuffer, NeverTornAndMonotonicAcrossThreads) {
-  TripleBuffer<Pair> tb;
+  loop::TripleBuffer<Pair> tb;
   read_while_writing(tb, [&](long i) { tb.publish({i, -i}); });
 }
 
 TEST(TripleBuffer, InPlaceBackThenPublishAndNewest) {
-  TripleBuffer<Pair> tb;
+  loop::TripleBuffer<Pair> tb;
   EXPECT_EQ(tb.newest().a, 0);  // T{} before the first publish
   for (long i = 1; i <= 10; ++i) {
     Pair& b = tb.back();
@@ -82,7 +82,7 @@ TEST(TripleBuffer, InPlaceWriterNeverTearsWhatTheReaderCopies) {
   // The loop's way: fill the back buffer field by field, publish, read the newest back while the
   // reader copies (ThreadSanitizer checks that no buffer is written by one side while the other
   // reads it).
-  TripleBuffer<Pair> tb;
+  loop::TripleBuffer<Pair> tb;
   long newest_mismatch = 0;
   read_while_writing(tb, [&](long i) {
     Pair& b = tb.back();

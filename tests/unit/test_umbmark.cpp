@@ -116,7 +116,7 @@ TEST(Umbmark, WheelbaseFactorEq629AgainstChongKleemanEq9) {
 TEST(Umbmark, WheelFactorsKeepTheMeanDiameter) {
   // E_d = 1.002: c_L = 2/2.002 = 0.999000999, c_R = 2/(1/1.002 + 1) = 2.004/2.002 = 1.000999001;
   // c_R/c_L = E_d and (c_L + c_R)/2 = 1 (Eq. 6.30).
-  const Factors f = wheel_factors(1.002);
+  const PassFactors f = wheel_factors(1.002);
   EXPECT_NEAR(f.c_l, 0.999000999, 1e-9);
   EXPECT_NEAR(f.c_r, 1.000999001, 1e-9);
   EXPECT_NEAR(f.c_r / f.c_l, 1.002, 1e-12);

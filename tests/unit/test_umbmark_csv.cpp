@@ -1,16 +1,16 @@
-// The UMBmark CSV of `odomctl umbmark compute` (fw::read_umbmark_runs).
+// The UMBmark CSV of `odomctl umbmark compute` (analysis::read_umbmark_runs).
 #include <gtest/gtest.h>
 
 #include <sstream>
 
-#include "odo/firmware/umbmark_tools.hpp"
+#include "odo/analysis/umbmark_tools.hpp"
 
 namespace odo::fw {
 namespace {
 
 Result<std::vector<calib::UmbmarkRun>> read(const std::string& text) {
   std::istringstream in(text);
-  return read_umbmark_runs(in, "runs.csv");
+  return analysis::read_umbmark_runs(in, "runs.csv");
 }
 
 TEST(UmbmarkCsv, ReadsAnyColumnOrderCommentsAndCrlf) {

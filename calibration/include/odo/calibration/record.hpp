@@ -71,4 +71,7 @@ struct RecordLimits {
 // the allowed range.
 Status validate_record(const CalibrationRecord& r);
 
+// utc_text: a record time [s since the Unix epoch] as "YYYY-MM-DDTHH:MM:SSZ".
+std::string utc_text(std::int64_t t);
+
 }  // namespace odo::calib

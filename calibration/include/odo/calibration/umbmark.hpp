@@ -90,13 +90,21 @@ double diameter_ratio(std::optional<double> radius, double wheelbase);
 // wheelbase_factor: E_b from alpha [rad]: Eq. 6.29 (pi/2)/((pi/2) - alpha) or C&K Eq. 9.
 double wheelbase_factor(double alpha, WheelbaseFormula f = WheelbaseFormula::kUmbmark629);
 
-// wheel_factors: Eq. 6.33/6.34, c_L = 2/(E_d + 1), c_R = 2/(1/E_d + 1); keeps (D_L+D_R)/2.
-Factors wheel_factors(double e_d);
+// PassFactors: what one pass finds: wheel factors c_L, c_R and the wheelbase ratio E_b (a
+// ratio, not metres).
+struct PassFactors {
+  double c_l = 1.0;
+  double c_r = 1.0;
+  double e_b = 1.0;
+};
+
+// wheel_factors: Eq. 6.33/6.34, c_L = 2/(E_d + 1), c_R = 2/(1/E_d + 1); keeps (D_L+D_R)/2; E_b 1.
+PassFactors wheel_factors(double e_d);
 
 // compose: the factors after a pass on a robot that already ran with `current`: the pass saw
 // the compensated robot as a new robot, so c_L = c_L,cur * c_L,pass, c_R = c_R,cur * c_R,pass and
-// b = E_b * b_cur (pass.wheelbase carries E_b here, a ratio, not metres).
-Factors compose(const Factors& current, const Factors& pass);
+// b = E_b * b_cur [m].
+Factors compose(const Factors& current, const PassFactors& pass);
 
 // return_spread: sigma [m], the pooled standard deviation of the return positions about their
 // direction's centre of gravity: sqrt(sum |e_i - cg_dir|^2 / (n_cw + n_ccw - 2)) over the plain
@@ -129,7 +137,7 @@ struct UmbmarkResult {
   std::optional<double> radius;  // R [m]; nullopt when beta = 0
   double e_d = 1.0;              // Eq. 6.24
   double e_b = 1.0;              // Eq. 6.29 (or C&K Eq. 9)
-  Factors pass;                  // this pass alone: c_L, c_R (Eq. 6.33/6.34), wheelbase = E_b
+  PassFactors pass;              // this pass alone: c_L, c_R (Eq. 6.33/6.34) and E_b
   Factors composed;              // what to use from now on: c_l, c_r, b_new [m] (Eq. 6.28)
   std::optional<double> sigma;   // [m], see return_spread()
   double sem = 0.0;              // sigma / sqrt(min(n_cw, n_ccw)) [m] (0 without sigma)

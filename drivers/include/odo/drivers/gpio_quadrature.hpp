@@ -6,6 +6,7 @@
 // the .cpp.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -48,7 +49,18 @@ struct GpioWheelStats {
   std::uint64_t invalid = 0;
   std::uint64_t index_pulses = 0;
   std::int64_t index_count = 0;  // count at the last index rising edge
+  std::uint64_t dropped = 0;     // events read but lost: the pending buffer was full
 };
+
+// BatchSplit: of `got` events read from the kernel, how many fit the `room` free slots of the
+// pending buffer; the rest are dropped, and counted (GpioWheelStats::dropped).
+struct BatchSplit {
+  std::size_t taken = 0;
+  std::size_t dropped = 0;
+};
+constexpr BatchSplit split_batch(std::size_t got, std::size_t room) noexcept {
+  return got <= room ? BatchSplit{got, 0} : BatchSplit{room, got - room};
+}
 
 class GpioQuadratureEncoder final : public EncoderSource {
  public:

@@ -10,12 +10,11 @@
 #include "odo/hal/nv_storage.hpp"
 #include "odo/hal/result.hpp"
 
-namespace odo::drv {
+namespace odo::drivers {
 
 enum class NvBackend : std::uint8_t { kAuto, kFile, kNvmem, kMtd };
 
-// parse_nv_backend: "auto", "file", "nvmem", "mtd".
-Result<NvBackend> parse_nv_backend(std::string_view name);
+// nv_backend_name: "auto", "file", "nvmem", "mtd".
 const char* nv_backend_name(NvBackend b) noexcept;
 // detect_nv_backend: /dev/mtd* -> mtd, a file named "nvmem" or under /sys/ -> nvmem, else file.
 NvBackend detect_nv_backend(std::string_view path) noexcept;
@@ -79,4 +78,4 @@ class MtdStorage final : public NvStorage {
 // open_nv_storage: the backend `kind` (kAuto: detect_nv_backend) on `path`.
 Result<std::unique_ptr<NvStorage>> open_nv_storage(const std::string& path, NvBackend kind);
 
-}  // namespace odo::drv
+}  // namespace odo::drivers

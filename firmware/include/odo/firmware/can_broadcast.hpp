@@ -1,4 +1,4 @@
-// CAN pose broadcast (issue 10): a TickObserver that encodes the protocol's frames at their
+// CAN pose broadcast (issue 10): a loop::TickObserver that encodes the protocol's frames at their
 // configured rates and sends them through a CanBus without ever blocking, takes set-pose
 // commands addressed to this node, and (optionally) hands every frame sent to a candump-format
 // log written by a thread of its own. README "CAN protocol" documents the frames.
@@ -13,11 +13,13 @@
 #include <thread>
 #include <vector>
 
-#include "odo/firmware/can_protocol.hpp"
 #include "odo/firmware/config.hpp"
-#include "odo/firmware/loop.hpp"
 #include "odo/hal/can_bus.hpp"
 #include "odo/hal/result.hpp"
+#include "odo/loop/command.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/protocol/can_protocol.hpp"
+#include "odo/protocol/candump_log.hpp"
 
 namespace odo::sim {
 class SimCanPort;
@@ -46,10 +48,6 @@ class CanFrameRing {
   std::atomic<std::uint64_t> tail_{0};  // next read (consumer)
   std::atomic<std::uint64_t> dropped_{0};
 };
-
-// format_candump_line: "(sec.usec) iface ID#HEX\n" of candump -L into buf; returns the length.
-std::size_t format_candump_line(char* buf, std::size_t size, std::int64_t wall_ns,
-                                const char* iface, const CanFrame& f) noexcept;
 
 // CanLogWriter: drains a CanFrameRing into a candump -L file from its own thread (every 20 ms),
 // so the loop never does file I/O. Frame stamps are loop time [ns]; the wall-clock time of loop
@@ -85,7 +83,7 @@ struct CanBroadcastCounters {
   std::uint64_t dropped_queue_full = 0;
   std::uint64_t dropped_link_down = 0;
   std::uint64_t dropped_error = 0;
-  std::uint64_t set_pose_applied = 0;   // commands handed to the loop
+  std::uint64_t set_pose_applied = 0;   // commands posted to the loop
   std::uint64_t set_pose_rejected = 0;  // for this node but malformed (length, theta range)
   std::uint64_t dropped() const noexcept {
     return dropped_queue_full + dropped_link_down + dropped_error;
@@ -98,25 +96,25 @@ struct CanDivisors {
 };
 
 struct CanBroadcastOptions {
-  std::uint32_t base_id = can::kDefaultBaseId;
-  int node_id = can::kDefaultNodeId;
+  std::uint32_t base_id = protocol::kDefaultBaseId;
+  int node_id = protocol::kDefaultNodeId;
   CanDivisors div;
   bool set_pose = true;             // accept set-pose commands
   std::size_t max_rx_per_tick = 8;  // receive() calls per tick at most (a flood cannot stall us)
   bool lossless_log = false;        // virtual time: wait for the log writer instead of dropping
 };
 
-class CanBroadcaster final : public TickObserver {
+class CanBroadcaster final : public loop::TickObserver {
  public:
-  // bus: where frames go; loop: receives set-pose requests (may be null: commands ignored);
-  // wire: the simulated port to drain every tick (null for a real bus); log: optional ring.
-  CanBroadcaster(const CanBroadcastOptions& o, CanBus& bus, OdometryLoop* loop,
-                 sim::SimCanPort* wire, CanFrameRing* log) noexcept;
+  // bus: where frames go; commands: the loop's queue for set-pose commands (may be null:
+  // commands ignored); log: optional ring that gets every frame the bus accepted.
+  CanBroadcaster(const CanBroadcastOptions& o, CanBus& bus, loop::CommandQueue* commands,
+                 CanFrameRing* log) noexcept;
 
-  void on_tick(LoopSnapshot& snap) noexcept override;
+  void on_tick(const loop::LoopSnapshot& snap) noexcept override;
   // send_final: the final pose group, velocity, uncertainty, timing and a status frame with the
   // stopping flag (clean stop); call on the loop thread after run() returned.
-  void send_final(const LoopSnapshot& snap) noexcept;
+  void send_final(const loop::LoopSnapshot& snap) noexcept;
 
   const CanBroadcastCounters& counters() const noexcept { return c_; }
   std::uint8_t seq() const noexcept { return seq_; }
@@ -126,24 +124,24 @@ class CanBroadcaster final : public TickObserver {
   // max_rx_per_tick frames in all (`f` is scratch space).
   void take_commands(CanFrame& f) noexcept;
   void send(const CanFrame& f, std::int64_t loop_time) noexcept;
-  void send_pose_group(const LoopSnapshot& s) noexcept;
-  void send_velocity(const LoopSnapshot& s) noexcept;
-  void send_uncertainty(const LoopSnapshot& s) noexcept;
-  void send_status(const LoopSnapshot& s, bool stopping) noexcept;
-  void send_timing(const LoopSnapshot& s) noexcept;
-  void drain_wire(std::int64_t loop_time) noexcept;
+  void send_pose_group(const loop::LoopSnapshot& s) noexcept;
+  void send_velocity(const loop::LoopSnapshot& s) noexcept;
+  void send_uncertainty(const loop::LoopSnapshot& s) noexcept;
+  void send_status(const loop::LoopSnapshot& s, bool stopping) noexcept;
+  void send_timing(const loop::LoopSnapshot& s) noexcept;
   void log_frame(const CanFrame& f) noexcept {
     if (o_.lossless_log)
       log_->push_wait(f);
     else
       log_->push(f);
   }
-  std::uint32_t id(can::Msg m) const noexcept { return can::frame_id(o_.base_id, o_.node_id, m); }
+  std::uint32_t id(protocol::Msg m) const noexcept {
+    return protocol::frame_id(o_.base_id, o_.node_id, m);
+  }
 
   CanBroadcastOptions o_;
   CanBus* bus_;
-  OdometryLoop* loop_;
-  sim::SimCanPort* wire_;
+  loop::CommandQueue* commands_;
   CanFrameRing* log_;
   CanBroadcastCounters c_;
   std::uint8_t seq_ = 0;  // pose group counter (first group: 0)
@@ -156,7 +154,7 @@ class CanBroadcaster final : public TickObserver {
   std::uint64_t quiet_span_ = 0;
 
   // send_due: sends what is due on tick t (t % divisor == 0) and notes the next such tick.
-  void send_due(const LoopSnapshot& s) noexcept;
+  void send_due(const loop::LoopSnapshot& s) noexcept;
 };
 
 // CanLink: the [can] section wired up: the bus (simulated port or SocketCAN), the broadcaster
@@ -167,16 +165,17 @@ class CanLink {
   // create: null (and ok) for bus = "none" with no log; errors name the interface.
   // virtual_time: the log waits for its writer rather than dropping (no deadlines to keep).
   static Result<std::unique_ptr<CanLink>> create(const CanSection& s, double loop_hz,
-                                                 OdometryLoop& loop, const std::string& can_log,
+                                                 loop::OdometryLoop& loop,
+                                                 const std::string& can_log,
                                                  bool virtual_time = false);
   // start: the log thread (call just before the loop runs).
   void start(std::int64_t epoch_ns);
   // send_final: final frames with the stopping status (loop thread, after run()).
-  void send_final(const LoopSnapshot& snap) noexcept { bc_->send_final(snap); }
+  void send_final(const loop::LoopSnapshot& snap) noexcept { bc_->send_final(snap); }
   // close_log: writes what is queued and closes the log (joins its thread).
   void close_log();
   // finish: send_final, then close_log.
-  void finish(const LoopSnapshot& snap);
+  void finish(const loop::LoopSnapshot& snap);
   const CanBroadcastCounters& counters() const noexcept { return bc_->counters(); }
   std::uint64_t log_written() const noexcept { return log_ ? log_->written() : 0; }
   std::uint64_t log_dropped() const noexcept { return log_ ? log_->ring().dropped() : 0; }

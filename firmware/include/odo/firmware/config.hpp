@@ -3,8 +3,12 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <span>
 #include <string>
 #include <string_view>
+#include <tuple>
+#include <vector>
 
 #include "odo/hal/result.hpp"
 #include "odo/odometry/error_model.hpp"
@@ -12,26 +16,122 @@
 
 namespace odo::fw {
 
+// Choices of the config file: each an enum, spelt once in its table below; code compares
+// enum values, so a misspelt choice does not compile.
+template <class E>
+struct Choice {
+  E value;
+  std::string_view name;  // as written in the file
+};
+
+enum class EncoderKind : std::uint8_t { kSim, kHctl1100, kGpio, kCan };
+enum class SimRobotKind : std::uint8_t { kLabmate, kNominal };
+enum class SimScenario : std::uint8_t { kSquareCcw, kSquareCw, kSquares, kIdle };
+enum class HctlBus : std::uint8_t { kGpio, kSim };
+enum class HctlLatch : std::uint8_t { kNone, kLsb };
+enum class CanEncoderBus : std::uint8_t { kSocketCan, kSim };
+enum class CanEncoderProtocol : std::uint8_t { kOdrive, kGeneric };
+enum class ByteOrder : std::uint8_t { kLittle, kBig };
+enum class StoreBackend : std::uint8_t { kAuto, kFile, kNvmem, kMtd };
+enum class CanBusKind : std::uint8_t { kSim, kSocketCan, kNone };
+
+inline constexpr Choice<EncoderKind> kEncoderKinds[] = {{EncoderKind::kSim, "sim"},
+                                                        {EncoderKind::kHctl1100, "hctl1100"},
+                                                        {EncoderKind::kGpio, "gpio"},
+                                                        {EncoderKind::kCan, "can"}};
+inline constexpr Choice<SimRobotKind> kSimRobotKinds[] = {{SimRobotKind::kLabmate, "labmate"},
+                                                          {SimRobotKind::kNominal, "nominal"}};
+inline constexpr Choice<SimScenario> kSimScenarios[] = {{SimScenario::kSquareCcw, "square-ccw"},
+                                                        {SimScenario::kSquareCw, "square-cw"},
+                                                        {SimScenario::kSquares, "squares"},
+                                                        {SimScenario::kIdle, "idle"}};
+inline constexpr Choice<HctlBus> kHctlBuses[] = {{HctlBus::kGpio, "gpio"}, {HctlBus::kSim, "sim"}};
+inline constexpr Choice<HctlLatch> kHctlLatches[] = {{HctlLatch::kNone, "none"},
+                                                     {HctlLatch::kLsb, "lsb"}};
+inline constexpr Choice<CanEncoderBus> kCanEncoderBuses[] = {
+    {CanEncoderBus::kSocketCan, "socketcan"}, {CanEncoderBus::kSim, "sim"}};
+inline constexpr Choice<CanEncoderProtocol> kCanEncoderProtocols[] = {
+    {CanEncoderProtocol::kOdrive, "odrive"}, {CanEncoderProtocol::kGeneric, "generic"}};
+inline constexpr Choice<ByteOrder> kByteOrders[] = {{ByteOrder::kLittle, "little"},
+                                                    {ByteOrder::kBig, "big"}};
+inline constexpr Choice<StoreBackend> kStoreBackends[] = {{StoreBackend::kAuto, "auto"},
+                                                          {StoreBackend::kFile, "file"},
+                                                          {StoreBackend::kNvmem, "nvmem"},
+                                                          {StoreBackend::kMtd, "mtd"}};
+inline constexpr Choice<CanBusKind> kCanBusKinds[] = {
+    {CanBusKind::kSim, "sim"}, {CanBusKind::kSocketCan, "socketcan"}, {CanBusKind::kNone, "none"}};
+
+// kChoiceTables: every choice table, found by its enum type (choices<E>()).
+inline constexpr std::tuple kChoiceTables{
+    std::span<const Choice<EncoderKind>>(kEncoderKinds),
+    std::span<const Choice<SimRobotKind>>(kSimRobotKinds),
+    std::span<const Choice<SimScenario>>(kSimScenarios),
+    std::span<const Choice<HctlBus>>(kHctlBuses),
+    std::span<const Choice<HctlLatch>>(kHctlLatches),
+    std::span<const Choice<CanEncoderBus>>(kCanEncoderBuses),
+    std::span<const Choice<CanEncoderProtocol>>(kCanEncoderProtocols),
+    std::span<const Choice<ByteOrder>>(kByteOrders),
+    std::span<const Choice<StoreBackend>>(kStoreBackends),
+    std::span<const Choice<CanBusKind>>(kCanBusKinds)};
+
+// choices: the table of enum E's choices.
+template <class E>
+constexpr std::span<const Choice<E>> choices() {
+  return std::get<std::span<const Choice<E>>>(kChoiceTables);
+}
+
+// name_of: how the config file spells choice v.
+template <class E>
+constexpr std::string_view name_of(E v) {
+  for (const Choice<E>& c : choices<E>())
+    if (c.value == v) return c.name;
+  return "?";
+}
+
+// parse_choice: the choice spelt `name`; nullopt when it is none of them.
+template <class E>
+constexpr std::optional<E> parse_choice(std::string_view name) {
+  for (const Choice<E>& c : choices<E>())
+    if (c.name == name) return c.value;
+  return std::nullopt;
+}
+
+// choice_names: the spellings of E's choices, in table order.
+template <class E>
+std::vector<std::string> choice_names() {
+  std::vector<std::string> v;
+  for (const Choice<E>& c : choices<E>()) v.emplace_back(c.name);
+  return v;
+}
+
+// choice_list: "a, b, c": the spellings of E's choices, for messages.
+template <class E>
+std::string choice_list() {
+  std::string s;
+  for (const Choice<E>& c : choices<E>()) s += (s.empty() ? "" : ", ") + std::string(c.name);
+  return s;
+}
+
 struct LoopSection {
   double rate_hz = 100.0;      // [Hz] 50..2000
   double status_period = 1.0;  // [s] between status lines, 0 = none
 };
 
 struct SimSection {
-  std::string robot = "labmate";        // labmate | nominal (true geometry = believed)
-  std::string scenario = "square-ccw";  // square-ccw | square-cw | squares | idle
-  double side = 4.0;                    // [m]
-  double speed = 0.2;                   // [m/s]
-  double turn_rate = 0.5;               // [rad/s]
-  double pause = 0.5;                   // [s]
-  int counter_bits = 32;                // simulated counter width, 16..64
+  SimRobotKind robot = SimRobotKind::kLabmate;  // nominal: true geometry = believed
+  SimScenario scenario = SimScenario::kSquareCcw;
+  double side = 4.0;       // [m]
+  double speed = 0.2;      // [m/s]
+  double turn_rate = 0.5;  // [rad/s]
+  double pause = 0.5;      // [s]
+  int counter_bits = 32;   // simulated counter width, 16..64
 };
 
 // [hctl1100]: two HCTL-1100 counter chips on one 8-bit multiplexed bus (AD0..AD7, ALE, /OE,
 // R/W, one /CS per chip). bus = "gpio": the lines on a GPIO chip via libgpiod; bus = "sim": the
 // register model following the simulated robot (same driver, same bus interface).
 struct Hctl1100Section {
-  std::string bus = "gpio";  // gpio | sim
+  HctlBus bus = HctlBus::kGpio;
   std::string chip = "gpiochip0";
   int ad[8] = {0, 1, 2, 3, 4, 5, 6, 7};  // line offsets of AD0..AD7
   int ale = 8;
@@ -46,8 +146,8 @@ struct Hctl1100Section {
   int max_attempts = 4;            // 2..16
   bool reverse_left = false;
   bool reverse_right = false;
-  std::string latch = "none";  // bus = "sim" only: none | lsb (byte-latch model)
-  double bus_cycle = 1e-6;     // bus = "sim" only: [s] duration of one simulated bus cycle
+  HctlLatch latch = HctlLatch::kNone;  // bus = "sim" only: byte-latch model
+  double bus_cycle = 1e-6;             // bus = "sim" only: [s] duration of one simulated bus cycle
 };
 
 // [gpio]: A/B (and optional index) lines of both wheels, decoded in software.
@@ -71,10 +171,10 @@ struct GpioSection {
 // a SocketCAN interface; bus = "sim": a simulated ODrive pair following the simulated robot
 // (same driver on a simulated bus port).
 struct CanEncoderSection {
-  std::string bus = "socketcan";    // socketcan | sim
-  std::string interface = "can0";   // SocketCAN interface
-  std::string protocol = "odrive";  // odrive (CAN Simple Get_Encoder_Count) | generic
-  int node_left = 0;                // odrive: axis node ids 0..63
+  CanEncoderBus bus = CanEncoderBus::kSocketCan;
+  std::string interface = "can0";                             // SocketCAN interface
+  CanEncoderProtocol protocol = CanEncoderProtocol::kOdrive;  // odrive: CAN Simple counts
+  int node_left = 0;                                          // odrive: axis node ids 0..63
   int node_right = 1;
   bool reverse_left = false;
   bool reverse_right = false;
@@ -88,9 +188,9 @@ struct CanEncoderSection {
   bool extended = false;  // 29-bit ids
   int left_offset = 0;    // [bytes] 0..7
   int right_offset = 0;
-  int width = 32;                     // [bits] 16, 24, ..., 64
-  bool is_signed = true;              // key "signed"
-  std::string byte_order = "little";  // little | big
+  int width = 32;         // [bits] 16, 24, ..., 64
+  bool is_signed = true;  // key "signed"
+  ByteOrder byte_order = ByteOrder::kLittle;
   // bus = "sim" only
   double sim_period = 0.01;           // [s] cyclic message period of the simulated controllers
   double sim_stop_left_after = -1.0;  // [s] the left axis stops sending after this; < 0 never
@@ -98,7 +198,7 @@ struct CanEncoderSection {
 };
 
 struct EncoderSection {
-  std::string backend = "sim";  // sim | hctl1100 | gpio | can
+  EncoderKind backend = EncoderKind::kSim;
 };
 
 // [realtime]: how the loop thread is made real-time at start (each part reported at start).
@@ -113,12 +213,12 @@ struct RealtimeSection {
 // Where the calibration record lives ([calibration]); see calibration_io.hpp.
 struct CalibrationSection {
   std::string store = "/var/lib/odometryd/calibration.bin";  // "" = no store: nominal values
-  std::string backend = "auto";                              // auto | file | nvmem | mtd
+  StoreBackend backend = StoreBackend::kAuto;
 };
 
 // [can]: the CAN pose broadcast (README "CAN protocol"). Rates must divide the loop rate.
 struct CanSection {
-  std::string bus = "sim";         // sim (simulated bus) | socketcan | none
+  CanBusKind bus = CanBusKind::kSim;
   std::string interface = "can0";  // bus = "socketcan": the SocketCAN interface
   int node_id = 1;                 // 0..63: frame ids = base_id + 16 * node_id + message
   int base_id = 0x400;             // 0..1024, multiple of 16, base_id + 16 * node_id <= 0x7F0

@@ -3,7 +3,15 @@
 
 #include <atomic>
 #include <iosfwd>
+#include <memory>
 #include <string>
+
+namespace odo {
+struct KinematicParams;
+}
+namespace odo::loop {
+class OdometryLoop;
+}
 
 namespace odo::fw {
 
@@ -17,6 +25,40 @@ struct DaemonOptions {
   bool stats = false;                   // timing statistics table at exit
   std::string can_log;                  // --can-log: every frame sent, candump -L format
   std::atomic<bool>* reload = nullptr;  // set (e.g. by SIGHUP) to re-read the calibration store
+};
+
+struct Config;
+struct AppliedCalibration;
+class Rig;
+class CanLink;
+class CalibrationReloader;
+
+// Daemon: odometryd in three steps: configure (config, calibration store, rig, loop, CAN link,
+// reloader; start-up report), run (status thread, systemd watchdog, real-time set-up, the loop
+// on this thread until stop or duration, clean-stop frames) and report (final lines, --stats,
+// --json). configure and run return the process exit code (0: go on).
+class Daemon {
+ public:
+  Daemon(const DaemonOptions& o, std::ostream& out, std::ostream& err);
+  ~Daemon();
+  int configure();
+  int run(std::atomic<bool>& stop);
+  void report();
+
+ private:
+  int fail(const std::string& message, int code = 2);
+  void report_start(const KinematicParams& p);
+
+  const DaemonOptions& o_;
+  std::ostream& out_;
+  std::ostream& err_;
+  std::ostream& log_;  // human-readable progress: stderr when stdout carries JSON
+  std::unique_ptr<Config> cfg_;
+  std::unique_ptr<AppliedCalibration> cal_;
+  std::unique_ptr<Rig> rig_;
+  std::unique_ptr<loop::OdometryLoop> loop_;
+  std::unique_ptr<CanLink> can_;
+  std::unique_ptr<CalibrationReloader> reloader_;
 };
 
 // run_daemon: runs the firmware until stop, duration or signal; returns the process exit code.

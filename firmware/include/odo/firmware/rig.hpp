@@ -7,11 +7,15 @@
 #include <string>
 
 #include "odo/firmware/config.hpp"
-#include "odo/firmware/loop.hpp"
 #include "odo/hal/clock.hpp"
 #include "odo/hal/encoder.hpp"
 #include "odo/hal/result.hpp"
+#include "odo/loop/loop.hpp"
 #include "odo/odometry/kinematics.hpp"
+
+namespace odo::sim {
+class TruthRecorder;
+}
 
 namespace odo::fw {
 
@@ -27,8 +31,9 @@ class Rig {
 
   Clock& clock() noexcept;
   EncoderSource& encoder() noexcept;
-  // truth_observer: fills the snapshot's ground truth (simulation only; null otherwise).
-  TickObserver* truth_observer() noexcept;
+  // truth: the simulated robot's ground truth beside each tick, to register on the loop
+  // (simulation only; null otherwise).
+  sim::TruthRecorder* truth() noexcept;
   // describe: one line saying what is wired, for the start-up report.
   const std::string& describe() const noexcept;
   // scenario_duration: length of the simulated motion [s], 0 when not simulated.

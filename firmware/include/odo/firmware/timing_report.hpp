@@ -5,15 +5,15 @@
 #include <cstddef>
 #include <iosfwd>
 
-#include "odo/firmware/loop.hpp"
+#include "odo/loop/loop.hpp"
 
 namespace odo::fw {
 
 // print_timing_stats: the table of wake-up latency and compute time (min, mean, p99, p99.9,
 // max in microseconds) and the missed deadlines, for a loop of period `period` [ns].
-void print_timing_stats(std::ostream& out, const LoopStats& st, TimeNs period);
+void print_timing_stats(std::ostream& out, const loop::LoopStats& st, TimeNs period);
 
 // format_timing_status: "lat p99/max=12/80 us cmp p99=4 us" into buf (no allocation); returns buf.
-const char* format_timing_status(char* buf, std::size_t size, const LoopStats& st) noexcept;
+const char* format_timing_status(char* buf, std::size_t size, const loop::LoopStats& st) noexcept;
 
 }  // namespace odo::fw

@@ -10,6 +10,8 @@
 
 #include <toml++/toml.h>
 
+#include "odo/firmware/config.hpp"
+
 namespace odo::fw {
 
 class TableReader {
@@ -24,9 +26,14 @@ class TableReader {
   std::int64_t integer(std::string_view key, std::int64_t def, std::int64_t lo, std::int64_t hi);
   bool boolean(std::string_view key, bool def);
   std::string string(std::string_view key, std::string def);
-  // choice: a string that must be one of `allowed`.
-  std::string choice(std::string_view key, std::string def,
-                     std::initializer_list<std::string_view> allowed);
+  // choice: a string that must spell one of E's choices (config.hpp).
+  template <class E>
+  E choice(std::string_view key, E def) {
+    const std::string v = string(key, std::string(name_of(def)));
+    if (auto e = parse_choice<E>(v)) return *e;
+    reject_choice(key, v, choice_list<E>());
+    return def;
+  }
   // reject: reports a problem found across settings at the line of `key` (or of the table).
   void reject(std::string_view key, const std::string& what);
   // sub: a nested table (may be absent).
@@ -39,6 +46,7 @@ class TableReader {
  private:
   const toml::node* get(std::string_view key);
   void fail(const toml::node* n, std::string_view key, const std::string& what);
+  void reject_choice(std::string_view key, const std::string& v, const std::string& list);
   std::string where(const toml::node* n) const;
 
   const toml::table* table_;

@@ -6,7 +6,9 @@
 #pragma once
 
 #include <array>
+#include <optional>
 
+#include "odo/hal/field_range.hpp"
 #include "odo/hal/result.hpp"
 
 namespace odo {
@@ -23,7 +25,10 @@ struct ErrorModelParams {
 // Allowed range of k_L and k_R [m^(1/2)]: 0 (no noise) up to 0.1 (10 cm after 1 m).
 inline constexpr double kErrorModelKMax = 0.1;
 
-// check_error_model: both coefficients finite and within [0, kErrorModelKMax].
+// error_model_range: the first coefficient that is not finite or not within
+// [0, kErrorModelKMax], as data (field "k_left" or "k_right"); nullopt when both are.
+std::optional<FieldRange> error_model_range(const ErrorModelParams& k);
+// check_error_model: the same as an error (message from range_message).
 Status check_error_model(const ErrorModelParams& k);
 
 // ArcTerms: the shape integrals of one arc of heading change phi = (d_R - d_L) / b, each

@@ -16,6 +16,10 @@ struct KinematicParams {
   double c_r = 1.0;                // UMBmark correction factor of the right wheel (Eq. 6.34)
 };
 
+// counts_per_metre: encoder counts per metre of nominal wheel travel, Ce * n / (pi * Dn)
+// [counts/m] (the inverse of Kinematics::metres_per_count, for unvalidated parameters).
+double counts_per_metre(const KinematicParams& p) noexcept;
+
 // Validated parameters plus the derived per-count distances.
 class Kinematics {
  public:

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
 
 namespace odo {
@@ -70,14 +71,28 @@ class PoseIntegrator {
   std::uint32_t steps_since_sync_ = 0;
 };
 
-// Odometry: counts -> pose and velocity with the calibrated kinematics.
+// Odometry: counts -> pose and velocity with the calibrated kinematics, and the pose's
+// covariance under the Chong-Kleeman error model.
 class Odometry {
  public:
-  explicit Odometry(const Kinematics& k) : k_(k) {}
-  // update: integrate the count deltas of one tick of length dt [s] (dt <= 0: velocity kept).
+  explicit Odometry(const Kinematics& k, const ErrorModelParams& error_model = {})
+      : k_(k), cov_(error_model) {}
+  // update: integrate the count deltas of one tick of length dt [s] (dt <= 0: velocity kept);
+  // the pose only.
   void update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept;
-  // reset: set the pose; velocities and travelled distance are kept.
-  void reset(const Pose2& p) noexcept { integ_.reset(p); }
+  // advance: update() and the covariance step of the same tick.
+  void advance(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
+    // The covariance needs the heading at the start of the tick; the integrator's cached sine
+    // and cosine of it spare a trigonometric call.
+    const double s0 = sin_theta(), c0 = cos_theta();
+    update(dn_left, dn_right, dt);
+    cov_.step_sc(s0, c0, d_left_, d_right_, k_.wheelbase());
+  }
+  // reset: set the pose, taken as exact (zero covariance); velocities and distance are kept.
+  void reset(const Pose2& p) noexcept {
+    integ_.reset(p);
+    cov_.reset();
+  }
   // set_kinematics: swap in new calibration (e.g. after SIGHUP); the pose is kept.
   void set_kinematics(const Kinematics& k) noexcept { k_ = k; }
 
@@ -90,9 +105,12 @@ class Odometry {
   double distance() const noexcept { return distance_; }            // path length of the centre [m]
   double last_d_left() const noexcept { return d_left_; }    // wheel travel of the last tick [m]
   double last_d_right() const noexcept { return d_right_; }  // [m]
+  // covariance: of (x, y, theta), row-major [m^2, m rad, rad^2], accumulated by advance().
+  const Cov3& covariance() const noexcept { return cov_.cov(); }
 
  private:
   Kinematics k_;
+  PoseCovariance cov_;
   PoseIntegrator integ_;
   double v_ = 0.0;
   double w_ = 0.0;

@@ -1,5 +1,6 @@
 // SimCanPort: a simulated CAN bus endpoint for tests and the simulated robot. Frames the firmware
-// sends wait in a bounded transmit queue until the simulated wire takes them (drain_tx); frames
+// sends wait in a bounded transmit queue until the simulated wire takes them (drain_tx), or are
+// taken at once by a connected wire (connect_wire: an idle bus, as the daemon simulates); frames
 // for the firmware are injected into a bounded receive queue. Faults: link down, a transmit
 // queue that fills (the controller stalls), and receive floods that overflow the queue.
 // Fixed capacities: no allocation after construction.
@@ -32,7 +33,7 @@ class FrameRing {
 };
 
 struct SimCanCounters {
-  std::uint64_t sent = 0;        // frames accepted into the transmit queue
+  std::uint64_t sent = 0;        // frames accepted (queued, or taken by a connected wire)
   std::uint64_t tx_full = 0;     // sends refused: transmit queue full
   std::uint64_t tx_down = 0;     // sends refused: link down
   std::uint64_t rx_dropped = 0;  // injected frames lost: receive queue full or link down
@@ -50,6 +51,9 @@ class SimCanPort final : public CanBus {
   bool inject(const CanFrame& f) noexcept;
   // drain_tx: the wire takes the oldest queued frame; false when the queue is empty.
   bool drain_tx(CanFrame& out) noexcept { return tx_.pop(out); }
+  // connect_wire: from now on the wire takes every frame as it is sent (an idle bus that never
+  // backs up): nothing waits in the transmit queue, nobody has to drain it.
+  void connect_wire() noexcept { wire_ = true; }
   // set_link_up: a downed link refuses sends and loses what was queued, like a bus-off.
   void set_link_up(bool up) noexcept;
   bool link_up() const noexcept { return up_; }
@@ -60,6 +64,7 @@ class SimCanPort final : public CanBus {
   FrameRing tx_;
   FrameRing rx_;
   bool up_ = true;
+  bool wire_ = false;  // connect_wire()
   SimCanCounters counters_;
 };
 

@@ -1,0 +1,82 @@
+// Tools around the UMBmark calibration (odomctl umbmark): the CSV of measured return errors,
+// the automated self-calibration on the simulated robot (through the firmware's own loop) and
+// the SVG of the return errors before and after (like Fig. 3.4 / 6.5 of the report).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <istream>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "odo/calibration/umbmark.hpp"
+#include "odo/hal/result.hpp"
+
+namespace odo::analysis {
+
+// read_umbmark_runs: the CSV of `umbmark compute`: header direction,ex,ey with optional
+// etheta and bumps; direction cw|ccw, ex, ey [m] and etheta [rad] finite and within +-1000,
+// bumps 0|1. Errors name source:line and the field.
+Result<std::vector<calib::UmbmarkRun>> read_umbmark_runs(std::istream& in,
+                                                         const std::string& source);
+
+struct UmbmarkSimOptions {
+  std::string robot = "labmate";  // the reference robot of DESIGN.md (only one so far)
+  int runs = 5;                   // N squares a direction per set, 1 .. 1000
+  int passes = 1;                 // 1 .. 10
+  double side = 4.0;              // L [m], 0.5 .. 20
+  std::string noise = "none";     // none | paper (floor roughness + reference-sensor error)
+  bool bumps = false;             // add N + N extended-UMBmark runs to the first pass
+  std::uint64_t seed = 1;
+  calib::WheelbaseFormula formula = calib::WheelbaseFormula::kUmbmark629;
+};
+
+// The floor and reference of --noise paper (README "UMBmark calibration" shows the resulting
+// sigma): roughness bumps every ~2 cm with heights uniform in [0, kPaperRoughness], the
+// reference ("sonar calibrator") with standard deviations 2 mm and 0.4 deg.
+inline constexpr double kPaperRoughness = 0.0013;          // [m]
+inline constexpr double kReferenceSigmaXy = 0.002;         // [m]
+inline constexpr double kReferenceSigmaTheta = 0.0069813;  // [rad] = 0.4 deg
+// Travel loss of one extended-UMBmark bump: the report's 0.44 deg per 10 mm bump on a LabMate
+// (Sec. 3.4) times the true wheelbase 0.337 m.
+inline constexpr double kBumpLoss = 0.337 * 0.44 * std::numbers::pi / 180.0;  // [m]
+
+// One set of N + N runs driven with the given factors.
+struct UmbmarkRunSet {
+  calib::Factors factors;               // c_L, c_R, b [m] the robot used
+  std::vector<calib::UmbmarkRun> runs;  // return errors (with etheta)
+  calib::CentreOfGravity cw, ccw;
+  double e_max_syst = 0.0;  // [m]
+};
+
+struct UmbmarkSimPass {
+  UmbmarkRunSet before;         // the pass's input runs (pass > 1: the previous verification)
+  calib::UmbmarkResult result;  // computed from `before` (plus bump runs in pass 1)
+  UmbmarkRunSet after;          // verification with result.composed
+};
+
+struct UmbmarkSimResult {
+  std::vector<UmbmarkSimPass> passes;
+  std::vector<calib::UmbmarkRun> bump_runs;  // extended UMBmark runs of pass 1 (--bumps)
+  double improvement = 0.0;                  // first before / last after E_max,syst
+};
+
+// check_umbmark_sim_options: validates every field; the message names the option and its range.
+Status check_umbmark_sim_options(const UmbmarkSimOptions& o);
+
+// run_umbmark_simulation: the automated self-calibration on the simulated robot in virtual time.
+// Every square is driven by the robot's own odometry with its current factors
+// (sim::square_scenario) and integrated by loop::OdometryLoop; the return error is the reference pose
+// (true pose, plus the reference's error with --noise paper) minus the loop's pose. Pass k's
+// input is pass k-1's verification set (the compensated robot as a "new" robot).
+// progress(done, total) after every run.
+Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
+                                                const std::function<void(int, int)>& progress = {});
+
+// umbmark_svg: the ex-ey plane [mm] with every run of the first "before" set and of each
+// verification set, cw and ccw, and their centres of gravity.
+std::string umbmark_svg(const UmbmarkSimResult& r, const std::string& title);
+
+}  // namespace odo::analysis

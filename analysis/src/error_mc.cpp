@@ -1,0 +1,136 @@
+// Monte Carlo validation of the error model on the simulated robot, with the firmware's loop.
+#include <atomic>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "odo/analysis/error_model_tools.hpp"
+#include "odo/analysis/seed.hpp"
+#include "odo/hal/field_range.hpp"
+#include "odo/sim/robot.hpp"
+#include "odo/sim/sim_run.hpp"
+#include "odo/sim/wheel_noise.hpp"
+
+namespace odo::analysis {
+namespace {
+
+constexpr double kOutbackDistance = 10.0;             // [m] each way (the paper's experiment)
+constexpr double kArcRadius = 2.0;                    // [m] of the centre
+constexpr double kArcAngle = 1.5 * std::numbers::pi;  // 270 deg counter-clockwise
+
+// make_path: constant wheel speeds per segment for a robot with wheel radius rw and wheelbase b.
+sim::Scenario make_path(const McOptions& o) {
+  const double rw = o.wheel_diameter / 2.0;
+  const double w = o.speed / rw;  // wheel angular velocity for the centre speed [rad/s]
+  if (o.path == "outback") {
+    const double t = kOutbackDistance / o.speed;
+    return {{t, w, w}, {t, -w, -w}};
+  }
+  // arc: the centre runs on a circle of radius kArcRadius; the wheels on kArcRadius -+ b/2.
+  const double t = kArcRadius * kArcAngle / o.speed;
+  const double q = o.wheelbase / (2.0 * kArcRadius);
+  return {{t, w * (1.0 - q), w * (1.0 + q)}};
+}
+
+}  // namespace
+
+std::string path_description(const std::string& path) {
+  if (path == "outback")
+    return "10 m forward then 10 m backward, no turn (Chong & Kleeman Sec. 5.2)";
+  return "counter-clockwise arc of 270 deg on a 2 m radius (9.42 m)";
+}
+
+Status check_mc_options(const McOptions& o) {
+  std::ostringstream m;
+  if (o.runs < 2 || o.runs > 1000000) {
+    m << range_message({"--runs", static_cast<double>(o.runs), 2, 1000000, "", false, true});
+  } else if (o.path != "outback" && o.path != "arc") {
+    m << "--path = '" << o.path << "' must be outback or arc";
+  } else if (!(o.wheelbase >= 0.05 && o.wheelbase <= 5.0)) {
+    m << range_message({"--wheelbase", o.wheelbase, 0.05, 5.0, "m"});
+  } else if (!(o.wheel_diameter >= 0.01 && o.wheel_diameter <= 2.0)) {
+    m << "wheel diameter = " << o.wheel_diameter << " m is outside [0.01, 2] m";
+  } else if (!(o.speed > 0.0 && o.speed <= 5.0)) {
+    m << "speed = " << o.speed << " m/s is outside (0, 5] m/s";
+  } else if (auto r = error_model_range(o.k)) {
+    r->field = r->field == "k_left" ? "--k-left" : "--k-right";  // the options' names
+    m << range_message(*r);
+  } else {
+    return Ok{};
+  }
+  return make_error(Errc::kInvalidArgument, m.str());
+}
+
+Cov3 sample_covariance(const std::vector<PoseError>& e, PoseError* mean) {
+  PoseError mu{};
+  for (const PoseError& r : e)
+    for (int i = 0; i < 3; ++i) mu[i] += r[i];
+  const double n = static_cast<double>(e.size());
+  for (double& v : mu) v /= n;
+  Cov3 c{};
+  for (const PoseError& r : e)
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) c[3 * i + j] += (r[i] - mu[i]) * (r[j] - mu[j]);
+  for (double& v : c) v /= (n - 1.0);
+  if (mean != nullptr) *mean = mu;
+  return c;
+}
+
+Result<McResult> run_error_monte_carlo(const McOptions& o,
+                                       const std::function<void(int, int)>& progress) {
+  if (auto s = check_mc_options(o); !s) return std::move(s).error();
+  KinematicParams p;
+  p.wheel_diameter = o.wheel_diameter;
+  p.counts_per_rev = 2048;
+  p.gear_ratio = 16;
+  p.wheelbase_nominal = p.wheelbase = o.wheelbase;
+  auto k = Kinematics::create(p);
+  if (!k) return std::move(k).error();
+  sim::RobotGeometry g;  // true geometry = believed: no systematic error, only the noise
+  g.wheel_diameter_left = g.wheel_diameter_right = o.wheel_diameter;
+  g.wheelbase = o.wheelbase;
+  g.counts_per_rev = p.counts_per_rev;
+  g.gear_ratio = p.gear_ratio;
+  const sim::Scenario path = make_path(o);
+  // Two periods of standstill after the path so that the last reading sees the robot stopped.
+  const double standstill = 2.0 / o.rate_hz;
+  sim::WheelNoise noise(o.k.k_left, o.k.k_right, 0);
+  sim::SimRunOptions so;
+  so.loop.rate_hz = o.rate_hz;
+  so.loop.error_model = o.k;
+  so.perturbation = &noise;
+
+  McResult r;
+  r.runs = o.runs;
+  r.errors.reserve(static_cast<std::size_t>(o.runs));
+  const int report_every = std::max(1, o.runs / 20);
+  for (int i = 0; i < o.runs; ++i) {
+    noise.reseed(seed_of(o.seed, static_cast<std::uint64_t>(i)));
+    auto run = sim::SimRun::create(g, *k, path, so);
+    if (!run) return std::move(run).error();
+    (*run)->drive(standstill);
+    const Pose2 e = (*run)->error();
+    r.errors.push_back({e.x, e.y, e.theta});
+    // The encoders count the wheels' rotation, which the noise does not touch, so every run's
+    // odometry and covariance are the same; keep the last.
+    r.predicted = (*run)->loop().snapshot().cov;
+    if (progress && ((i + 1) % report_every == 0 || i + 1 == o.runs)) progress(i + 1, o.runs);
+  }
+  r.sample = sample_covariance(r.errors, &r.mean);
+  for (int i = 0; i < 3; ++i) {
+    const double pv = r.predicted[4 * i], sv = r.sample[4 * i];
+    // With k = 0 both variances vanish (every run is identical); that is agreement, not 0/0.
+    r.rel_error[i] = (pv <= 1e-30 && sv <= 1e-30) ? 0.0 : std::fabs(pv - sv) / sv;
+    r.max_rel_error_diag = std::max(r.max_rel_error_diag, r.rel_error[i]);
+  }
+  return r;
+}
+
+Cov3 outback_covariance(double d, double b, const ErrorModelParams& k) {
+  Cov3 c{};
+  propagate_arc(c, 0.0, d, d, b, k);
+  propagate_arc(c, 0.0, -d, -d, b, k);
+  return c;
+}
+
+}  // namespace odo::analysis

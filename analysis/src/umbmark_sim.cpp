@@ -1,0 +1,151 @@
+// The automated UMBmark self-calibration on the simulated robot, with the firmware's loop.
+#include <atomic>
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "odo/analysis/seed.hpp"
+#include "odo/analysis/umbmark_tools.hpp"
+#include "odo/hal/field_range.hpp"
+#include "odo/sim/floor.hpp"
+#include "odo/sim/robot.hpp"
+#include "odo/sim/sim_run.hpp"
+
+namespace odo::analysis {
+namespace {
+
+using calib::Direction;
+using calib::Factors;
+using calib::UmbmarkRun;
+
+constexpr double kNominalDiameter = 0.15;   // [m] Dn of the simulated LabMate
+constexpr double kNominalWheelbase = 0.34;  // [m] what the uncalibrated LabMate believes
+
+struct Driver {
+  const UmbmarkSimOptions& o;
+  sim::RobotGeometry truth = sim::labmate_geometry(kNominalDiameter);
+  std::uint64_t run_index = 0;  // every run draws its own random sequences
+  int done = 0, total = 0;
+  const std::function<void(int, int)>& progress;
+
+  // square: one square in direction d with factors f; the return error truth - odometry in the
+  // start frame (which is the odometry frame: both start at the origin, heading 0).
+  Result<UmbmarkRun> square(const Factors& f, Direction d, bool bumps) {
+    KinematicParams p = sim::nominal_params(kNominalDiameter, kNominalWheelbase, truth);
+    p.wheelbase = f.wheelbase;
+    p.c_l = f.c_l;
+    p.c_r = f.c_r;
+    auto k = Kinematics::create(p);
+    if (!k) return std::move(k).error();
+    sim::SquareOptions so;
+    so.side = o.side;
+    so.direction = d == Direction::kCw ? sim::Turn::kClockwise : sim::Turn::kCounterClockwise;
+    const bool paper = o.noise == "paper";
+    const std::uint64_t seed = seed_of(o.seed, run_index++);
+    sim::UmbmarkFloor::Options fo;
+    fo.wheel_radius = kNominalDiameter / 2.0;
+    fo.roughness_height = paper ? kPaperRoughness : 0.0;
+    fo.bumps = bumps ? 10 : 0;
+    fo.bump_loss = kBumpLoss;
+    fo.first_leg = o.side;
+    fo.bumps_under_left = d == Direction::kCcw;  // the wheel facing the inside of the square
+    sim::UmbmarkFloor floor(fo, seed);
+    sim::SimRunOptions ro;
+    ro.perturbation = &floor;
+    auto run = sim::SimRun::create(truth, *k, sim::square_scenario(*k, so), ro);
+    if (!run) return std::move(run).error();
+    // One second of standstill after the path: the last readings see the robot stopped.
+    (*run)->drive(1.0);
+    const Pose2 e = (*run)->error();
+    UmbmarkRun r;
+    r.direction = d;
+    r.bumps = bumps;
+    r.ex = e.x;
+    r.ey = e.y;
+    r.etheta = e.theta;
+    if (paper) {
+      // The reference ("sonar calibrator") measures the absolute pose with its own error.
+      std::mt19937_64 rng(seed ^ 0x5EC0ADULL);
+      std::normal_distribution<double> n01(0.0, 1.0);
+      r.ex += kReferenceSigmaXy * n01(rng);
+      r.ey += kReferenceSigmaXy * n01(rng);
+      *r.etheta += kReferenceSigmaTheta * n01(rng);
+    }
+    if (progress) progress(++done, total);
+    return r;
+  }
+
+  // set: N cw and N ccw squares with factors f.
+  Result<UmbmarkRunSet> set(const Factors& f, bool bumps) {
+    UmbmarkRunSet s;
+    s.factors = f;
+    for (Direction d : {Direction::kCw, Direction::kCcw}) {
+      for (int i = 0; i < o.runs; ++i) {
+        auto r = square(f, d, bumps);
+        if (!r) return std::move(r).error();
+        s.runs.push_back(*r);
+      }
+    }
+    s.cw = calib::centre_of_gravity(s.runs, Direction::kCw);
+    s.ccw = calib::centre_of_gravity(s.runs, Direction::kCcw);
+    s.e_max_syst = calib::e_max_syst(s.cw, s.ccw);
+    return s;
+  }
+};
+
+}  // namespace
+
+Status check_umbmark_sim_options(const UmbmarkSimOptions& o) {
+  std::ostringstream m;
+  if (o.robot != "labmate") {
+    m << "--robot = '" << o.robot << "' is not known (allowed: labmate)";
+  } else if (o.runs < 1 || o.runs > 1000) {
+    m << range_message({"--runs", static_cast<double>(o.runs), 1, 1000, "", false, true});
+  } else if (o.passes < 1 || o.passes > 10) {
+    m << range_message({"--passes", static_cast<double>(o.passes), 1, 10, "", false, true});
+  } else if (!(o.side >= 0.5 && o.side <= 20.0)) {
+    m << range_message({"--side", o.side, 0.5, 20.0, "m"});
+  } else if (o.noise != "none" && o.noise != "paper") {
+    m << "--noise = '" << o.noise << "' must be none or paper";
+  } else {
+    return Ok{};
+  }
+  return make_error(Errc::kInvalidArgument, m.str());
+}
+
+Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
+                                                const std::function<void(int, int)>& progress) {
+  if (auto s = check_umbmark_sim_options(o); !s) return std::move(s).error();
+  Driver drv{o, sim::labmate_geometry(kNominalDiameter), 0, 0, 0, progress};
+  // Pass 1 drives a "before" set (plus the bump runs) and a verification; later passes reuse
+  // the previous verification as their "before" set.
+  drv.total = 2 * o.runs * (1 + (o.bumps ? 1 : 0) + o.passes);
+  UmbmarkSimResult res;
+  auto first = drv.set(Factors{1.0, 1.0, kNominalWheelbase}, false);
+  if (!first) return std::move(first).error();
+  if (o.bumps) {
+    auto b = drv.set(first->factors, true);
+    if (!b) return std::move(b).error();
+    res.bump_runs = std::move(b->runs);
+  }
+  UmbmarkRunSet before = std::move(first).value();
+  for (int p = 0; p < o.passes; ++p) {
+    calib::UmbmarkInput in;
+    in.runs = before.runs;
+    if (p == 0) in.runs.insert(in.runs.end(), res.bump_runs.begin(), res.bump_runs.end());
+    in.side = o.side;
+    in.current = before.factors;
+    in.formula = o.formula;
+    auto r = calib::umbmark_compute(in);
+    if (!r) return std::move(r).error();
+    auto after = drv.set(r->composed, false);
+    if (!after) return std::move(after).error();
+    res.passes.push_back(UmbmarkSimPass{std::move(before), std::move(r).value(), *after});
+    before = std::move(after).value();
+  }
+  const double last = res.passes.back().after.e_max_syst;
+  res.improvement = last > 0.0 ? res.passes.front().before.e_max_syst / last : 0.0;
+  return res;
+}
+
+}  // namespace odo::analysis

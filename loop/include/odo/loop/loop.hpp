@@ -1,0 +1,154 @@
+// OdometryLoop: the fixed-rate loop. One tick: sleep to an absolute deadline, apply the commands
+// posted since the last tick, read the encoders, take wrap-aware deltas, integrate the pose and
+// its covariance, update timing statistics, hand the snapshot to the (read-only) observers.
+// The same code runs against real drivers and against sim_hal; only the wiring differs.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+
+#include "odo/calibration/store.hpp"
+#include "odo/hal/clock.hpp"
+#include "odo/hal/encoder.hpp"
+#include "odo/hal/result.hpp"
+#include "odo/loop/command.hpp"
+#include "odo/loop/latency_histogram.hpp"
+#include "odo/loop/triple_buffer.hpp"
+#include "odo/odometry/error_model.hpp"
+#include "odo/odometry/kinematics.hpp"
+#include "odo/odometry/pose.hpp"
+
+namespace odo::loop {
+
+// Timing figures of the loop; updated every tick without allocation.
+struct LoopStats {
+  std::uint64_t ticks = 0;
+  std::uint64_t missed_deadlines = 0;  // periods skipped because a tick overran
+  TimeNs wakeup_latency_last = 0;      // wake-up time minus deadline [ns]
+  TimeNs wakeup_latency_max = 0;       // [ns]
+  TimeNs wakeup_latency_sum = 0;       // [ns], for the mean
+  TimeNs compute_max = 0;              // tick body duration, worst [ns]
+  // Histogram summaries (min, mean, p99, p99.9, max [ns]) of the wake-up latency and of the
+  // compute time; refreshed every kSummaryTicks ticks and when run() returns.
+  TimingSummary wakeup_latency;
+  TimingSummary compute_time;
+};
+
+// What one tick produced; observers and the status thread see this.
+struct LoopSnapshot {
+  std::uint64_t tick = 0;
+  TimeNs stamp = 0;                 // sample time of the encoder reading [ns]
+  TimeNs loop_time = 0;             // time since the loop started [ns]
+  Pose2 pose;                       // cumulative heading
+  double v = 0.0;                   // [m/s]
+  double w = 0.0;                   // [rad/s]
+  double distance = 0.0;            // path length of the centre point [m]
+  std::uint32_t encoder_flags = 0;  // EncoderFlag bits of the last sample
+  EncoderCounters encoder_counters;
+  LoopStats stats;
+  // Pose covariance of (x, y, theta), row-major [m^2, m rad, rad^2]; valid when has_cov.
+  std::array<double, 9> cov{};
+  bool has_cov = false;
+  // The calibration store's status of the kinematics in use (kUncalibrated: nominal values).
+  calib::StoreStatus calibration_state = calib::StoreStatus::kUncalibrated;
+};
+
+// TickObserver: called on the loop thread after every tick with that tick's snapshot; reads it,
+// must not block or allocate. An observer that wants to change the loop posts a Command. Its
+// stats are those up to this tick's wake-up (compute time and missed deadlines: up to the
+// previous tick).
+class TickObserver {
+ public:
+  virtual ~TickObserver() = default;
+  virtual void on_tick(const LoopSnapshot& snap) noexcept = 0;
+};
+
+struct LoopConfig {
+  double rate_hz = 100.0;        // [Hz], 50..2000
+  ErrorModelParams error_model;  // Chong-Kleeman k_L, k_R for the pose covariance
+  // The store's status of the kinematics the loop starts with (snapshot calibration_state).
+  calib::StoreStatus calibration = calib::StoreStatus::kUncalibrated;
+};
+
+class OdometryLoop {
+ public:
+  static constexpr std::size_t kMaxObservers = 8;
+  static constexpr std::uint64_t kSummaryTicks = 256;  // power of two
+
+  // create: validates the rate and the encoder's counter width (heap-allocated once, at
+  // configure time: the loop holds atomics and is neither copied nor moved).
+  static Result<std::unique_ptr<OdometryLoop>> create(const LoopConfig& cfg, const Kinematics& k,
+                                                      EncoderSource& encoder, Clock& clock);
+
+  // add_observer: registers a per-tick observer (configure time only); false when full.
+  bool add_observer(TickObserver* o) noexcept;
+  // start: latches the reference counts and sets the first deadline one period from now.
+  void start() noexcept;
+  // tick: runs one period of the loop (sleeps until the deadline first).
+  void tick() noexcept;
+  // run: ticks until `stop` is set or `duration` [ns] of loop time passed (duration <= 0: no
+  // limit). Calls start() first.
+  void run(TimeNs duration, const std::atomic<bool>& stop) noexcept;
+
+  // post: any thread (observers included); the command is applied at the top of the next tick.
+  // False when the queue is full (CommandQueue::kCapacity commands not yet taken).
+  bool post(const Command& c) noexcept { return commands_.post(c); }
+  // commands: the inbound queue, for producers that are handed the queue rather than the loop.
+  CommandQueue& commands() noexcept { return commands_; }
+  // commands_applied: commands applied so far, readable from any thread.
+  std::uint64_t commands_applied() const noexcept {
+    return commands_applied_.load(std::memory_order_acquire);
+  }
+
+  const Odometry& odometry() const noexcept { return odom_; }
+  const LoopStats& stats() const noexcept { return stats_; }
+  // Full histograms (loop thread, or after run() returned).
+  const LatencyHistogram& wakeup_histogram() const noexcept { return wakeup_hist_; }
+  const LatencyHistogram& compute_histogram() const noexcept { return compute_hist_; }
+  // heartbeat: ticks so far, readable from any thread (the watchdog proves the loop is alive).
+  std::uint64_t heartbeat() const noexcept { return heartbeat_.load(std::memory_order_relaxed); }
+  // snapshot: the newest snapshot, for the loop's own thread (or after run() returned).
+  const LoopSnapshot& snapshot() const noexcept { return published_.newest(); }
+  TimeNs period() const noexcept { return period_; }
+  // snapshots: the newest snapshot for another thread (status printer, supervisor).
+  TripleBuffer<LoopSnapshot>& snapshots() noexcept { return published_; }
+
+ private:
+  OdometryLoop(TimeNs period, const LoopConfig& cfg, const Kinematics& k, EncoderSource& enc,
+               Clock& clock);
+
+  TimeNs period_;
+  Odometry odom_;
+  calib::StoreStatus calibration_;
+  EncoderSource* enc_;
+  Clock* clock_;
+  int bits_;
+  std::array<TickObserver*, kMaxObservers> observers_{};
+  std::size_t n_observers_ = 0;
+
+  TimeNs start_ = 0;
+  TimeNs deadline_ = 0;
+  std::int64_t prev_left_ = 0;
+  std::int64_t prev_right_ = 0;
+  TimeNs prev_stamp_ = 0;
+  LoopStats stats_;
+  LatencyHistogram wakeup_hist_;
+  LatencyHistogram compute_hist_;
+  std::atomic<std::uint64_t> heartbeat_{0};
+  // Each tick builds its snapshot in the triple buffer's back slot and publishes it in place.
+  TripleBuffer<LoopSnapshot> published_;
+
+  // copy_newest: the back slot filled with the newest snapshot and the current statistics, to be
+  // published (start-up and end of run only: it copies the whole snapshot).
+  LoopSnapshot& copy_newest() noexcept;
+
+  // apply_commands: everything posted since the last tick, oldest first (top of a tick).
+  void apply_commands() noexcept;
+
+  CommandQueue commands_;
+  std::atomic<std::uint64_t> commands_applied_{0};
+};
+
+}  // namespace odo::loop

@@ -1,0 +1,160 @@
+#include "odo/loop/loop.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "odo/hal/field_range.hpp"
+#include "odo/odometry/count_delta.hpp"
+
+namespace odo::loop {
+
+Result<std::unique_ptr<OdometryLoop>> OdometryLoop::create(const LoopConfig& cfg,
+                                                           const Kinematics& k,
+                                                           EncoderSource& encoder, Clock& clock) {
+  if (!(cfg.rate_hz >= 50.0 && cfg.rate_hz <= 2000.0)) {
+    return make_error(Errc::kInvalidArgument,
+                      range_message({"loop.rate_hz", cfg.rate_hz, 50.0, 2000.0, "Hz", false}));
+  }
+  if (auto s = check_counter_bits(encoder.counter_bits()); !s) return std::move(s).error();
+  if (auto s = check_error_model(cfg.error_model); !s) {
+    return make_error(Errc::kInvalidArgument, "error_model." + s.error().message);
+  }
+  const auto period = static_cast<TimeNs>(std::llround(1e9 / cfg.rate_hz));
+  return std::unique_ptr<OdometryLoop>(new OdometryLoop(period, cfg, k, encoder, clock));
+}
+
+OdometryLoop::OdometryLoop(TimeNs period, const LoopConfig& cfg, const Kinematics& k,
+                           EncoderSource& enc, Clock& clock)
+    : period_(period),
+      odom_(k, cfg.error_model),
+      calibration_(cfg.calibration),
+      enc_(&enc),
+      clock_(&clock),
+      bits_(enc.counter_bits()) {}
+
+bool OdometryLoop::add_observer(TickObserver* o) noexcept {
+  if (n_observers_ >= kMaxObservers) return false;
+  observers_[n_observers_++] = o;
+  return true;
+}
+
+void OdometryLoop::start() noexcept {
+  const EncoderSample s = enc_->read(clock_->now());
+  prev_left_ = s.left;
+  prev_right_ = s.right;
+  prev_stamp_ = s.stamp;
+  // Loop time starts once the reference counts are latched, however long that read took; the
+  // first deadline is one period later.
+  start_ = clock_->now();
+  deadline_ = start_ + period_;
+  // The reference reading's flags are the snapshot until the first tick.
+  LoopSnapshot& b = copy_newest();
+  b.encoder_flags = s.flags;
+  b.encoder_counters = s.counters;
+  b.calibration_state = calibration_;
+  published_.publish();
+}
+
+LoopSnapshot& OdometryLoop::copy_newest() noexcept {
+  LoopSnapshot& b = published_.back();
+  b = published_.newest();
+  b.stats = stats_;
+  return b;
+}
+
+void OdometryLoop::apply_commands() noexcept {
+  const std::size_t n = commands_.drain([this](const Command& c) {
+    if (const auto* p = std::get_if<SetPose>(&c)) {
+      odom_.reset(p->pose);  // and its covariance: a set pose is exact
+    } else if (const auto* k = std::get_if<SetKinematics>(&c)) {
+      odom_.set_kinematics(k->kinematics);
+      calibration_ = k->calibration;
+    }
+  });
+  commands_applied_.fetch_add(n, std::memory_order_release);
+}
+
+void OdometryLoop::tick() noexcept {
+  clock_->sleep_until(deadline_);
+  const TimeNs woke = clock_->now();
+  const TimeNs latency = woke - deadline_;
+
+  // Commands take effect before this tick's motion is added; nearly every tick finds none.
+  if (!commands_.empty()) apply_commands();
+
+  const EncoderSample s = enc_->read(woke);
+  if ((s.flags & kEncoderReadError) == 0) {
+    // Counts are cumulative, so a late tick simply integrates a longer interval: nothing is lost.
+    const std::int64_t dl = wrap_delta(prev_left_, s.left, bits_);
+    const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
+    odom_.advance(dl, dr, to_seconds(s.stamp - prev_stamp_));
+    prev_left_ = s.left;
+    prev_right_ = s.right;
+    prev_stamp_ = s.stamp;
+  }
+
+  ++stats_.ticks;
+  stats_.wakeup_latency_last = latency;
+  stats_.wakeup_latency_sum += latency;
+  if (latency > stats_.wakeup_latency_max) stats_.wakeup_latency_max = latency;
+
+  // Built where the status thread will read it: the back slot of the triple buffer. That slot
+  // holds a snapshot two or three ticks old, so every field that changes is written here or by
+  // the observers on every tick.
+  LoopSnapshot& snap = published_.back();
+  snap.tick = stats_.ticks;
+  snap.stamp = s.stamp;
+  snap.loop_time = woke - start_;
+  snap.pose = odom_.pose();
+  snap.v = odom_.linear_velocity();
+  snap.w = odom_.angular_velocity();
+  snap.distance = odom_.distance();
+  snap.cov = odom_.covariance();
+  snap.has_cov = true;
+  snap.calibration_state = calibration_;
+  snap.encoder_flags = s.flags;
+  snap.encoder_counters = s.counters;
+  // Observers see the statistics up to this tick's wake-up; the fields that change after them
+  // are patched in below, so the published snapshot carries the statistics of the whole tick.
+  snap.stats = stats_;
+  for (std::size_t i = 0; i < n_observers_; ++i) observers_[i]->on_tick(snap);
+
+  const TimeNs done = clock_->now();
+  const TimeNs compute = done - woke;
+  if (compute > stats_.compute_max) stats_.compute_max = compute;
+  wakeup_hist_.record(latency);
+  compute_hist_.record(compute);
+  if ((stats_.ticks & (kSummaryTicks - 1)) == 0) {
+    stats_.wakeup_latency = wakeup_hist_.summary();
+    stats_.compute_time = compute_hist_.summary();
+    snap.stats.wakeup_latency = stats_.wakeup_latency;
+    snap.stats.compute_time = stats_.compute_time;
+  }
+  heartbeat_.store(stats_.ticks, std::memory_order_relaxed);
+
+  // Next deadline; after an overrun skip the missed periods instead of bursting to catch up.
+  deadline_ += period_;
+  if (done >= deadline_) {
+    const TimeNs behind = done - deadline_;
+    const TimeNs skipped = behind / period_ + 1;
+    deadline_ += skipped * period_;
+    stats_.missed_deadlines += static_cast<std::uint64_t>(skipped);
+  }
+  snap.stats.compute_max = stats_.compute_max;
+  snap.stats.missed_deadlines = stats_.missed_deadlines;
+  published_.publish();
+}
+
+void OdometryLoop::run(TimeNs duration, const std::atomic<bool>& stop) noexcept {
+  start();
+  while (!stop.load(std::memory_order_relaxed)) {
+    if (duration > 0 && deadline_ - start_ > duration) break;
+    tick();
+  }
+  stats_.wakeup_latency = wakeup_hist_.summary();
+  stats_.compute_time = compute_hist_.summary();
+  copy_newest();
+  published_.publish();
+}
+
+}  // namespace odo::loop

@@ -1,0 +1,195 @@
+// odomctl errormodel: validate (Monte Carlo on the simulated robot) and fit (k_L, k_R from runs).
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "odo/analysis/error_model_tools.hpp"
+#include "odo/hal/field_range.hpp"
+
+namespace odo::ctl {
+namespace {
+
+nlohmann::json nested(const Cov3& c) {
+  return nlohmann::json::array({{c[0], c[1], c[2]}, {c[3], c[4], c[5]}, {c[6], c[7], c[8]}});
+}
+
+void print_table(std::ostream& out, const Cov3& predicted, const Cov3& sample) {
+  static const char* names[3] = {"x", "y", "theta"};
+  out << "entry          predicted        sample           predicted/sample\n";
+  for (int i = 0; i < 3; ++i) {
+    for (int j = i; j < 3; ++j) {
+      const double p = predicted[3 * i + j], s = sample[3 * i + j];
+      std::string name = std::string("cov(") + names[i] + "," + names[j] + ")";
+      out << std::left << std::setw(15) << name << std::right << std::scientific
+          << std::setprecision(6) << std::setw(14) << p << "   " << std::setw(14) << s << "   ";
+      out << std::defaultfloat << std::setprecision(4) << (s != 0.0 ? p / s : 0.0) << "\n";
+    }
+  }
+  out << "units: m^2, m^2, m rad; rad^2 (SI)\n";
+}
+
+namespace {
+
+struct ValidateOpts {
+  analysis::McOptions mc;
+  std::string plot, csv;
+  bool json = false;
+};
+
+// run_validate: `odomctl ... validate` once its options are parsed; sets exit_code.
+void run_validate(const ValidateOpts& o, int& exit_code) {
+  if (auto s = analysis::check_mc_options(o.mc); !s) {
+    std::cerr << "odomctl errormodel validate: " << s.error().message << "\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  std::cerr << "errormodel validate: " << o.mc.runs << " runs, "
+            << analysis::path_description(o.mc.path) << ", k_L " << o.mc.k.k_left << ", k_R "
+            << o.mc.k.k_right << " m^(1/2), b " << o.mc.wheelbase << " m, seed " << o.mc.seed
+            << "\n";
+  auto r = analysis::run_error_monte_carlo(
+      o.mc, [](int done, int total) { std::cerr << "  " << done << "/" << total << " runs\n"; });
+  if (!r) {
+    std::cerr << "odomctl errormodel validate: " << r.error().message << "\n";
+    exit_code = kExitFailed;
+    return;
+  }
+  if (!o.plot.empty()) {
+    std::ostringstream title;
+    title << "Chong-Kleeman error model, " << r->runs
+          << " runs: " << analysis::path_description(o.mc.path) << "; k_L = " << o.mc.k.k_left
+          << ", k_R = " << o.mc.k.k_right << " m^(1/2), b = " << o.mc.wheelbase << " m";
+    if (!write_output_file(
+            o.plot,
+            analysis::error_ellipse_svg(r->errors, r->predicted, r->sample, r->mean, title.str()),
+            "errormodel validate")) {
+      exit_code = kExitFailed;
+      return;
+    }
+  }
+  if (!o.csv.empty()) {
+    std::ostringstream text;
+    analysis::write_run_errors(text, r->errors);
+    if (!write_output_file(o.csv, text.str(), "errormodel validate")) {
+      exit_code = kExitFailed;
+      return;
+    }
+  }
+  if (o.json) {
+    nlohmann::json j{{"runs", r->runs},
+                     {"path", o.mc.path},
+                     {"wheelbase", o.mc.wheelbase},
+                     {"k_left", o.mc.k.k_left},
+                     {"k_right", o.mc.k.k_right},
+                     {"seed", o.mc.seed},
+                     {"predicted", nested(r->predicted)},
+                     {"sample", nested(r->sample)},
+                     {"mean", r->mean},
+                     {"rel_error_diag", r->rel_error},
+                     {"max_rel_error_diag", r->max_rel_error_diag}};
+    std::cout << j.dump() << "\n";
+  } else {
+    print_table(std::cout, r->predicted, r->sample);
+    std::cout << "mean error          " << r->mean[0] << " m, " << r->mean[1] << " m, "
+              << r->mean[2] << " rad\n"
+              << "max |pred - sample| / sample over the variances: " << r->max_rel_error_diag
+              << "\n";
+  }
+  exit_code = kExitOk;
+}
+
+}  // namespace
+
+void add_validate(CLI::App& parent, int& exit_code) {
+  auto o = std::make_shared<ValidateOpts>();
+  CLI::App* c = parent.add_subcommand(
+      "validate", "Monte Carlo on the simulated robot: predicted against sample covariance");
+  c->add_option("--runs", o->mc.runs, "number of runs (default 2000)");
+  c->add_option("--path", o->mc.path,
+                "outback (10 m forward, 10 m back) or arc (270 deg, 2 m radius)");
+  c->add_option("--k-left", o->mc.k.k_left, "k_L [m^(1/2)] (default 0.00040)");
+  c->add_option("--k-right", o->mc.k.k_right, "k_R [m^(1/2)] (default 0.00058)");
+  c->add_option("--wheelbase", o->mc.wheelbase, "wheelbase b [m] (default 0.34)");
+  c->add_option("--seed", o->mc.seed, "random seed (default 1)");
+  c->add_option("--plot", o->plot, "write an SVG of the 95% error ellipses");
+  c->add_option("--csv", o->csv, "write every run's error in the CSV format of `fit`");
+  c->add_flag("--json", o->json, "print one JSON object on stdout");
+  c->callback([o, &exit_code] { run_validate(*o, exit_code); });
+}
+
+namespace {
+
+struct FitOpts {
+  std::string file;
+  double distance = 10.0, wheelbase = 0.34;
+  bool json = false;
+};
+
+// run_fit: `odomctl ... fit` once its options are parsed; sets exit_code.
+void run_fit(const FitOpts& o, int& exit_code) {
+  auto bad = [&](const std::string& m) {
+    std::cerr << "odomctl errormodel fit: " << m << "\n";
+    exit_code = kExitBadInput;
+  };
+  if (!(o.distance >= 0.1 && o.distance <= 10000.0)) {
+    return bad(range_message({"--distance", o.distance, 0.1, 10000.0, "m"}));
+  }
+  if (!(o.wheelbase >= 0.05 && o.wheelbase <= 5.0)) {
+    return bad(range_message({"--wheelbase", o.wheelbase, 0.05, 5.0, "m"}));
+  }
+  std::ifstream in(o.file, std::ios::binary);
+  if (!in) return bad(o.file + ": cannot open");
+  auto errors = analysis::read_run_errors(in, o.file);
+  if (!errors) return bad(errors.error().message);
+  auto r = analysis::fit_error_model(*errors, o.distance, o.wheelbase);
+  if (!r) return bad(o.file + ": " + r.error().message);
+  if (o.json) {
+    nlohmann::json j{{"runs", r->runs},
+                     {"distance", o.distance},
+                     {"wheelbase", o.wheelbase},
+                     {"k_left", r->k.k_left},
+                     {"k_right", r->k.k_right},
+                     {"predicted", nested(r->predicted)},
+                     {"sample", nested(r->sample)},
+                     {"mean", r->mean}};
+    std::cout << j.dump() << "\n";
+  } else {
+    std::cout << "runs      " << r->runs << "\n"
+              << "k_left    " << r->k.k_left << " m^(1/2)\n"
+              << "k_right   " << r->k.k_right << " m^(1/2)\n"
+              << "mean error (systematic, removed before the fit) " << r->mean[0] << " m, "
+              << r->mean[1] << " m, " << r->mean[2] << " rad\n";
+    print_table(std::cout, r->predicted, r->sample);
+    std::cout << "[error_model] for odometryd.toml:\nk_left = " << r->k.k_left
+              << "\nk_right = " << r->k.k_right << "\n";
+  }
+  exit_code = kExitOk;
+}
+
+}  // namespace
+
+void add_fit(CLI::App& parent, int& exit_code) {
+  auto o = std::make_shared<FitOpts>();
+  CLI::App* c = parent.add_subcommand(
+      "fit", "estimate k_L and k_R from the return errors of repeated out-and-back runs");
+  c->add_option("FILE", o->file, "CSV with header ex,ey,etheta (optional column run)")->required();
+  c->add_option("--distance", o->distance, "distance driven each way [m] (default 10)");
+  c->add_option("--wheelbase", o->wheelbase, "wheelbase b [m] (default 0.34)");
+  c->add_flag("--json", o->json, "print one JSON object on stdout");
+  c->callback([o, &exit_code] { run_fit(*o, exit_code); });
+}
+
+}  // namespace
+
+void add_errormodel(CLI::App& app, int& exit_code) {
+  CLI::App* c = app.add_subcommand("errormodel", "the Chong-Kleeman odometry error model");
+  c->require_subcommand(1);
+  add_validate(*c, exit_code);
+  add_fit(*c, exit_code);
+}
+
+}  // namespace odo::ctl

@@ -1,0 +1,85 @@
+#include <fstream>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "odo/analysis/replay.hpp"
+
+namespace odo::ctl {
+
+namespace {
+
+struct ReplayOpts {
+  std::string ticks;
+  double wheel_diameter = 0, counts_per_rev = 0, gear_ratio = 1, wheelbase = 0;
+  double cl = 1, cr = 1;
+  int bits = 64;
+  bool json = false;
+};
+
+// run_replay: `odomctl ... replay` once its options are parsed; sets exit_code.
+void run_replay(const ReplayOpts& o, int& exit_code) {
+  KinematicParams p;
+  p.wheel_diameter = o.wheel_diameter;
+  p.counts_per_rev = o.counts_per_rev;
+  p.gear_ratio = o.gear_ratio;
+  p.wheelbase_nominal = p.wheelbase = o.wheelbase;
+  p.c_l = o.cl;
+  p.c_r = o.cr;
+  auto k = Kinematics::create(p);
+  if (!k) {
+    std::cerr << "odomctl replay: " << k.error().message << "\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  std::ifstream in(o.ticks, std::ios::binary);
+  if (!in) {
+    std::cerr << "odomctl replay: " << o.ticks << ": cannot open\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  auto r = analysis::replay_ticks(in, o.ticks, *k, o.bits);
+  if (!r) {
+    std::cerr << "odomctl replay: " << r.error().message << "\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  if (o.json) {
+    nlohmann::json j{{"x", r->pose.x},
+                     {"y", r->pose.y},
+                     {"theta", r->pose.theta},
+                     {"distance", r->distance},
+                     {"samples", r->samples}};
+    std::cout << j.dump() << "\n";
+  } else {
+    std::cout << "samples   " << r->samples << "\n"
+              << "x         " << r->pose.x << " m\n"
+              << "y         " << r->pose.y << " m\n"
+              << "theta     " << r->pose.theta << " rad (cumulative, "
+              << r->pose.theta * 180.0 / 3.14159265358979323846 << " deg)\n"
+              << "distance  " << r->distance << " m\n";
+  }
+  exit_code = kExitOk;
+}
+
+}  // namespace
+
+void add_replay(CLI::App& app, int& exit_code) {
+  auto o = std::make_shared<ReplayOpts>();
+  CLI::App* c = app.add_subcommand("replay", "integrate a CSV log of raw counter readings");
+  c->add_option("--ticks", o->ticks, "CSV file with header t,left,right")->required();
+  c->add_option("--wheel-diameter", o->wheel_diameter, "nominal wheel diameter Dn [m]")->required();
+  c->add_option("--counts-per-rev", o->counts_per_rev,
+                "encoder counts per motor revolution after quadrature (Ce)")
+      ->required();
+  c->add_option("--gear-ratio", o->gear_ratio, "motor revolutions per wheel revolution (n)");
+  c->add_option("--wheelbase", o->wheelbase, "effective wheelbase b [m]")->required();
+  c->add_option("--cl", o->cl, "left wheel correction factor c_L");
+  c->add_option("--cr", o->cr, "right wheel correction factor c_R");
+  c->add_option("--counter-bits", o->bits, "counter width in bits, 16..64 (default 64)");
+  c->add_flag("--json", o->json, "print one JSON object");
+  c->callback([o, &exit_code] { run_replay(*o, exit_code); });
+}
+
+}  // namespace odo::ctl

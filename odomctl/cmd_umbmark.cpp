@@ -1,0 +1,362 @@
+// odomctl umbmark: compute (measured return errors), scale (E_s), simulate (self-calibration).
+#include <cmath>
+#include <ctime>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <numbers>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "odo/analysis/calibration_json.hpp"
+#include "odo/analysis/umbmark_tools.hpp"
+#include "odo/calibration/scaling.hpp"
+#include "odo/firmware/calibration_store.hpp"
+
+namespace odo::ctl {
+namespace {
+
+using nlohmann::json;
+
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+json opt(const std::optional<double>& v) {
+  return v ? json(*v) : json(nullptr);
+}
+
+// compute_json: the documented keys of `umbmark compute --json` (SI units, radians); also what
+// `odomctl calib import` reads (c_l, c_r, b_new, e_max_syst, n_cw, n_ccw).
+json compute_json(const calib::UmbmarkResult& r) {
+  json j{{"method", "umbmark"},
+         {"n_cw", r.cw.n},
+         {"n_ccw", r.ccw.n},
+         {"x_cg_cw", r.cw.x},
+         {"y_cg_cw", r.cw.y},
+         {"x_cg_ccw", r.ccw.x},
+         {"y_cg_ccw", r.ccw.y},
+         {"r_cg_cw", r.cw.r},
+         {"r_cg_ccw", r.ccw.r},
+         {"e_max_syst", r.e_max_syst},
+         {"alpha", r.ab.alpha},
+         {"alpha_x", r.ab.alpha_x},
+         {"alpha_y", r.ab.alpha_y},
+         {"beta", r.ab.beta},
+         {"beta_x", r.ab.beta_x},
+         {"beta_y", r.ab.beta_y},
+         {"radius", opt(r.radius)},
+         {"e_d", r.e_d},
+         {"e_b", r.e_b},
+         {"b_new", r.composed.wheelbase},
+         {"c_l_pass", r.pass.c_l},
+         {"c_r_pass", r.pass.c_r},
+         {"c_l", r.composed.c_l},
+         {"c_r", r.composed.c_r},
+         {"sigma", opt(r.sigma)},
+         {"sem", r.sem},
+         {"second_pass_recommended", r.second_pass}};
+  if (r.eps_theta_nonsys) j["eps_theta_nonsys"] = *r.eps_theta_nonsys;
+  return j;
+}
+
+void print_compute(std::ostream& out, const calib::UmbmarkResult& r, double wheelbase) {
+  out << std::fixed << std::setprecision(2) << "UMBmark (Borenstein & Feng 1994)\n"
+      << "runs                 cw " << r.cw.n << ", ccw " << r.ccw.n << "\n"
+      << "centre of gravity cw  x " << r.cw.x * 1e3 << " mm, y " << r.cw.y * 1e3 << " mm, r_cg "
+      << r.cw.r * 1e3 << " mm\n"
+      << "centre of gravity ccw x " << r.ccw.x * 1e3 << " mm, y " << r.ccw.y * 1e3 << " mm, r_cg "
+      << r.ccw.r * 1e3 << " mm\n"
+      << "E_max,syst           " << r.e_max_syst * 1e3 << " mm\n"
+      << std::setprecision(4) << "alpha (Type A)       " << r.ab.alpha * kDeg
+      << " deg per corner (x: " << r.ab.alpha_x * kDeg << ", y: " << r.ab.alpha_y * kDeg << ")\n"
+      << "beta (Type B)        " << r.ab.beta * kDeg << " deg per leg (x: " << r.ab.beta_x * kDeg
+      << ", y: " << r.ab.beta_y * kDeg << ")\n";
+  if (r.radius) {
+    out << std::setprecision(1) << "R                    " << *r.radius << " m\n";
+  } else {
+    out << "R                    infinite (beta = 0)\n";
+  }
+  out << std::setprecision(6) << "E_d = D_R/D_L        " << r.e_d << "\n"
+      << "E_b                  " << r.e_b << "\n"
+      << "this pass            c_l " << r.pass.c_l << ", c_r " << r.pass.c_r << "\n"
+      << std::setprecision(2) << "wheelbase            " << wheelbase * 1e3 << " mm -> b_new "
+      << r.composed.wheelbase * 1e3 << " mm\n"
+      << std::setprecision(6) << "use from now on      c_l " << r.composed.c_l << ", c_r "
+      << r.composed.c_r << ", wheelbase " << r.composed.wheelbase << " m\n";
+  if (r.sigma) {
+    out << std::setprecision(2) << "spread sigma         " << *r.sigma * 1e3 << " mm, SEM "
+        << r.sem * 1e3 << " mm, 3 x SEM " << 3 * r.sem * 1e3 << " mm\n";
+  } else {
+    out << "spread sigma         unknown (fewer than 3 runs)\n";
+  }
+  out << "second pass          "
+      << (r.second_pass ? "recommended (E_max,syst > 3 x SEM)"
+                        : "not worthwhile (E_max,syst <= 3 x SEM)")
+      << "\n";
+  if (r.eps_theta_nonsys) {
+    out << std::setprecision(3) << "eps_theta,nonsys     " << *r.eps_theta_nonsys * kDeg
+        << " deg (extended UMBmark)\n";
+  }
+}
+
+namespace {
+
+struct ComputeOpts {
+  std::string file;
+  double side = 0.0, wheelbase = 0.0, cl = 1.0, cr = 1.0;
+  bool json = false;
+};
+
+// run_compute: `odomctl ... compute` once its options are parsed; sets exit_code.
+void run_compute(const ComputeOpts& o, int& exit_code) {
+  auto bad = [&](const std::string& m) {
+    std::cerr << "odomctl umbmark compute: " << m << "\n";
+    exit_code = kExitBadInput;
+  };
+  std::ifstream in(o.file, std::ios::binary);
+  if (!in) return bad(o.file + ": cannot open");
+  auto runs = analysis::read_umbmark_runs(in, o.file);
+  if (!runs) return bad(runs.error().message);
+  calib::UmbmarkInput ui;
+  ui.runs = std::move(runs).value();
+  ui.side = o.side;
+  ui.current = {o.cl, o.cr, o.wheelbase};
+  auto r = calib::umbmark_compute(ui);
+  if (!r) {
+    // Option values are named as options; run values by the file.
+    std::string m = r.error().message;
+    for (auto [from, to] : {std::pair{"side", "--side"},
+                            {"wheelbase", "--wheelbase"},
+                            {"current c_l", "--current-cl"},
+                            {"current c_r", "--current-cr"}}) {
+      if (m.rfind(std::string(from) + " = ", 0) == 0) m = to + m.substr(std::string(from).size());
+    }
+    if (m.rfind("--", 0) != 0) m = o.file + ": " + m;
+    return bad(m);
+  }
+  for (const std::string& w : r->warnings)
+    std::cerr << "odomctl umbmark compute: warning: " << w << "\n";
+  if (o.json) {
+    std::cout << compute_json(*r).dump() << "\n";
+  } else {
+    print_compute(std::cout, *r, o.wheelbase);
+  }
+  exit_code = kExitOk;
+}
+
+}  // namespace
+
+void add_compute(CLI::App& parent, int& exit_code) {
+  auto o = std::make_shared<ComputeOpts>();
+  CLI::App* c = parent.add_subcommand(
+      "compute", "correction factors from measured return errors of cw and ccw squares");
+  c->add_option("--runs", o->file, "CSV: direction,ex,ey[,etheta][,bumps] (m, rad)")->required();
+  c->add_option("--side", o->side, "side L of the square [m]")->required();
+  c->add_option("--wheelbase", o->wheelbase, "wheelbase the robot used during the runs [m]")
+      ->required();
+  c->add_option("--current-cl", o->cl, "c_l the robot used during the runs (default 1)");
+  c->add_option("--current-cr", o->cr, "c_r the robot used during the runs (default 1)");
+  c->add_flag("--json", o->json, "print one JSON object on stdout");
+  c->callback([o, &exit_code] { run_compute(*o, exit_code); });
+}
+
+namespace {
+
+struct ScaleOpts {
+  double calculated = 0.0, measured = 0.0, diameter = 0.0;
+  bool json = false;
+};
+
+// run_scale: `odomctl ... scale` once its options are parsed; sets exit_code.
+void run_scale(const ScaleOpts& o, int& exit_code) {
+  auto r = calib::scaling_error(o.calculated, o.measured, o.diameter);
+  if (!r) {
+    std::cerr << "odomctl umbmark scale: " << r.error().message << "\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  if (o.json) {
+    std::cout << json{{"l_calc", o.calculated},
+                      {"l_actual", o.measured},
+                      {"e_s", r->e_s},
+                      {"wheel_diameter_nominal", o.diameter},
+                      {"wheel_diameter", r->wheel_diameter_new}}
+                     .dump()
+              << "\n";
+  } else {
+    std::cout << std::setprecision(6) << "E_s = L_calc / L_actual   " << r->e_s << "\n"
+              << std::fixed << std::setprecision(3) << "Dn                        "
+              << o.diameter * 1e3 << " mm\nDn* (corrected)           "
+              << r->wheel_diameter_new * 1e3 << " mm\n"
+              << "apply: odomctl calib set --wheel-diameter " << std::setprecision(6)
+              << r->wheel_diameter_new << " (metres)\n";
+  }
+  exit_code = kExitOk;
+}
+
+}  // namespace
+
+void add_scale(CLI::App& parent, int& exit_code) {
+  auto o = std::make_shared<ScaleOpts>();
+  CLI::App* c = parent.add_subcommand(
+      "scale", "scaling error E_s and corrected wheel diameter Dn* from a straight run (App. B)");
+  c->add_option("--calculated", o->calculated, "length the odometry computed [m]")->required();
+  c->add_option("--measured", o->measured, "length measured with a tape [m]")->required();
+  c->add_option("--diameter", o->diameter, "nominal wheel diameter Dn used in the run [m]")
+      ->required();
+  c->add_flag("--json", o->json, "print one JSON object on stdout");
+  c->callback([o, &exit_code] { run_scale(*o, exit_code); });
+}
+
+// store_result: saves the final factors as a record (method umbmark-sim) in the store at `path`.
+bool store_result(const std::string& path, const analysis::UmbmarkSimResult& r) {
+  auto s = fw::open_calibration_store(path, fw::StoreBackend::kAuto);
+  if (!s) {
+    std::cerr << "odomctl umbmark simulate: " << s.error().message << "\n";
+    return false;
+  }
+  const analysis::UmbmarkSimPass& last = r.passes.back();
+  calib::CalibrationRecord rec;
+  rec.c_l = last.result.composed.c_l;
+  rec.c_r = last.result.composed.c_r;
+  rec.wheelbase = last.result.composed.wheelbase;
+  rec.method = "umbmark-sim";
+  rec.time = static_cast<std::int64_t>(std::time(nullptr));
+  rec.e_max_before = r.passes.front().before.e_max_syst;
+  rec.e_max_after = last.after.e_max_syst;
+  rec.runs = static_cast<std::uint32_t>(last.before.runs.size());
+  auto seq = s->store->save(rec);
+  if (!seq) {
+    std::cerr << "odomctl umbmark simulate: " << path << ": " << seq.error().message << "\n";
+    return false;
+  }
+  std::cerr << "umbmark simulate: stored sequence " << *seq << " in " << path << " (" << s->backend
+            << ")\n";
+  return true;
+}
+
+namespace {
+
+struct SimulateOpts {
+  analysis::UmbmarkSimOptions sim;
+  std::string store, plot, eb_form = "umbmark";
+  bool json = false;
+};
+
+// run_simulate: `odomctl ... simulate` once its options are parsed; sets exit_code.
+void run_simulate(SimulateOpts o, int& exit_code) {  // a copy: sets o.sim.formula
+  if (o.eb_form != "umbmark" && o.eb_form != "chong") {
+    std::cerr << "odomctl umbmark simulate: --eb-form = '" << o.eb_form
+              << "' must be umbmark or chong\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  o.sim.formula = o.eb_form == "chong" ? calib::WheelbaseFormula::kChongKleeman9
+                                       : calib::WheelbaseFormula::kUmbmark629;
+  if (auto s = analysis::check_umbmark_sim_options(o.sim); !s) {
+    std::cerr << "odomctl umbmark simulate: " << s.error().message << "\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  std::cerr << "umbmark simulate: " << o.sim.robot << ", " << o.sim.runs << " cw + ccw squares of "
+            << o.sim.side << " m per set, " << o.sim.passes << " pass(es), noise " << o.sim.noise
+            << (o.sim.bumps ? ", bumps" : "") << ", seed " << o.sim.seed << "\n";
+  auto r = analysis::run_umbmark_simulation(o.sim, [](int done, int total) {
+    std::cerr << "  " << done << "/" << total << " squares\n";
+  });
+  if (!r) {
+    std::cerr << "odomctl umbmark simulate: " << r.error().message << "\n";
+    exit_code = kExitFailed;
+    return;
+  }
+  for (const std::string& w : r->passes.front().result.warnings)
+    std::cerr << "odomctl umbmark simulate: warning: " << w << "\n";
+  if (!o.store.empty() && !store_result(o.store, *r)) {
+    exit_code = kExitFailed;
+    return;
+  }
+  if (!o.plot.empty()) {
+    std::ostringstream title;
+    title << "UMBmark on the simulated " << o.sim.robot << ": " << o.sim.runs
+          << " cw + ccw squares of " << o.sim.side << " m, noise " << o.sim.noise << ", seed "
+          << o.sim.seed;
+    if (!write_output_file(o.plot, analysis::umbmark_svg(*r, title.str()), "umbmark simulate")) {
+      exit_code = kExitFailed;
+      return;
+    }
+  }
+  if (o.json) {
+    json passes = json::array();
+    for (const analysis::UmbmarkSimPass& p : r->passes) {
+      json jp{{"e_max_syst_before", p.before.e_max_syst},
+              {"e_max_syst_after", p.after.e_max_syst},
+              {"c_l", p.result.composed.c_l},
+              {"c_r", p.result.composed.c_r},
+              {"b", p.result.composed.wheelbase},
+              {"alpha", p.result.ab.alpha},
+              {"beta", p.result.ab.beta},
+              {"sigma", opt(p.result.sigma)},
+              {"sem", p.result.sem},
+              {"second_pass_recommended", p.result.second_pass}};
+      if (p.result.eps_theta_nonsys) jp["eps_theta_nonsys"] = *p.result.eps_theta_nonsys;
+      passes.push_back(jp);
+    }
+    std::cout << json{{"passes", passes}, {"improvement", r->improvement}}.dump() << "\n";
+  } else {
+    std::cout << "pass  E_max,syst before  after [mm]   c_l        c_r        b [mm]    "
+                 "sigma [mm]  3xSEM [mm]  2nd pass?\n";
+    int i = 1;
+    for (const analysis::UmbmarkSimPass& p : r->passes) {
+      const calib::UmbmarkResult& u = p.result;
+      std::cout << std::fixed << std::setw(4) << i++ << std::setprecision(2) << std::setw(19)
+                << p.before.e_max_syst * 1e3 << std::setw(11) << p.after.e_max_syst * 1e3
+                << std::setprecision(6) << std::setw(11) << u.composed.c_l << std::setw(11)
+                << u.composed.c_r << std::setprecision(3) << std::setw(10)
+                << u.composed.wheelbase * 1e3 << std::setprecision(2) << std::setw(12)
+                << (u.sigma ? *u.sigma * 1e3 : 0.0) << std::setw(12) << 3 * u.sem * 1e3 << "  "
+                << (u.second_pass ? "yes" : "no") << "\n";
+    }
+    std::cout << std::setprecision(1)
+              << "improvement (first before / last after): " << r->improvement << "-fold\n";
+    if (const auto& e = r->passes.front().result.eps_theta_nonsys) {
+      std::cout << std::setprecision(3) << "eps_theta,nonsys (extended UMBmark): " << *e * kDeg
+                << " deg\n";
+    }
+  }
+  exit_code = kExitOk;
+}
+
+}  // namespace
+
+void add_simulate(CLI::App& parent, int& exit_code) {
+  auto o = std::make_shared<SimulateOpts>();
+  CLI::App* c = parent.add_subcommand(
+      "simulate", "automated UMBmark self-calibration of the simulated robot (virtual time)");
+  c->add_option("--robot", o->sim.robot, "simulated robot (labmate: DESIGN.md reference)");
+  c->add_option("--runs", o->sim.runs, "squares a direction per set (default 5)");
+  c->add_option("--passes", o->sim.passes, "calibration passes (default 1)");
+  c->add_option("--side", o->sim.side, "side of the square [m] (default 4)");
+  c->add_option("--noise", o->sim.noise, "none | paper (floor roughness, reference error)");
+  c->add_flag("--bumps", o->sim.bumps, "add extended-UMBmark runs (ten 10 mm bumps)");
+  c->add_option("--seed", o->sim.seed, "random seed (default 1)");
+  c->add_option("--store", o->store, "write the final factors to this calibration store");
+  c->add_option("--plot", o->plot, "write an SVG of the return errors before and after");
+  c->add_option("--eb-form", o->eb_form,
+                "wheelbase formula: umbmark (Eq. 6.29, default) or chong (C&K Eq. 9)");
+  c->add_flag("--json", o->json, "print one JSON object on stdout");
+  c->callback([o, &exit_code] { run_simulate(*o, exit_code); });
+}
+
+}  // namespace
+
+void add_umbmark(CLI::App& app, int& exit_code) {
+  CLI::App* c = app.add_subcommand("umbmark", "UMBmark calibration (Borenstein & Feng)");
+  c->require_subcommand(1);
+  add_compute(*c, exit_code);
+  add_scale(*c, exit_code);
+  add_simulate(*c, exit_code);
+}
+
+}  // namespace odo::ctl

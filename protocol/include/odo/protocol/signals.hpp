@@ -1,0 +1,133 @@
+// The CAN pose protocol written down once: every signal of every message (name, start bit,
+// width, scale, signedness, raw range, unit). The encoders and decoders (can_protocol.cpp),
+// `odomctl decode` and the candump decoding read their layout from this table, and a unit test
+// checks protocol/odometry.dbc against it, so the four cannot drift apart.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+
+#include "odo/hal/bytes.hpp"
+#include "odo/hal/can_bus.hpp"
+#include "odo/protocol/can_protocol.hpp"
+
+namespace odo::protocol {
+
+// Signal: bits [start_bit, start_bit + width) of the 8-byte payload, Intel byte order;
+// physical value = raw * scale with raw in [raw_min, raw_max].
+struct Signal {
+  const char* name;  // as in the DBC file
+  int start_bit;
+  int width;  // [bits]
+  double scale;
+  bool is_signed;
+  std::int64_t raw_min;
+  std::int64_t raw_max;
+  const char* unit;
+};
+
+namespace sig {
+constexpr std::int64_t kI32Min = std::numeric_limits<std::int32_t>::min();
+constexpr std::int64_t kI32Max = std::numeric_limits<std::int32_t>::max();
+constexpr std::int64_t kI24Min = -(std::int64_t{1} << 23);
+constexpr std::int64_t kI24Max = (std::int64_t{1} << 23) - 1;
+
+inline constexpr Signal x{"x", 0, 32, kPosScale, true, kI32Min, kI32Max, "m"};
+inline constexpr Signal y{"y", 0, 32, kPosScale, true, kI32Min, kI32Max, "m"};
+inline constexpr Signal theta{"theta",      32,   16, kThetaScale, true, -(kThetaRawMax - 1),
+                              kThetaRawMax, "rad"};
+inline constexpr Signal seq{"seq", 56, 8, 1.0, false, 0, 255, ""};
+inline constexpr Signal v{"v", 0, 16, kVelScale, true, -32768, 32767, "m/s"};
+inline constexpr Signal w{"w", 16, 16, kOmegaScale, true, -32768, 32767, "rad/s"};
+inline constexpr Signal sigma_x{"sigma_x", 0, 16, kSigmaPosScale, false, 0, 65535, "m"};
+inline constexpr Signal sigma_y{"sigma_y", 16, 16, kSigmaPosScale, false, 0, 65535, "m"};
+inline constexpr Signal sigma_theta{"sigma_theta", 32, 16,    kSigmaThetaScale,
+                                    false,         0,  65535, "rad"};
+inline constexpr Signal rho_xy{"rho_xy", 48, 8, kRhoScale, true, -100, 100, ""};
+inline constexpr Signal encoder_flags{"encoder_flags", 0, 8, 1.0, false, 0, 255, ""};
+inline constexpr Signal calibration_state{"calibration_state", 8, 2, 1.0, false, 0, 2, ""};
+inline constexpr Signal stopping{"stopping", 10, 1, 1.0, false, 0, 1, ""};
+inline constexpr Signal set_pose_ack{"set_pose_ack", 16, 8, 1.0, false, 0, 255, ""};
+inline constexpr Signal missed_deadlines{"missed_deadlines", 24, 16, 1.0, false, 0, 65535, ""};
+inline constexpr Signal uptime{"uptime", 40, 24, 1.0, false, 0, 0xFFFFFF, "s"};
+inline constexpr Signal wakeup_p99{"wakeup_p99", 0, 16, kLatencyScale, false, 0, 65535, "s"};
+inline constexpr Signal wakeup_max{"wakeup_max", 16, 16, kLatencyScale, false, 0, 65535, "s"};
+inline constexpr Signal compute_max{"compute_max", 32, 16, kLatencyScale, false, 0, 65535, "s"};
+inline constexpr Signal tx_dropped{"tx_dropped", 48, 16, 1.0, false, 0, 65535, ""};
+inline constexpr Signal set_x{"set_x", 0, 24, kSetPosScale, true, kI24Min, kI24Max, "m"};
+inline constexpr Signal set_y{"set_y", 24, 24, kSetPosScale, true, kI24Min, kI24Max, "m"};
+inline constexpr Signal set_theta{"set_theta",   48,           16,   kThetaScale, true,
+                                  -kThetaRawMax, kThetaRawMax, "rad"};
+
+inline constexpr const Signal* kPoseX[] = {&x, &seq};
+inline constexpr const Signal* kPoseYTheta[] = {&y, &theta, &seq};
+inline constexpr const Signal* kVelocity[] = {&v, &w, &seq};
+inline constexpr const Signal* kUncertainty[] = {&sigma_x, &sigma_y, &sigma_theta, &rho_xy, &seq};
+inline constexpr const Signal* kStatus[] = {&encoder_flags, &calibration_state, &stopping,
+                                            &set_pose_ack,  &missed_deadlines,  &uptime};
+inline constexpr const Signal* kTiming[] = {&wakeup_p99, &wakeup_max, &compute_max, &tx_dropped};
+inline constexpr const Signal* kSetPose[] = {&set_x, &set_y, &set_theta};
+}  // namespace sig
+
+// MessageSpec: one message: its offset in the node's id block, DBC name and signals in order.
+struct MessageSpec {
+  Msg msg;
+  const char* name;
+  bool to_node;  // a command to odometryd (SetPose) rather than sent by it
+  std::span<const Signal* const> signals;
+};
+
+inline constexpr MessageSpec kMessages[] = {
+    {Msg::kPoseX, "PoseX", false, sig::kPoseX},
+    {Msg::kPoseYTheta, "PoseYTheta", false, sig::kPoseYTheta},
+    {Msg::kVelocity, "Velocity", false, sig::kVelocity},
+    {Msg::kUncertainty, "Uncertainty", false, sig::kUncertainty},
+    {Msg::kStatus, "Status", false, sig::kStatus},
+    {Msg::kTiming, "Timing", false, sig::kTiming},
+    {Msg::kSetPose, "SetPose", true, sig::kSetPose},
+};
+
+// message_spec: the table entry of message m (every Msg has one).
+const MessageSpec& message_spec(Msg m) noexcept;
+
+// dbc_decimal: `v` as a plain decimal with at most 9 decimals and no trailing zeros.
+std::string dbc_decimal(double v);
+// dbc_message_line: the BO_ line of message m for node kDefaultNodeId at kDefaultBaseId.
+std::string dbc_message_line(const MessageSpec& m);
+// dbc_signal_line: the SG_ line of signal s of message m.
+std::string dbc_signal_line(const MessageSpec& m, const Signal& s);
+
+// put_raw: writes `raw` (already within the signal's range) into the signal's bits.
+constexpr void put_raw(CanFrame& f, const Signal& s, std::int64_t raw) noexcept {
+  const auto u = static_cast<std::uint64_t>(raw);
+  if (s.start_bit % 8 == 0 && s.width % 8 == 0) {
+    put_le(f.data.data() + s.start_bit / 8, static_cast<std::size_t>(s.width / 8), u);
+    return;
+  }
+  // A bit field inside one byte (the Status flags): keep the byte's other bits.
+  const auto mask = static_cast<std::uint8_t>(((1u << s.width) - 1u) << (s.start_bit % 8));
+  std::uint8_t& b = f.data[static_cast<std::size_t>(s.start_bit / 8)];
+  b = static_cast<std::uint8_t>((b & ~mask) | ((u << (s.start_bit % 8)) & mask));
+}
+
+// get_raw: the signal's raw value, sign-extended when the signal is signed.
+constexpr std::int64_t get_raw(const CanFrame& f, const Signal& s) noexcept {
+  std::uint64_t u = 0;
+  if (s.start_bit % 8 == 0 && s.width % 8 == 0) {
+    u = get_le(f.data.data() + s.start_bit / 8, static_cast<std::size_t>(s.width / 8));
+  } else {
+    u = (f.data[static_cast<std::size_t>(s.start_bit / 8)] >> (s.start_bit % 8)) &
+        ((1u << s.width) - 1u);
+  }
+  return s.is_signed ? sign_extend(u, s.width) : static_cast<std::int64_t>(u);
+}
+
+// get_value: the signal's physical value (raw * scale).
+constexpr double get_value(const CanFrame& f, const Signal& s) noexcept {
+  return static_cast<double>(get_raw(f, s)) * s.scale;
+}
+
+}  // namespace odo::protocol

@@ -1,0 +1,212 @@
+#include "odo/protocol/can_protocol.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "odo/odometry/pose.hpp"
+#include "odo/protocol/signals.hpp"
+
+namespace odo::protocol {
+namespace {
+
+// quantise: round(value / scale) clamped to [lo, hi]; NaN gives `nan_raw`.
+std::int64_t quantise(double value, double scale, std::int64_t lo, std::int64_t hi,
+                      std::int64_t nan_raw) noexcept {
+  if (std::isnan(value)) return nan_raw;
+  const double r = std::round(value / scale);
+  if (r <= static_cast<double>(lo)) return lo;
+  if (r >= static_cast<double>(hi)) return hi;
+  return static_cast<std::int64_t>(r);
+}
+
+// put_value: `value` quantised to the signal (saturating at its range); NaN gives `nan_raw`.
+void put_value(CanFrame& f, const Signal& s, double value, std::int64_t nan_raw = 0) noexcept {
+  put_raw(f, s, quantise(value, s.scale, s.raw_min, s.raw_max, nan_raw));
+}
+
+// put_count: an unsigned counter, saturating at the signal's maximum.
+void put_count(CanFrame& f, const Signal& s, std::uint64_t n) noexcept {
+  const auto hi = static_cast<std::uint64_t>(s.raw_max);
+  put_raw(f, s, static_cast<std::int64_t>(n > hi ? hi : n));
+}
+
+void start(std::uint32_t id, CanFrame& f) noexcept {
+  f.id = id;
+  f.extended = false;
+  f.len = 8;
+  f.data = {};
+  f.stamp = 0;
+}
+
+}  // namespace
+
+const MessageSpec& message_spec(Msg m) noexcept {
+  for (const MessageSpec& s : kMessages)
+    if (s.msg == m) return s;
+  return kMessages[0];  // unreachable: every Msg is in the table
+}
+
+bool valid_addressing(std::uint32_t base_id, int node) noexcept {
+  return base_id % 16 == 0 && node >= 0 && node <= kMaxNodeId &&
+         frame_id(base_id, node, Msg::kSetPose) + 7 <= 0x7FF;
+}
+
+bool split_id(std::uint32_t base_id, const CanFrame& f, int& node, Msg& m) noexcept {
+  if (f.extended || f.id < base_id || f.id > 0x7FF) return false;
+  const std::uint32_t rel = f.id - base_id;
+  if (rel / 16 > static_cast<std::uint32_t>(kMaxNodeId)) return false;
+  const std::uint32_t off = rel % 16;
+  if (off > 5 && off != 8) return false;
+  node = static_cast<int>(rel / 16);
+  m = static_cast<Msg>(off);
+  return true;
+}
+
+std::int64_t divisor_for(double loop_hz, double rate_hz) noexcept {
+  if (rate_hz == 0.0) return 0;
+  if (!(rate_hz > 0.0) || !(loop_hz > 0.0) || rate_hz > loop_hz) return -1;
+  const double d = loop_hz / rate_hz;
+  const double n = std::round(d);
+  if (std::fabs(d - n) > 1e-9 * n) return -1;
+  return static_cast<std::int64_t>(n);
+}
+
+std::int16_t theta_raw(double theta) noexcept {
+  if (!std::isfinite(theta)) return 0;
+  std::int64_t r = quantise(wrap_angle(theta), kThetaScale, -kThetaRawMax, kThetaRawMax, 0);
+  if (r == -kThetaRawMax) r = kThetaRawMax;  // -pi after rounding is +pi
+  return static_cast<std::int16_t>(r);
+}
+
+void encode_pose_x(std::uint32_t id, const PoseMsg& p, CanFrame& f) noexcept {
+  start(id, f);
+  put_value(f, sig::x, p.x);
+  put_raw(f, sig::seq, p.seq);
+}
+
+void encode_pose_y_theta(std::uint32_t id, const PoseMsg& p, CanFrame& f) noexcept {
+  start(id, f);
+  put_value(f, sig::y, p.y);
+  put_raw(f, sig::theta, theta_raw(p.theta));
+  put_raw(f, sig::seq, p.seq);
+}
+
+void encode_velocity(std::uint32_t id, const VelocityMsg& v, CanFrame& f) noexcept {
+  start(id, f);
+  put_value(f, sig::v, v.v);
+  put_value(f, sig::w, v.w);
+  put_raw(f, sig::seq, v.seq);
+}
+
+void encode_uncertainty(std::uint32_t id, const UncertaintyMsg& u, CanFrame& f) noexcept {
+  start(id, f);
+  // Unknown (NaN) or infinite standard deviations are sent as the maximum.
+  auto sigma = [&f](const Signal& s, double value) {
+    put_value(f, s, std::isfinite(value) ? value : HUGE_VAL, s.raw_max);
+  };
+  sigma(sig::sigma_x, u.sigma_x);
+  sigma(sig::sigma_y, u.sigma_y);
+  sigma(sig::sigma_theta, u.sigma_theta);
+  put_value(f, sig::rho_xy, u.rho_xy);
+  put_raw(f, sig::seq, u.seq);
+}
+
+void encode_status(std::uint32_t id, const StatusMsg& s, CanFrame& f) noexcept {
+  start(id, f);
+  put_raw(f, sig::encoder_flags, s.encoder_flags);
+  put_raw(f, sig::calibration_state, s.calibration_state & 0x3u);
+  put_raw(f, sig::stopping, s.stopping ? 1 : 0);
+  put_raw(f, sig::set_pose_ack, s.set_pose_ack);
+  put_count(f, sig::missed_deadlines, s.missed_deadlines);
+  put_value(f, sig::uptime, std::floor(s.uptime));
+}
+
+void encode_timing(std::uint32_t id, const TimingMsg& t, CanFrame& f) noexcept {
+  start(id, f);
+  const std::int64_t over = sig::wakeup_p99.raw_max;  // NaN: sent as the maximum
+  put_value(f, sig::wakeup_p99, t.wakeup_p99, over);
+  put_value(f, sig::wakeup_max, t.wakeup_max, over);
+  put_value(f, sig::compute_max, t.compute_max, over);
+  put_count(f, sig::tx_dropped, t.tx_dropped);
+}
+
+void encode_set_pose(std::uint32_t id, const SetPoseCmd& c, CanFrame& f) noexcept {
+  start(id, f);
+  if (c.reset) {
+    f.len = 0;
+    return;
+  }
+  put_value(f, sig::set_x, c.x);
+  put_value(f, sig::set_y, c.y);
+  put_raw(f, sig::set_theta, theta_raw(c.theta));
+}
+
+bool decode_pose_x(const CanFrame& f, double& x, std::uint8_t& seq) noexcept {
+  if (f.len != 8) return false;
+  x = get_value(f, sig::x);
+  seq = static_cast<std::uint8_t>(get_raw(f, sig::seq));
+  return true;
+}
+
+bool decode_pose_y_theta(const CanFrame& f, double& y, double& theta, std::uint8_t& seq) noexcept {
+  if (f.len != 8) return false;
+  y = get_value(f, sig::y);
+  theta = get_value(f, sig::theta);
+  seq = static_cast<std::uint8_t>(get_raw(f, sig::seq));
+  return true;
+}
+
+bool decode_velocity(const CanFrame& f, VelocityMsg& v) noexcept {
+  if (f.len != 8) return false;
+  v.v = get_value(f, sig::v);
+  v.w = get_value(f, sig::w);
+  v.seq = static_cast<std::uint8_t>(get_raw(f, sig::seq));
+  return true;
+}
+
+bool decode_uncertainty(const CanFrame& f, UncertaintyMsg& u) noexcept {
+  if (f.len != 8) return false;
+  u.sigma_x = get_value(f, sig::sigma_x);
+  u.sigma_y = get_value(f, sig::sigma_y);
+  u.sigma_theta = get_value(f, sig::sigma_theta);
+  u.rho_xy = get_value(f, sig::rho_xy);
+  u.seq = static_cast<std::uint8_t>(get_raw(f, sig::seq));
+  return true;
+}
+
+bool decode_status(const CanFrame& f, StatusMsg& s) noexcept {
+  if (f.len != 8) return false;
+  s.encoder_flags = static_cast<std::uint8_t>(get_raw(f, sig::encoder_flags));
+  s.calibration_state = static_cast<std::uint8_t>(get_raw(f, sig::calibration_state));
+  s.stopping = get_raw(f, sig::stopping) != 0;
+  s.set_pose_ack = static_cast<std::uint8_t>(get_raw(f, sig::set_pose_ack));
+  s.missed_deadlines = static_cast<std::uint32_t>(get_raw(f, sig::missed_deadlines));
+  s.uptime = get_value(f, sig::uptime);
+  return true;
+}
+
+bool decode_timing(const CanFrame& f, TimingMsg& t) noexcept {
+  if (f.len != 8) return false;
+  t.wakeup_p99 = get_value(f, sig::wakeup_p99);
+  t.wakeup_max = get_value(f, sig::wakeup_max);
+  t.compute_max = get_value(f, sig::compute_max);
+  t.tx_dropped = static_cast<std::uint32_t>(get_raw(f, sig::tx_dropped));
+  return true;
+}
+
+bool decode_set_pose(const CanFrame& f, SetPoseCmd& c) noexcept {
+  if (f.len == 0) {
+    c = SetPoseCmd{true, 0.0, 0.0, 0.0};
+    return true;
+  }
+  if (f.len != 8) return false;
+  const std::int64_t th = get_raw(f, sig::set_theta);
+  if (th < sig::set_theta.raw_min || th > sig::set_theta.raw_max) return false;
+  c.reset = false;
+  c.x = get_value(f, sig::set_x);
+  c.y = get_value(f, sig::set_y);
+  c.theta = static_cast<double>(th) * sig::set_theta.scale;
+  return true;
+}
+
+}  // namespace odo::protocol

@@ -1,0 +1,51 @@
+// SimRun: one simulated drive in virtual time: the simulated robot following a scenario, its
+// encoders, a virtual clock and the firmware's own loop. The error-model Monte Carlo, the UMBmark
+// simulation and the simulation tests all drive the robot through this one harness.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "odo/hal/result.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/odometry/kinematics.hpp"
+#include "odo/sim/robot.hpp"
+#include "odo/sim/sim_encoder.hpp"
+#include "odo/sim/virtual_clock.hpp"
+
+namespace odo::sim {
+
+struct SimRunOptions {
+  int counter_bits = 32;                       // simulated counter width, 16..64
+  std::int64_t counter_offset = 0;             // counter value at zero counts (start near the wrap)
+  loop::LoopConfig loop;                       // rate, error model, calibration status
+  TravelPerturbation* perturbation = nullptr;  // floor or wheel noise on the true travel
+};
+
+class SimRun {
+ public:
+  // create: the robot with true geometry g driving `scenario`, the loop believing `believed`.
+  // Errors: the robot's geometry or the loop's configuration is out of range.
+  static Result<std::unique_ptr<SimRun>> create(const RobotGeometry& g, const Kinematics& believed,
+                                                Scenario scenario, const SimRunOptions& o = {});
+
+  // drive: runs the loop for the scenario plus `extra` [s] of standstill (the last readings see
+  // the robot stopped).
+  void drive(double extra = 1.0) noexcept;
+  // error: true pose minus the loop's pose (x [m], y [m], theta [rad]; cumulative headings).
+  Pose2 error() const noexcept;
+
+  SimRobot& robot() noexcept { return robot_; }
+  SimEncoderSource& encoder() noexcept { return encoder_; }
+  VirtualClock& clock() noexcept { return clock_; }
+  loop::OdometryLoop& loop() noexcept { return *loop_; }
+
+ private:
+  SimRun(SimRobot robot, const SimRunOptions& o);
+  VirtualClock clock_;
+  SimRobot robot_;
+  SimEncoderSource encoder_;
+  std::unique_ptr<loop::OdometryLoop> loop_;
+};
+
+}  // namespace odo::sim

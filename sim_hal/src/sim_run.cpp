@@ -1,0 +1,34 @@
+#include "odo/sim/sim_run.hpp"
+
+#include <atomic>
+#include <utility>
+
+namespace odo::sim {
+
+SimRun::SimRun(SimRobot robot, const SimRunOptions& o)
+    : robot_(std::move(robot)), encoder_(robot_, o.counter_bits, o.counter_offset) {}
+
+Result<std::unique_ptr<SimRun>> SimRun::create(const RobotGeometry& g, const Kinematics& believed,
+                                               Scenario scenario, const SimRunOptions& o) {
+  auto robot = SimRobot::create(g, std::move(scenario));
+  if (!robot) return std::move(robot).error();
+  std::unique_ptr<SimRun> run(new SimRun(std::move(robot).value(), o));
+  if (o.perturbation != nullptr) run->robot_.set_travel_perturbation(o.perturbation);
+  auto loop = loop::OdometryLoop::create(o.loop, believed, run->encoder_, run->clock_);
+  if (!loop) return std::move(loop).error();
+  run->loop_ = std::move(loop).value();
+  return run;
+}
+
+void SimRun::drive(double extra) noexcept {
+  const std::atomic<bool> stop{false};
+  loop_->run(from_seconds(scenario_duration(robot_.scenario()) + extra), stop);
+}
+
+Pose2 SimRun::error() const noexcept {
+  const Pose2& t = robot_.true_pose();
+  const Pose2& p = loop_->odometry().pose();
+  return Pose2{t.x - p.x, t.y - p.y, t.theta - p.theta};
+}
+
+}  // namespace odo::sim
