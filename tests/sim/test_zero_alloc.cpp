@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <memory>
 #include <new>
+#include <thread>
 
 #include "odo/firmware/can_broadcast.hpp"
 #include "odo/firmware/config.hpp"
@@ -324,6 +326,17 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
       if ((i & 1023) == 0 && loop->snapshots().latest(reader)) ++published;
       if (i == 100'000)  // new calibration from the reloader thread: the other producer
         ASSERT_TRUE(loop->post(loop::SetKinematics{*kin, calib::StoreStatus::kOk}));
+      if (i == 120'000) {
+        // Let the log's writer thread catch up once while the window is open, so that "it
+        // wrote while the loop ran" below does not depend on the scheduler: on a loaded
+        // machine the writer could otherwise get no CPU during these ~0.1 s of ticks and only
+        // drain the ring at close (4096 frames, as seen on a fresh CI machine under load).
+        // Sleeping does not allocate; the ring still overflows before and after this point.
+        const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+        while ((*can)->log_written() + (*can)->log_dropped() < (*can)->counters().sent &&
+               std::chrono::steady_clock::now() < until)
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
       if (i == 150'000) {  // a set-pose command (reset to zero) arrives on the bus
         CanFrame cmd;
         protocol::encode_set_pose(
