@@ -1,0 +1,246 @@
+// SimGyro: error terms against their definitions, delay, quantisation, faults, determinism; and
+// gyrodometry on the simulated robot with the extended UMBmark's bumps on the first leg.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "odo/odometry/gyrodometry.hpp"
+#include "odo/odometry/kinematics.hpp"
+#include "odo/odometry/pose.hpp"
+#include "odo/sim/floor.hpp"
+#include "odo/sim/robot.hpp"
+#include "odo/sim/sim_gyro.hpp"
+
+namespace odo::sim {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr TimeNs kTickNs = 5'000'000;  // 200 Hz
+
+// quiet: a model without random terms, so outputs can be predicted exactly.
+GyroModel quiet() {
+  GyroModel m = consumer_gyro();
+  m.noise_density = 0.0;
+  m.bias_walk = 0.0;
+  return m;
+}
+
+// spin: stands still for `still` s, then turns on the spot at `w` rad/s (true geometry).
+SimRobot spin(double still, double w, double duration) {
+  const RobotGeometry g;  // 0.15 m wheels, b = 0.34 m
+  const double omega_wheel = w * g.wheelbase / 2.0 / (g.wheel_diameter_left / 2.0);
+  Scenario s{{still, 0.0, 0.0}, {duration, -omega_wheel, omega_wheel}};
+  return SimRobot::create(g, s).value();
+}
+
+TEST(SimGyro, ParameterSetsFromTheDatasheets) {
+  // BMI088: 0.014 deg/s/sqrt(Hz) = 2.443461e-4 rad/s/sqrt(Hz); 2000 deg/s = 34.90659 rad/s over
+  // 32768 LSB = 1.065264e-3 rad/s (16.384 LSB per deg/s); 1 deg/s offset = 1.745329e-2 rad/s.
+  const GyroModel c = consumer_gyro();
+  EXPECT_NEAR(c.noise_density, 2.443461e-4, 1e-10);
+  EXPECT_NEAR(c.full_scale, 34.90659, 1e-5);
+  EXPECT_NEAR(c.bias_offset, 1.745329e-2, 1e-8);
+  // ADIS16470: ARW 0.34 deg/sqrt(h) = 0.34/60 deg/s/sqrt(Hz) = 9.890199e-5 rad/s/sqrt(Hz).
+  const GyroModel i = industrial_gyro();
+  EXPECT_NEAR(i.noise_density, 9.890199e-5, 1e-10);
+  EXPECT_LT(i.noise_density, c.noise_density);
+  EXPECT_LT(std::fabs(i.bias_offset), std::fabs(c.bias_offset));
+  EXPECT_TRUE(check_gyro_model(c).ok());
+  EXPECT_TRUE(check_gyro_model(i).ok());
+  GyroModel bad = c;
+  bad.odr = 0.0;
+  const Status s = check_gyro_model(bad);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("odr"), std::string::npos);
+}
+
+TEST(SimGyro, ScaleBiasAndQuantisation) {
+  // Turning at 0.5 rad/s with +0.5 % scale error and a 1 deg/s offset, no noise: every sample
+  // reads 1.005 * 0.5 + 0.01745329 = 0.5199533 rad/s, rounded to the LSB 1.065264e-3 rad/s:
+  // 488.1 LSB -> 488 LSB = 0.5198488 rad/s.
+  SimRobot robot = spin(0.0, 0.5, 10.0);
+  SimGyro g = SimGyro::create(robot, quiet(), 1).value();
+  const double lsb = g.lsb();
+  EXPECT_NEAR(lsb, 34.90658503988659 / 32768.0, 1e-15);
+  for (TimeNs t = kTickNs; t < 2 * kNsPerSecond; t += kTickNs) {
+    const GyroSample s = g.read(t);
+    EXPECT_EQ(s.flags, kGyroOk);
+    // 1000 Hz read at 200 Hz; the first read gets 3 (samples of 1, 2, 3 ms, available 2 ms later).
+    EXPECT_EQ(s.samples, t == kTickNs ? 3u : 5u);
+    // Mean of whole LSBs: a multiple of the LSB unless the samples straddle a rounding edge.
+    if (t > 100'000'000) EXPECT_NEAR(s.rate_z, 488.0 * lsb, 1e-9) << t;
+  }
+}
+
+TEST(SimGyro, OutputDelayed) {
+  // Still for 1 s, then turning at 1 rad/s: with the 2 ms delay the first sample that sees the
+  // turn (motion in (1.000, 1.001] s) is available at 1.003 s.
+  SimRobot robot = spin(1.0, 1.0, 1.0);
+  GyroModel m = quiet();
+  m.bias_offset = 0.0;
+  SimGyro g = SimGyro::create(robot, m, 1).value();
+  const TimeNs ms = 1'000'000;
+  for (TimeNs t = ms; t <= 1002 * ms; t += ms) EXPECT_EQ(g.read(t).rate_z, 0.0) << t;
+  const GyroSample s = g.read(1003 * ms);
+  EXPECT_EQ(s.samples, 1u);
+  EXPECT_EQ(s.stamp, 1003 * ms);
+  EXPECT_NEAR(s.rate_z, std::nearbyint(1.005 / g.lsb()) * g.lsb(), 1e-12);
+}
+
+TEST(SimGyro, AngleRandomWalkMatchesTheDensity) {
+  // Standing still with only white noise: the angle integrated over 1 s blocks has standard
+  // deviation N sqrt(1 s) = 2.443461e-4 rad. 400 blocks: the sample std is within 10 % with
+  // probability > 0.95 (relative std error 1/sqrt(2 * 400) = 3.5 %, so 10 % is 2.8 sigma).
+  SimRobot robot = spin(500.0, 0.0, 0.0);
+  GyroModel m = quiet();
+  m.noise_density = consumer_gyro().noise_density;
+  m.bias_offset = 0.0;
+  SimGyro g = SimGyro::create(robot, m, 7).value();
+  std::vector<double> angles;
+  TimeNs t = 0;
+  for (int block = 0; block < 400; ++block) {
+    double a = 0.0;
+    for (int i = 0; i < 200; ++i) a += g.read(t += kTickNs).rate_z * 0.005;
+    angles.push_back(a);
+  }
+  double mean = 0.0, var = 0.0;
+  for (double a : angles) mean += a / 400.0;
+  for (double a : angles) var += (a - mean) * (a - mean) / 399.0;
+  EXPECT_NEAR(std::sqrt(var), 2.443461e-4, 0.1 * 2.443461e-4);
+}
+
+TEST(SimGyro, DeterministicForASeed) {
+  auto run = [](std::uint64_t seed) {
+    SimRobot robot = spin(0.5, 0.3, 2.0);
+    SimGyro g = SimGyro::create(robot, consumer_gyro(), seed).value();
+    std::vector<double> out;
+    for (TimeNs t = kTickNs; t < 2 * kNsPerSecond; t += kTickNs) out.push_back(g.read(t).rate_z);
+    return out;
+  };
+  EXPECT_EQ(run(3), run(3));
+  EXPECT_NE(run(3), run(4));
+}
+
+TEST(SimGyro, InjectedFaults) {
+  SimRobot robot = spin(10.0, 0.0, 0.0);
+  SimGyro g = SimGyro::create(robot, consumer_gyro(), 1, 20'000'000).value();
+  TimeNs t = 0;
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(g.read(t += kTickNs).flags, kGyroOk);
+  // Silent for 50 ms: no samples; flagged stale once nothing came for more than 20 ms.
+  g.arm_silence(50'000'000);
+  int stale = 0;
+  for (int i = 0; i < 10; ++i) {
+    const GyroSample s = g.read(t += kTickNs);
+    EXPECT_EQ(s.samples, 0u);
+    stale += (s.flags & kGyroStale) != 0;
+  }
+  EXPECT_EQ(stale, 6);  // reads at 25..50 ms after the last sample (50 - 20 ms + the last one)
+  EXPECT_EQ(g.read(t += kTickNs).flags, kGyroOk);
+  EXPECT_EQ(g.read(t).counters.stale_events, 1u);
+  // Saturation: 3 samples at the end of the range, flagged.
+  g.arm_saturation(3);
+  const GyroSample sat = g.read(t += kTickNs);
+  EXPECT_TRUE(sat.flags & kGyroSaturated);
+  EXPECT_EQ(g.injected().saturated_samples, 3u);
+  // NaN from a broken backend: not flagged (the fusion must catch it itself).
+  g.arm_nan(1);
+  const GyroSample n = g.read(t += kTickNs);
+  EXPECT_TRUE(std::isnan(n.rate_z));
+  EXPECT_EQ(n.flags, kGyroOk);
+  EXPECT_TRUE(std::isfinite(g.read(t += kTickNs).rate_z));
+}
+
+// Drive: the extended UMBmark's first leg on a robot whose geometry is exactly what odometry
+// believes (no systematic error), 200 Hz, with and without the fusion.
+struct LegResult {
+  double odo_error, fused_error;  // |heading - true heading| at the end [rad]
+  std::uint64_t events;
+};
+
+LegResult drive_leg(const GyroModel& m, std::uint64_t seed, int bumps, double gear = 16.0) {
+  RobotGeometry geo;  // 0.15 m wheels, 2048 x 16 counts, b = 0.34 m
+  geo.gear_ratio = gear;
+  const Kinematics k = Kinematics::create(nominal_params(0.15, 0.34, geo)).value();
+  const double omega = 0.2 / 0.075;  // 0.2 m/s
+  Scenario sc{{2.0, 0.0, 0.0}, {20.0, omega, omega}, {1.0, 0.0, 0.0}};
+  SimRobot robot = SimRobot::create(geo, sc).value();
+  UmbmarkFloor::Options fo;
+  fo.bumps = bumps;
+  fo.bump_loss = bump_travel_loss(0.075, 0.010);  // 10 mm bumps
+  UmbmarkFloor floor(fo, seed);
+  robot.set_travel_perturbation(&floor);
+  SimGyro gyro = SimGyro::create(robot, m, seed).value();
+  GyrodometryParams p;
+  p.noise.rate_noise_density = m.noise_density;
+  p.heading_quantum = (k.metres_per_count_left() + k.metres_per_count_right()) / k.wheelbase();
+  Gyrodometry fusion = Gyrodometry::create(p).value();
+  double th_odo = 0.0, th_fused = 0.0;
+  std::int64_t pl = 0, pr = 0;
+  for (TimeNs t = kTickNs; t <= from_seconds(23.0); t += kTickNs) {
+    robot.advance_to(t);
+    const std::int64_t cl = robot.counts_left(), cr = robot.counts_right();
+    FusionInput in;
+    in.dt = 0.005;
+    in.d_left = static_cast<double>(cl - pl) * k.metres_per_count_left();
+    in.d_right = static_cast<double>(cr - pr) * k.metres_per_count_right();
+    in.wheelbase = k.wheelbase();
+    in.gyro = gyro.read(t);
+    pl = cl;
+    pr = cr;
+    const FusedTick f = fusion.step(in);
+    th_odo += f.dtheta_odo;
+    th_fused += f.dtheta;
+  }
+  const double truth = robot.true_pose().theta;
+  return {std::fabs(th_odo - truth), std::fabs(th_fused - truth), fusion.counters().disagreements};
+}
+
+TEST(SimGyrodometry, BumpsOnTheFirstLegAreRejected) {
+  // Ten 10 mm bumps under the left wheel (rigid 75 mm wheel: travel loss
+  // 2 (0.075 acos(1 - 0.01/0.075) - sqrt(2 * 0.075 * 0.01 - 0.01^2)) = 3.514 mm each, i.e.
+  // 3.514e-3 / 0.34 = 0.01034 rad = 0.59 deg): odometry's heading is off by 0.1034 rad at the end
+  // of the leg (to within a count's 4.2e-5 rad). With the consumer gyro the fused heading must be
+  // at least 10x better, and each bump detected (10 events, at most 2 more from the gyro's noise).
+  const double per_bump = bump_travel_loss(0.075, 0.010) / 0.34;
+  EXPECT_NEAR(per_bump, 0.010335, 1e-6);
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const LegResult r = drive_leg(consumer_gyro(), seed, 10);
+    EXPECT_NEAR(r.odo_error, 10.0 * per_bump, 1e-4) << seed;
+    EXPECT_LT(r.fused_error, r.odo_error / 10.0) << seed;
+    EXPECT_GE(r.events, 10u) << seed;
+    EXPECT_LE(r.events, 12u) << seed;
+    RecordProperty("fused_error_seed" + std::to_string(seed), std::to_string(r.fused_error));
+    std::printf("seed %llu: odometry %.3e rad, fused %.3e rad, %llu events\n",
+                static_cast<unsigned long long>(seed), r.odo_error, r.fused_error,
+                static_cast<unsigned long long>(r.events));
+  }
+}
+
+TEST(SimGyrodometry, CoarseDirectDriveEncodersToo) {
+  // The same leg with 2048 counts per wheel revolution (direct drive, 0.23 mm a count, one or
+  // two counts a tick): the threshold is 1.78e-3 rad, still 5.8x below a bump's 1.03e-2.
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const LegResult r = drive_leg(consumer_gyro(), seed, 10, 1.0);
+    EXPECT_LT(r.fused_error, r.odo_error / 10.0) << seed;
+    EXPECT_EQ(r.events, 10u) << seed;
+    std::printf("direct drive seed %llu: odometry %.3e rad, fused %.3e rad\n",
+                static_cast<unsigned long long>(seed), r.odo_error, r.fused_error);
+    const LegResult smooth = drive_leg(consumer_gyro(), seed, 0, 1.0);
+    EXPECT_EQ(smooth.events, 0u) << seed;
+    EXPECT_EQ(smooth.fused_error, smooth.odo_error) << seed;
+  }
+}
+
+TEST(SimGyrodometry, SmoothFloorCostsNothing) {
+  // No bumps: nothing is flagged, the fused heading is odometry's exactly.
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const LegResult r = drive_leg(consumer_gyro(), seed, 0);
+    EXPECT_EQ(r.events, 0u) << seed;
+    EXPECT_EQ(r.fused_error, r.odo_error) << seed;
+  }
+}
+
+}  // namespace
+}  // namespace odo::sim
