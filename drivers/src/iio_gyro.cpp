@@ -138,7 +138,7 @@ Result<std::unique_ptr<IioGyro>> IioGyro::open(const IioGyroConfig& c) {
   g->chan_ = std::string("in_anglvel_") + axis_letter(c.axis);
   g->mode_ = c.mode;
   g->sign_ = c.sign;
-  g->stale_timeout_ = c.stale_timeout;
+  g->book_.stale_timeout = c.stale_timeout;
   if (auto s = g->read_scale(c); !s) return std::move(s).error();
   const Status s = c.mode == IioMode::kBuffered ? g->setup_buffer(c) : g->setup_polled(c);
   if (!s) return std::move(s).error();
@@ -205,21 +205,10 @@ IioGyro::~IioGyro() {
 }
 
 void IioGyro::finish(GyroSample& s, TimeNs now, double sum) noexcept {
-  counters_.samples += s.samples;
-  if (s.samples > 0) {
-    last_rate_ = sign_ * (sum / s.samples + offset_) * scale_;
-    have_sample_ = true;
-  }
-  if (!have_sample_ && last_stamp_ == 0) last_stamp_ = now;  // stale counts from the first read
-  const bool stale = now - last_stamp_ > stale_timeout_;
-  if (stale) {
-    s.flags |= kGyroStale;
-    if (!stale_) ++counters_.stale_events;
-  }
-  stale_ = stale;
-  s.rate_z = last_rate_;
-  s.stamp = last_stamp_;
-  s.counters = counters_;
+  if (s.samples > 0) have_sample_ = true;
+  if (!have_sample_ && book_.last_stamp == 0) book_.last_stamp = now;  // stale from the first read
+  const double mean = s.samples > 0 ? sign_ * (sum / s.samples + offset_) * scale_ : 0.0;
+  book_.close(s, now, mean);
 }
 
 GyroSample IioGyro::read(TimeNs now) noexcept {
@@ -234,7 +223,7 @@ double IioGyro::read_buffered(GyroSample& s) noexcept {
   if (n < 0) {
     if (errno != EAGAIN && errno != EINTR) {
       s.flags |= kGyroReadError;
-      ++counters_.read_errors;
+      ++book_.counters.read_errors;
     }
     return 0.0;
   }
@@ -246,10 +235,10 @@ double IioGyro::read_buffered(GyroSample& s) noexcept {
     const std::int64_t raw = iio_extract(scan + rate_off_, type_);
     if (raw <= raw_lo_ || raw >= raw_hi_) {
       s.flags |= kGyroSaturated;
-      ++counters_.saturated;
+      ++book_.counters.saturated;
     }
     sum += static_cast<double>(raw);
-    last_stamp_ = iio_extract(scan + ts_off_, ts_type_);
+    book_.last_stamp = iio_extract(scan + ts_off_, ts_type_);
   }
   s.samples = static_cast<std::uint32_t>(scans);
   // The kernel hands out whole scans; a pipe or file standing in for it need not.
@@ -263,7 +252,7 @@ double IioGyro::read_polled(GyroSample& s, TimeNs now) noexcept {
   const ssize_t n = ::pread(fd_, text, sizeof text - 1, 0);
   if (n <= 0) {
     s.flags |= kGyroReadError;  // e.g. EBUSY while someone else runs the buffer
-    ++counters_.read_errors;
+    ++book_.counters.read_errors;
     return 0.0;
   }
   text[n] = '\0';
@@ -272,15 +261,15 @@ double IioGyro::read_polled(GyroSample& s, TimeNs now) noexcept {
   const long long raw = std::strtoll(text, &end, 10);
   if (end == text || errno == ERANGE || (*end != '\n' && *end != '\0')) {
     s.flags |= kGyroInvalid;
-    ++counters_.invalid;
+    ++book_.counters.invalid;
     return 0.0;
   }
   if (have_type_ && (raw <= raw_lo_ || raw >= raw_hi_)) {
     s.flags |= kGyroSaturated;
-    ++counters_.saturated;
+    ++book_.counters.saturated;
   }
   s.samples = 1;
-  last_stamp_ = now;
+  book_.last_stamp = now;
   return static_cast<double>(raw);
 }
 

@@ -47,6 +47,7 @@ Status check_gyrodometry(const GyrodometryParams& p) {
       {"tick", p.tick, 0.0, 1.0, true},
       {"window", p.window, 2.0 * p.tick, std::max(10.0, 2.0 * p.tick), false},
       {"k_sigma", p.k_sigma, 1.0, 20.0, false},
+      {"gyro_delay", p.gyro_delay, 0.0, 1.0, false},
       {"heading_quantum", p.heading_quantum, 0.0, 0.1, false},
       {"max_wheel_speed", p.max_wheel_speed, 0.0, 100.0, true},
       {"max_wheel_accel", p.max_wheel_accel, 0.0, 1000.0, true},
@@ -77,6 +78,14 @@ Gyrodometry::Gyrodometry(const GyrodometryParams& p) : p_(p) {
   ring_.assign(2 * half, Entry{});
   const double t_w = static_cast<double>(ring_.size()) * p.tick;
   noise_term_ = p.k_sigma * p.noise.rate_noise_density * std::sqrt(t_w);
+  inv_t_h_ = 1.0 / (static_cast<double>(half_) * p.tick);
+  update_b_res();
+}
+
+void Gyrodometry::update_b_res() noexcept {
+  // The bias estimate's own noise: N / sqrt(seconds averaged), plus its drift since.
+  b_res_ = p_.noise.bias_instability +
+           p_.noise.rate_noise_density / std::sqrt(std::max(bias_time_, p_.still_time));
 }
 
 void Gyrodometry::reset() noexcept {
@@ -90,8 +99,8 @@ void Gyrodometry::reset() noexcept {
 }
 
 Gyrodometry::Entry& Gyrodometry::at(std::size_t age) noexcept {
-  const std::size_t n = ring_.size();
-  return ring_[(head_ + n - age) % n];
+  // age < ring size: one conditional wrap instead of a division.
+  return ring_[head_ >= age ? head_ - age : head_ + ring_.size() - age];
 }
 
 double Gyrodometry::threshold() const noexcept {
@@ -99,8 +108,13 @@ double Gyrodometry::threshold() const noexcept {
   // The bias estimate's own noise: N / sqrt(seconds averaged), plus its drift since.
   const double b_res = p_.noise.bias_instability +
                        p_.noise.rate_noise_density / std::sqrt(std::max(bias_time_, p_.still_time));
+  // Change of the rate of turn across the window: the halves' mean rates differ by half of it
+  // on a steady ramp.
+  const double turn_new = sum_new_r_ - sum_new_l_, turn_old = sum_old_r_ - sum_old_l_;
+  const double d_omega =
+      filled_ == ring_.size() ? 2.0 * std::fabs(turn_new - turn_old) * inv_t_h_ / wheelbase_ : 0.0;
   return p_.heading_quantum + noise_term_ + b_res * t_w +
-         p_.noise.scale_tolerance * std::fabs(sum_odo_);
+         p_.noise.scale_tolerance * std::fabs(sum_odo_) + p_.gyro_delay * d_omega;
 }
 
 void Gyrodometry::resum() noexcept {
@@ -170,6 +184,7 @@ void Gyrodometry::update_bias(const FusionInput& in, bool rate_ok, bool still, d
   if (!rate_ok || still_for_ < p_.still_time) return;
   bias_time_ = std::min(bias_time_ + dt, p_.bias_tau);
   bias_ += (in.gyro.rate_z - bias_) * dt / bias_time_;
+  update_b_res();
 }
 
 void Gyrodometry::update_scale(double odo, double raw_gyro, double dt) noexcept {
@@ -229,6 +244,7 @@ FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
   const double dt = in.dt > 0.0 && std::isfinite(in.dt) ? in.dt : p_.tick;
   const double odo = (in.d_right - in.d_left) / in.wheelbase;
   out.dtheta = out.dtheta_odo = odo;
+  wheelbase_ = in.wheelbase;
   const bool rate_ok = in.gyro.flags == kGyroOk && std::isfinite(in.gyro.rate_z);
   if (!rate_ok) {
     out.flags |= kFusionGyroFault;
@@ -261,8 +277,7 @@ FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
   }
   out.flags |= why | kFusionGyroUsed;
   const double n2 = p_.noise.rate_noise_density * p_.noise.rate_noise_density;
-  const double b_res = p_.noise.bias_instability +
-                       p_.noise.rate_noise_density / std::sqrt(std::max(bias_time_, p_.still_time));
+  const double b_res = b_res_;
   if (!in_interval_) {
     in_interval_ = true;
     interval_ticks_ = 0;

@@ -72,7 +72,7 @@ Result<SimGyro> SimGyro::create(SimRobot& robot, const GyroModel& m, std::uint64
 }
 
 SimGyro::SimGyro(SimRobot& robot, const GyroModel& m, std::uint64_t seed, TimeNs stale_timeout)
-    : robot_(robot), m_(m), stale_timeout_(stale_timeout), rng_(seed) {
+    : robot_(robot), m_(m), rng_(seed) {
   raw_max_ = (std::int64_t{1} << (m.bits - 1)) - 1;
   lsb_ = m.full_scale / static_cast<double>(raw_max_ + 1);
   period_ = from_seconds(1.0 / m.odr);
@@ -83,7 +83,8 @@ SimGyro::SimGyro(SimRobot& robot, const GyroModel& m, std::uint64_t seed, TimeNs
   walk_step_ = m.bias_walk * std::sqrt(to_seconds(period_));
   next_t_ = robot.time() + period_;
   last_theta_ = robot.true_pose().theta;
-  last_stamp_ = robot.time();
+  book_.stale_timeout = stale_timeout;
+  book_.last_stamp = robot.time();
   hist_[0] = {robot.time(), last_theta_};
   hist_n_ = 1;
 }
@@ -105,7 +106,6 @@ double SimGyro::heading_at(TimeNs t) const noexcept {
 }
 
 double SimGyro::sample(double true_rate, bool& saturated) noexcept {
-  walk_ += walk_step_ * normal_(rng_);
   double r = (1.0 + m_.scale_error) * true_rate + m_.bias_offset + walk_ + sigma_ * normal_(rng_);
   if (saturate_left_ > 0) {
     --saturate_left_;
@@ -144,28 +144,22 @@ GyroSample SimGyro::read(TimeNs now) noexcept {
     bool sat = false;
     sum += sample(true_rate, sat);
     ++s.samples;
-    last_stamp_ = avail;
+    book_.last_stamp = avail;
     if (sat) {
       s.flags |= kGyroSaturated;
-      ++counters_.saturated;
+      ++book_.counters.saturated;
     }
   }
-  counters_.samples += s.samples;
-  if (s.samples > 0) last_rate_ = sum / s.samples;
-  const bool stale = now - last_stamp_ > stale_timeout_;
-  if (stale) {
-    s.flags |= kGyroStale;
-    if (!stale_) ++counters_.stale_events;
-  }
-  stale_ = stale;
-  s.rate_z = last_rate_;
-  s.stamp = last_stamp_;
+  // The bias walks once per read by the samples' combined step (sigma K sqrt(n T_s)): the same
+  // statistics as a step per sample, at one random number per read instead of one per sample.
+  if (s.samples > 0 && walk_step_ > 0.0)
+    walk_ += walk_step_ * std::sqrt(static_cast<double>(s.samples)) * normal_(rng_);
+  book_.close(s, now, s.samples > 0 ? sum / s.samples : 0.0);
   if (nan_left_ > 0) {
     --nan_left_;
     ++injected_.nan_reads;
     s.rate_z = std::numeric_limits<double>::quiet_NaN();
   }
-  s.counters = counters_;
   return s;
 }
 

@@ -36,6 +36,33 @@ struct GyroSample {
   GyroCounters counters;
 };
 
+// GyroReadBook: the bookkeeping every gyro source does at the end of a read, shared by the IIO
+// backend (drivers/) and the simulated gyro (sim_hal/) so that both flag and count alike.
+struct GyroReadBook {
+  TimeNs stale_timeout = 0;  // no sample for longer than this: kGyroStale [ns]
+  TimeNs last_stamp = 0;     // time of the newest sample [ns]
+  double last_rate = 0.0;    // newest mean rate [rad/s]
+  bool stale = false;
+  GyroCounters counters;
+
+  // close: s.samples samples of mean rate `mean` [rad/s] arrived in this read; fills rate_z (the
+  // previous mean when none arrived), stamp, the stale flag (one stale event per transition into
+  // the stale state) and the counters.
+  void close(GyroSample& s, TimeNs now, double mean) noexcept {
+    counters.samples += s.samples;
+    if (s.samples > 0) last_rate = mean;
+    const bool now_stale = now - last_stamp > stale_timeout;
+    if (now_stale) {
+      s.flags |= kGyroStale;
+      if (!stale) ++counters.stale_events;
+    }
+    stale = now_stale;
+    s.rate_z = last_rate;
+    s.stamp = last_stamp;
+    s.counters = counters;
+  }
+};
+
 class YawRateSource {
  public:
   virtual ~YawRateSource() = default;

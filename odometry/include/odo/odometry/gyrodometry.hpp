@@ -14,15 +14,17 @@
 // noise over a window of T_w seconds grows as N sqrt(T_w). So the comparison is made on the sum of
 // the increments over the last n = T_w / tick ticks, E = sum (dtheta_gyro - dtheta_odo), against
 //
-//   T = q + k_sigma * N sqrt(T_w) + B_res T_w + s_tol |sum dtheta_odo|
+//   T = q + k_sigma * N sqrt(T_w) + B_res T_w + s_tol |sum dtheta_odo| + d |delta omega|
 //
 // (N rate noise density [rad/s/sqrt(Hz)], B_res the residual bias [rad/s], s_tol the residual
-// scale-factor error). When |E| > T, or a wheel's speed or acceleration exceeds the configured
-// limits, a flagged interval begins: the heading takes the gyro's increments for every tick of
-// the window that odometry had supplied (one correction, so the whole disturbance is replaced,
-// not just the part after detection), then the gyro's increment every tick until the window is
-// quiet again. The quantisation error introduced is below q once per interval and has no sign
-// preference; nothing is chosen per tick.
+// scale-factor error, d the gyro's delay [s] and delta omega the change of odometry's rate of
+// turn across the window: a delayed gyro's window sum is theta(t - d) - theta(t - T_w - d), off
+// by d (omega(t) - omega(t - T_w)) while the turn rate changes). When |E| > T, or a wheel's speed
+// or acceleration exceeds the configured limits, a flagged interval begins: the heading takes the
+// gyro's increments for every tick of the window that odometry had supplied (one correction, so the
+// whole disturbance is replaced, not just the part after detection), then the gyro's increment
+// every tick until the window is quiet again. The quantisation error introduced is below q once per
+// interval and has no sign preference; nothing is chosen per tick.
 //
 // Thresholds for the two reference set-ups (T_w = 0.1 s, k_sigma = 5, consumer gyro of the
 // BMI088 class: N = 0.014 deg/s/sqrt(Hz) = 2.4435e-4 rad/s/sqrt(Hz), bias instability 2 deg/h =
@@ -65,6 +67,7 @@ struct GyrodometryParams {
   double tick = 0.005;            // nominal loop period [s]
   double window = 0.1;            // comparison window T_w [s] (rounded to whole ticks)
   double k_sigma = 5.0;           // noise multiples in the threshold
+  double gyro_delay = 0.0025;     // the gyro's delay behind the encoders [s] (filter + transport)
   double heading_quantum = 0.0;   // q = (m_L + m_R)/b [rad]: one count on each wheel
   double max_wheel_speed = 2.0;   // |wheel speed| the robot cannot exceed [m/s]
   double max_wheel_accel = 10.0;  // |wheel acceleration| the robot cannot exceed [m/s^2]
@@ -152,6 +155,7 @@ class Gyrodometry {
   explicit Gyrodometry(const GyrodometryParams& p);
   void update_bias(const FusionInput& in, bool rate_ok, bool still, double dt) noexcept;
   void update_scale(double odo, double raw_gyro, double dt) noexcept;
+  void update_b_res() noexcept;
   void push(const Entry& e) noexcept;
   void resum() noexcept;
   std::uint32_t limit_flags() const noexcept;
@@ -164,6 +168,9 @@ class Gyrodometry {
   std::size_t filled_ = 0;   // entries in use (<= ring size)
   std::size_t half_ = 1;     // ticks in each half of the window (accelerations)
   double noise_term_ = 0.0;  // k_sigma N sqrt(T_w) [rad]
+  double wheelbase_ = 1.0;   // of the last tick [m], for the delay term
+  double inv_t_h_ = 1.0;     // 1 / duration of half the window [1/s]
+  double b_res_ = 0.0;       // residual bias B_res [rad/s], updated with the estimate
   // Running sums over the window (re-summed from the ring every time it wraps).
   double sum_err_ = 0.0;                      // sum (gyro - odo) of entries with gyro_ok
   double sum_odo_ = 0.0;                      // sum odo

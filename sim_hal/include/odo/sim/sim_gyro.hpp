@@ -92,7 +92,6 @@ class SimGyro final : public YawRateSource {
   static constexpr std::size_t kHistory = 64;
   SimRobot& robot_;
   GyroModel m_;
-  TimeNs stale_timeout_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
   double lsb_ = 0.0, sigma_ = 0.0, walk_step_ = 0.0;
@@ -103,12 +102,9 @@ class SimGyro final : public YawRateSource {
   double walk_ = 0.0;        // bias random walk so far [rad/s]
   std::array<Past, kHistory> hist_{};
   std::size_t hist_head_ = 0, hist_n_ = 0;
-  double last_rate_ = 0.0;
-  TimeNs last_stamp_ = 0;
-  bool stale_ = false;
+  GyroReadBook book_;
   TimeNs silence_ = 0, silent_until_ = -1;
   int saturate_left_ = 0, nan_left_ = 0;
-  GyroCounters counters_;
   InjectedGyroFaults injected_;
 };
 
