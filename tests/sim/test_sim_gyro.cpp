@@ -14,6 +14,7 @@
 #include "odo/sim/floor.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_gyro.hpp"
+#include "odo/sim/ziggurat.hpp"
 
 namespace odo::sim {
 namespace {
@@ -35,6 +36,31 @@ SimRobot spin(double still, double w, double duration) {
   const double omega_wheel = w * g.wheelbase / 2.0 / (g.wheel_diameter_left / 2.0);
   Scenario s{{still, 0.0, 0.0}, {duration, -omega_wheel, omega_wheel}};
   return SimRobot::create(g, s).value();
+}
+
+TEST(ZigguratNormal, MomentsAndTails) {
+  // 2e6 draws of N(0, 1): mean within 5 standard errors (5 / sqrt(2e6) = 3.5e-3), variance
+  // within 5 of its standard errors (sqrt(2 / 2e6) = 1e-3); beyond 3 sigma the two-sided
+  // fraction is 2.700e-3 (5400 expected, Poisson sigma 73), beyond 4 sigma 6.334e-5 (127, sigma
+  // 11): both within 5 sigma, so the base layer's tail and the wedges are drawn right.
+  ZigguratNormal z(42);
+  const int n = 2'000'000;
+  double sum = 0.0, sum2 = 0.0;
+  int beyond3 = 0, beyond4 = 0;
+  for (int i = 0; i < n; ++i) {
+    const double x = z();
+    sum += x;
+    sum2 += x * x;
+    beyond3 += std::fabs(x) > 3.0;
+    beyond4 += std::fabs(x) > 4.0;
+  }
+  const double mean = sum / n, var = sum2 / n - mean * mean;
+  EXPECT_NEAR(mean, 0.0, 3.5e-3);
+  EXPECT_NEAR(var, 1.0, 5e-3);
+  EXPECT_NEAR(beyond3, 5400, 5 * 73);
+  EXPECT_NEAR(beyond4, 127, 5 * 11);
+  ZigguratNormal a(7), b(7);
+  for (int i = 0; i < 1000; ++i) ASSERT_EQ(a(), b());
 }
 
 TEST(SimGyro, ParameterSetsFromTheDatasheets) {

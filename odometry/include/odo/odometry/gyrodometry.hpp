@@ -164,13 +164,17 @@ class Gyrodometry {
 
   GyrodometryParams p_;
   std::vector<Entry> ring_;
-  std::size_t head_ = 0;     // index of the newest entry
-  std::size_t filled_ = 0;   // entries in use (<= ring size)
-  std::size_t half_ = 1;     // ticks in each half of the window (accelerations)
-  double noise_term_ = 0.0;  // k_sigma N sqrt(T_w) [rad]
-  double wheelbase_ = 1.0;   // of the last tick [m], for the delay term
-  double inv_t_h_ = 1.0;     // 1 / duration of half the window [1/s]
-  double b_res_ = 0.0;       // residual bias B_res [rad/s], updated with the estimate
+  std::size_t head_ = 0;         // index of the newest entry
+  std::size_t filled_ = 0;       // entries in use (<= ring size)
+  std::size_t half_ = 1;         // ticks in each half of the window (accelerations)
+  double noise_term_ = 0.0;      // k_sigma N sqrt(T_w) [rad]
+  double wheelbase_ = 1.0;       // of the last tick [m], for the delay term
+  double inv_t_h_ = 1.0;         // 1 / duration of half the window [1/s]
+  double b_res_ = 0.0;           // residual bias B_res [rad/s], updated with the estimate
+  double base_threshold_ = 0.0;  // q + k_sigma N sqrt(T_w) + B_res T_w [rad]
+  double v_max_tick_ = 0.0;      // max_wheel_speed * tick [m]
+  double dv_max_ = 0.0;          // max_wheel_accel * T_h^2 [m]
+  std::uint32_t wraps_ = 0;      // passes of the ring (for the periodic re-sum)
   // Running sums over the window (re-summed from the ring every time it wraps).
   double sum_err_ = 0.0;                      // sum (gyro - odo) of entries with gyro_ok
   double sum_odo_ = 0.0;                      // sum odo

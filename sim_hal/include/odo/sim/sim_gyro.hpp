@@ -9,11 +9,11 @@
 
 #include <array>
 #include <cstdint>
-#include <random>
 
 #include "odo/hal/gyro.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/sim/robot.hpp"
+#include "odo/sim/ziggurat.hpp"
 
 namespace odo::sim {
 
@@ -92,8 +92,7 @@ class SimGyro final : public YawRateSource {
   static constexpr std::size_t kHistory = 64;
   SimRobot& robot_;
   GyroModel m_;
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  ZigguratNormal normal_;
   double lsb_ = 0.0, sigma_ = 0.0, walk_step_ = 0.0;
   std::int64_t raw_max_ = 0;
   TimeNs period_ = 0, delay_ = 0;
