@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
   double heading = 0.0;
   long used = 0;
   for (long i = 1; i <= n; ++i) {
-    const odo::TimeNs t = i * 1'000'000;
+    const odo::TimeNs t = odo::TimeNs{i} * 1'000'000;
     robot.advance_to(t);
     odo::FusionInput in;
     in.dt = 0.001;

@@ -8,6 +8,7 @@
 
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/gyrodometry.hpp"
+#include "odo/odometry/pose.hpp"
 
 namespace odo {
 namespace {
@@ -290,6 +291,35 @@ TEST(Gyrodometry, RejectsBadParameters) {
   r = Gyrodometry::create(p);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().message.find("bias_tau"), std::string::npos) << r.error().message;
+}
+
+TEST(Gyrodometry, FusedUpdateIsOdometryWhenNothingIsFlagged) {
+  // The loop integrates FusedTick::dtheta with Odometry::update_fused. When the fusion passes
+  // odometry's own increment through, the pose must be bit-identical to update()'s.
+  const Kinematics k = Kinematics::create({0.15, 2048, 16, 0.34, 0.34, 1.0, 1.0}).value();
+  Odometry plain(k), fused(k);
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  std::uint64_t x = 12345;
+  for (int i = 0; i < 5000; ++i) {
+    x = x * 6364136223846793005ull + 1442695040888963407ull;  // LCG: counts -3..+12 per tick
+    const std::int64_t dl = static_cast<std::int64_t>((x >> 33) % 16) - 3;
+    const std::int64_t dr = static_cast<std::int64_t>((x >> 45) % 16) - 3;
+    FusionInput in = input(static_cast<double>(dl) * k.metres_per_count_left(),
+                           static_cast<double>(dr) * k.metres_per_count_right(), 0.0);
+    in.gyro.flags = kGyroStale;  // odometry only
+    const FusedTick t = g.step(in);
+    plain.update(dl, dr, kTick);
+    fused.update_fused(dl, dr, kTick, t.dtheta);
+  }
+  EXPECT_EQ(plain.pose().x, fused.pose().x);
+  EXPECT_EQ(plain.pose().y, fused.pose().y);
+  EXPECT_EQ(plain.pose().theta, fused.pose().theta);
+  EXPECT_EQ(plain.angular_velocity(), fused.angular_velocity());
+  // Another heading: straight counts, 1e-3 rad per tick from elsewhere: 100 ticks turn 0.1 rad.
+  Odometry turn(k);
+  for (int i = 0; i < 100; ++i) turn.update_fused(70, 70, kTick, 1e-3);
+  EXPECT_NEAR(turn.pose().theta, 0.1, 1e-15);
+  EXPECT_NEAR(turn.angular_velocity(), 0.2, 1e-15);
 }
 
 enum { XX = 0, XY = 1, XT = 2, YY = 4, YT = 5, TT = 8 };
