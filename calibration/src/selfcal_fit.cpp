@@ -121,6 +121,22 @@ void summarise(const FixTrack& t, const SelfCalConfig& c, const std::vector<int>
   r.chi2_per_dof = dof > 0 ? chi / dof : 0.0;
 }
 
+// hold_scale: when the distance scale m = (c_L + c_R) / 2 is not determined to
+// max_sigma_factor (excursions that return to where they started cannot see it: scaling c_L,
+// c_R and b together scales the whole closed path about its start), the candidate is
+// conditioned on m = m_in_use (Gaussian conditioning: p += K (m_use - m), Sigma -= K a^T Sigma,
+// K = Sigma a / (a^T Sigma a)), which keeps what the data do determine. True when it did.
+bool hold_scale(const SelfCalConfig& c, FitOut& f) {
+  const Vec3 a(0.5, 0.5, 0.0);
+  const Vec3 sa = f.cov * a;
+  const double var = a.dot(sa);
+  if (std::sqrt(var) <= c.max_sigma_factor) return false;
+  const Vec3 k = sa / var;
+  f.p += k * (0.5 * (c.in_use.c_l + c.in_use.c_r) - a.dot(f.p));
+  f.cov -= k * sa.transpose();
+  return true;
+}
+
 Verdict decide(const SelfCalConfig& c, const SelfCalResult& r) {
   if (r.excursions_held_out == 0) return Verdict::kNoHeldOut;
   if (r.sigma[0] > c.max_sigma_factor || r.sigma[1] > c.max_sigma_factor ||
@@ -147,13 +163,17 @@ Result<SelfCalResult> fit_fixes(const FixTrack& t, const SelfCalConfig& c) {
   for (std::size_t k = 0; c.hold_out_every > 0 && k < train.size(); ++k)
     train[k] = (k % static_cast<std::size_t>(c.hold_out_every)) !=
                static_cast<std::size_t>(c.hold_out_every - 1);
-  const FitOut f = detail::fit_once(t, acc, c, train);
+  FitOut f = detail::fit_once(t, acc, c, train);
   if (!f.ok) return make_error(Errc::kInvalidArgument, "the fit diverged on the training set");
   SelfCalResult r;
+  r.free_scale = detail::to_factors(f.p);
+  r.scale_held = hold_scale(c, f);
   r.initial = detail::to_factors(f.initial);
   r.estimate = detail::to_factors(f.p);
   for (int i = 0; i < 9; ++i) r.covariance[static_cast<std::size_t>(i)] = f.cov(i / 3, i % 3);
-  for (int i = 0; i < 3; ++i) r.sigma[static_cast<std::size_t>(i)] = std::sqrt(f.cov(i, i));
+  // max(0, .): the conditioned variance along the held direction is zero up to rounding.
+  for (int i = 0; i < 3; ++i)
+    r.sigma[static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, f.cov(i, i)));
   r.iterations = f.iterations;
   r.fixes_used = static_cast<int>(acc.size());
   r.fixes_rejected = static_cast<int>(rejected.size());

@@ -15,6 +15,7 @@ namespace odo::calib {
 namespace {
 
 constexpr double kCm = 1e-4;  // [m/count]
+constexpr double kPi = 3.14159265358979323846;
 
 SelfCalConfig exact_config() {
   SelfCalConfig c;
@@ -22,6 +23,8 @@ SelfCalConfig exact_config() {
   c.in_use = {1.0, 1.0, 0.5};
   c.odometry_noise = {0.0, 0.0};  // the data below are exact
   c.hold_out_every = 0;
+  // These tracks do see the scale (open paths); sigma 1e-3 keeps it free even with 1 mm fixes.
+  c.max_sigma_factor = 1e-3;
   return c;
 }
 
@@ -283,6 +286,31 @@ TEST(SelfCal, AcceptanceNeedsBetterHeldOutPredictionAndSmallSigma) {
   r = fit_fixes(t, c);
   ASSERT_TRUE(r);
   EXPECT_EQ(r->verdict, Verdict::kTooUncertain);
+}
+
+TEST(SelfCal, ClosedLoopsHoldTheScale) {
+  // Out 1 m, turn pi, back 1 m, turn pi: the path closes, and so it closes for any common
+  // factor on (c_L, c_R, b): the scale m = (c_L + c_R)/2 is not observable, its sigma stays at
+  // the prior's 0.05 / sqrt(2) > 2e-4, so the estimate is conditioned on the in-use m = 1.
+  // What the loop does determine is the turn rate c/b: truth 1.002 / 0.4 with c = 1 gives
+  // b = 0.4 / 1.002 = 0.399202 m; c_R/c_L = 1 from the straight legs.
+  const Factors truth{1.002, 1.002, 0.4};
+  // A pi turn: 0.3 m (c_L + c_R) / b = pi -> counts per wheel = pi 0.4 / (2 * 1.002 * 1e-4).
+  const double n = kPi * 0.4 / (2.0 * 1.002 * kCm);
+  std::vector<std::vector<LegCounts>> legs;
+  for (int i = 0; i < 6; ++i)
+    legs.push_back(
+        {{10000, 10000}, {-n, n}, {10000, 10000}, {-n * (1 + 0.1 * i), n * (1 + 0.1 * i)}});
+  SelfCalConfig c = exact_config();
+  c.max_sigma_factor = 2e-4;
+  // Fixes of 1 um: the prior's pull on the observable directions is then below 1e-9.
+  auto r = fit_fixes(track(legs, truth, {}, 1e-6), c);
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_TRUE(r->scale_held);
+  EXPECT_NEAR(r->estimate.c_l, 1.0, 1e-7);
+  EXPECT_NEAR(r->estimate.c_r, 1.0, 1e-7);
+  EXPECT_NEAR(r->estimate.wheelbase, 0.4 / 1.002, 1e-7);
+  EXPECT_GT(std::fabs(r->free_scale.c_l - 1.0), 0.0);
 }
 
 TEST(SelfCal, BadInputIsNamed) {

@@ -21,7 +21,12 @@
 //     re-check: each rejected fix is tested again against the final estimate (both of its
 //     excursions within the gate, with the parameter uncertainty added to S) and re-admitted
 //     if it passes, followed by one more fit.
-//  4. Acceptance: every hold_out_every-th excursion (in time order, after rejection) is held
+//  4. Scale: excursions that end where they started (a dock) cannot see the distance scale:
+//     multiplying c_L, c_R and b by one factor scales the closed path about its start. When the
+//     standard deviation of m = (c_L + c_R)/2 exceeds max_sigma_factor, the estimate and its
+//     covariance are conditioned on m = m_in_use (scale_held): what the data determine (the
+//     ratio c_R/c_L and the turn rates c/b) is kept, the scale stays as it was.
+//  5. Acceptance: every hold_out_every-th excursion (in time order, after rejection) is held
 //     out of the fit; the score of a parameter set is the mean chi2 per degree of freedom of
 //     its predictions of the held-out excursions (same S for both). The candidate is accepted
 //     only when every standard deviation is below its bound AND its score is lower than the
@@ -88,7 +93,7 @@ struct SelfCalConfig {
   int max_iterations = 20;              // Gauss-Newton
   int hold_out_every = 4;               // every 4th excursion held out; 0: none (no decision)
   double max_sigma_factor = 2e-4;       // acceptance bound on sigma(c_L), sigma(c_R)
-  double max_sigma_wheelbase = 1e-4;    // [m] acceptance bound on sigma(b)
+  double max_sigma_wheelbase = 2e-4;    // [m] acceptance bound on sigma(b)
 };
 
 // check_selfcal_config: every field finite and in range; the message names the field.
@@ -107,7 +112,10 @@ const char* verdict_name(Verdict v) noexcept;
 
 struct SelfCalResult {
   Factors initial;                // Antonelli et al. linear estimate (in_use where not observable)
-  Factors estimate;               // Gauss-Newton on the training excursions
+  Factors estimate;               // Gauss-Newton on the training excursions (scale: below)
+  Factors free_scale;             // the same before the scale was held
+  bool scale_held = false;        // sigma((c_L + c_R)/2) was above max_sigma_factor: estimate
+                                  // and covariance are conditioned on the in-use value
   ParamCov covariance{};          // of estimate
   std::array<double, 3> sigma{};  // sqrt of the diagonal: c_L, c_R, b [-, -, m]
   int iterations = 0;             // Gauss-Newton iterations of the last fit
