@@ -177,9 +177,15 @@ detail::FitOut gauss_newton(const FixTrack& t, std::span<const int> acc, const S
     const Eigen::MatrixXd a = jc.llt.matrixL().solve(jac);
     const Eigen::VectorXd b = jc.llt.matrixL().solve(res);
     h = p_inf + a.transpose() * a;
-    const Vec3 step = h.ldlt().solve(p_inf * (prior - p) + a.transpose() * b);
+    Vec3 step = h.ldlt().solve(p_inf * (prior - p) + a.transpose() * b);
+    // Outliers not yet rejected can pull the estimate far out (along the scale, which closed
+    // excursions barely see): shorten the step to stay in the plausible box and stop there;
+    // the rejection that follows needs an estimate to score the fixes with, not a failure.
+    int halve = 0;
+    for (; halve < 40 && !plausible(p + step, c.in_use.wheelbase); ++halve) step *= 0.5;
+    if (!plausible(p + step, c.in_use.wheelbase)) break;
+    f.bounded = f.bounded || halve > 0;
     p += step;
-    if (!plausible(p, c.in_use.wheelbase)) return f;
     if (step.cwiseAbs().maxCoeff() < 1e-13) break;
   }
   f.iterations = std::min(f.iterations, c.max_iterations);

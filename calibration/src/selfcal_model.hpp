@@ -70,7 +70,8 @@ struct FitOut {
   Vec3 p = Vec3::Zero();        // Gauss-Newton
   Mat3 cov = Mat3::Zero();
   int iterations = 0;
-  bool ok = false;  // false: the iteration left the plausible box
+  bool ok = false;       // false: the start value was not plausible
+  bool bounded = false;  // a step was shortened to stay in the plausible box
 };
 
 // fit_once: linear initial value and Gauss-Newton over the excursions of `acc` admitted by
