@@ -14,14 +14,9 @@ namespace {
 
 constexpr TimeNs kMs = 1'000'000;
 
+// The reference robot's belief: 0.15 m wheels, 2048 counts, 16:1 gear, 0.34 m wheelbase.
 Kinematics labmate() {
-  KinematicParams p;
-  p.wheel_diameter = 0.15;
-  p.counts_per_rev = 2048;
-  p.gear_ratio = 16;
-  p.wheelbase_nominal = 0.34;
-  p.wheelbase = 0.34;
-  return *Kinematics::create(p);
+  return *Kinematics::create(KinematicParams{0.15, 2048, 16, 0.34, 0.34, 1.0, 1.0});
 }
 
 TEST(CountRecorder, LimitsInCounts) {
