@@ -1,0 +1,136 @@
+// Second receiver on Cyclone DDS's C API (separate process, the library's IDL compiled by idlc):
+// receives rt<ns>/odom and rt/tf, prints them in peer_common.hpp's format or a latency summary,
+// and publishes rt<ns>/set_pose. Network set-up from CYCLONEDDS_URI (the test sets loopback).
+#include <dds/dds.h>
+
+#include <cmath>
+
+#include "peer_common.hpp"
+#include "ros2_msgs.h"
+
+namespace {
+
+dds_qos_t* ros_qos() {
+  dds_qos_t* q = dds_create_qos();
+  dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+  dds_qset_durability(q, DDS_DURABILITY_VOLATILE);
+  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 10);
+  return q;
+}
+
+std::string odom_line(const nav_msgs_msg_dds__Odometry_& o, std::int64_t recv) {
+  char b[160];
+  std::snprintf(b, sizeof b, "odom %d %u %" PRId64 " %s %s", o.header.stamp.sec,
+                o.header.stamp.nanosec, recv, o.header.frame_id, o.child_frame_id);
+  std::string s = b;
+  const auto& p = o.pose.pose;
+  const double pose[] = {p.position.x,    p.position.y,    p.position.z,   p.orientation.x,
+                         p.orientation.y, p.orientation.z, p.orientation.w};
+  peer::print_doubles(s, pose, 7);
+  peer::print_doubles(s, o.pose.covariance, 36);
+  const auto& t = o.twist.twist;
+  const double tw[] = {t.linear.x, t.linear.y, t.linear.z, t.angular.x, t.angular.y, t.angular.z};
+  peer::print_doubles(s, tw, 6);
+  peer::print_doubles(s, o.twist.covariance, 36);
+  return s;
+}
+
+std::string tf_line(const tf2_msgs_msg_dds__TFMessage_& m, std::int64_t recv) {
+  std::string s;
+  for (uint32_t i = 0; i < m.transforms._length; ++i) {
+    const auto& t = m.transforms._buffer[i];
+    char b[160];
+    std::snprintf(b, sizeof b, "tf %d %u %" PRId64 " %s %s", t.header.stamp.sec,
+                  t.header.stamp.nanosec, recv, t.header.frame_id, t.child_frame_id);
+    s += b;
+    const auto& x = t.transform;
+    const double v[] = {x.translation.x, x.translation.y, x.translation.z, x.rotation.x,
+                        x.rotation.y,    x.rotation.z,    x.rotation.w};
+    peer::print_doubles(s, v, 7);
+  }
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  peer::Args a;
+  if (!peer::parse(argc, argv, a)) return peer::usage(argv[0]);
+  const dds_entity_t dp = dds_create_participant(a.domain, nullptr, nullptr);
+  if (dp < 0) return std::fprintf(stderr, "cyclone_peer: %s\n", dds_strretcode(dp)), 1;
+  dds_qos_t* q = ros_qos();
+  const std::string odom_name = "rt" + a.ns + "/odom", sp_name = "rt" + a.ns + "/set_pose";
+  const dds_entity_t odom_t =
+      dds_create_topic(dp, &nav_msgs_msg_dds__Odometry__desc, odom_name.c_str(), nullptr, nullptr);
+  const dds_entity_t tf_t =
+      dds_create_topic(dp, &tf2_msgs_msg_dds__TFMessage__desc, "rt/tf", nullptr, nullptr);
+  const dds_entity_t sp_t =
+      dds_create_topic(dp, &geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc, sp_name.c_str(),
+                       nullptr, nullptr);
+  const dds_entity_t odom_r = dds_create_reader(dp, odom_t, q, nullptr);
+  const dds_entity_t tf_r = dds_create_reader(dp, tf_t, q, nullptr);
+  const dds_entity_t sp_w = dds_create_writer(dp, sp_t, q, nullptr);
+  dds_delete_qos(q);
+  if (odom_r < 0 || tf_r < 0 || sp_w < 0)
+    return std::fprintf(stderr, "cyclone_peer: endpoints\n"), 1;
+  // Wait on either reader's data with a 20 ms timeout (to publish set_pose on time).
+  const dds_entity_t ws = dds_create_waitset(dp);
+  dds_set_status_mask(odom_r, DDS_DATA_AVAILABLE_STATUS);
+  dds_set_status_mask(tf_r, DDS_DATA_AVAILABLE_STATUS);
+  dds_waitset_attach(ws, odom_r, odom_r);
+  dds_waitset_attach(ws, tf_r, tf_r);
+
+  geometry_msgs_msg_dds__PoseWithCovarianceStamped_ sp{};
+  char odom_frame[] = "odom";
+  sp.header.frame_id = odom_frame;
+  sp.pose.pose.position.x = a.sp_x;
+  sp.pose.pose.position.y = a.sp_y;
+  sp.pose.pose.orientation.z = std::sin(a.sp_yaw / 2);
+  sp.pose.pose.orientation.w = std::cos(a.sp_yaw / 2);
+  for (int i : {0, 7, 35}) sp.pose.covariance[i] = a.sp_var;
+
+  peer::Latency lat;
+  lat.skip = a.skip;
+  int n_odom = 0, n_tf = 0;
+  const double end = peer::monotonic_s() + a.timeout_s;
+  double next_sp = 0;
+  void* samples[16] = {};
+  dds_sample_info_t infos[16];
+  while ((n_odom < a.odom || n_tf < a.tf) && peer::monotonic_s() < end) {
+    dds_waitset_wait(ws, nullptr, 0, DDS_MSECS(20));
+    dds_return_t n;
+    while ((n = dds_take(odom_r, samples, infos, 16, 16)) > 0) {
+      const std::int64_t recv = peer::realtime_ns();
+      for (int i = 0; i < n; ++i) {
+        if (!infos[i].valid_data) continue;
+        const auto& o = *static_cast<const nav_msgs_msg_dds__Odometry_*>(samples[i]);
+        ++n_odom;
+        lat.add(o.header.stamp.sec, o.header.stamp.nanosec, recv);
+        if (!a.quiet) std::printf("%s\n", odom_line(o, recv).c_str());
+      }
+      dds_return_loan(odom_r, samples, n);
+    }
+    while ((n = dds_take(tf_r, samples, infos, 16, 16)) > 0) {
+      const std::int64_t recv = peer::realtime_ns();
+      for (int i = 0; i < n; ++i) {
+        if (!infos[i].valid_data) continue;
+        ++n_tf;
+        if (!a.quiet) {
+          std::printf(
+              "%s\n",
+              tf_line(*static_cast<const tf2_msgs_msg_dds__TFMessage_*>(samples[i]), recv).c_str());
+        }
+      }
+      dds_return_loan(tf_r, samples, n);
+    }
+    if (a.set_pose && peer::monotonic_s() >= next_sp) {
+      dds_write(sp_w, &sp);
+      next_sp = peer::monotonic_s() + 0.2;
+    }
+    std::fflush(stdout);
+  }
+  if (a.quiet) lat.print_summary(n_odom + n_tf);
+  std::printf("done odom=%d tf=%d\n", n_odom, n_tf);
+  dds_delete(dp);
+  return (n_odom >= a.odom && n_tf >= a.tf) ? 0 : 3;
+}

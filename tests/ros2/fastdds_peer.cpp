@@ -1,0 +1,163 @@
+// Independent ROS 2-style peer on Fast DDS (eProsima, Debian libfastrtps-dev), types generated
+// by fastddsgen from ros2/idl/ros2_msgs.idl: receives rt<ns>/odom and rt/tf, prints each message
+// (peer_common.hpp's format) or a latency summary, and publishes rt<ns>/set_pose. UDPv4 on
+// 127.0.0.1 only, unicast discovery to the well-known ports of participants 0..9, no shared
+// memory: nothing leaves the machine.
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include <cmath>
+#include <memory>
+#include <thread>
+
+#include "peer_common.hpp"
+#include "ros2_msgs.h"
+#include "ros2_msgsPubSubTypes.h"
+
+using namespace eprosima::fastdds::dds;
+using eprosima::fastdds::rtps::UDPv4TransportDescriptor;
+using eprosima::fastrtps::rtps::IPLocator;
+using eprosima::fastrtps::rtps::Locator_t;
+
+namespace {
+
+DomainParticipantQos loopback_qos(int domain) {
+  DomainParticipantQos q;
+  q.transport().use_builtin_transports = false;
+  auto udp = std::make_shared<UDPv4TransportDescriptor>();
+  udp->interfaceWhiteList.emplace_back("127.0.0.1");
+  q.transport().user_transports.push_back(udp);
+  for (int pid = 0; pid < 10; ++pid) {
+    Locator_t l;
+    IPLocator::setIPv4(l, 127, 0, 0, 1);
+    l.port = static_cast<uint32_t>(7400 + 250 * domain + 10 + 2 * pid);  // RTPS metatraffic unicast
+    q.wire_protocol().builtin.initialPeersList.push_back(l);
+  }
+  return q;
+}
+
+std::string odom_line(const nav_msgs::msg::dds_::Odometry_& o, std::int64_t recv) {
+  char b[160];
+  std::snprintf(b, sizeof b, "odom %d %u %" PRId64 " %s %s", o.header().stamp().sec(),
+                o.header().stamp().nanosec(), recv, o.header().frame_id().c_str(),
+                o.child_frame_id().c_str());
+  std::string s = b;
+  const auto& p = o.pose().pose();
+  const double pose[] = {p.position().x(),    p.position().y(),    p.position().z(),
+                         p.orientation().x(), p.orientation().y(), p.orientation().z(),
+                         p.orientation().w()};
+  peer::print_doubles(s, pose, 7);
+  peer::print_doubles(s, o.pose().covariance().data(), 36);
+  const auto& t = o.twist().twist();
+  const double tw[] = {t.linear().x(),  t.linear().y(),  t.linear().z(),
+                       t.angular().x(), t.angular().y(), t.angular().z()};
+  peer::print_doubles(s, tw, 6);
+  peer::print_doubles(s, o.twist().covariance().data(), 36);
+  return s;
+}
+
+std::string tf_line(const tf2_msgs::msg::dds_::TFMessage_& m, std::int64_t recv) {
+  std::string s;
+  for (const auto& t : m.transforms()) {
+    char b[160];
+    std::snprintf(b, sizeof b, "tf %d %u %" PRId64 " %s %s", t.header().stamp().sec(),
+                  t.header().stamp().nanosec(), recv, t.header().frame_id().c_str(),
+                  t.child_frame_id().c_str());
+    s += b;
+    const auto& x = t.transform();
+    const double v[] = {x.translation().x(), x.translation().y(), x.translation().z(),
+                        x.rotation().x(),    x.rotation().y(),    x.rotation().z(),
+                        x.rotation().w()};
+    peer::print_doubles(s, v, 7);
+  }
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  peer::Args a;
+  if (!peer::parse(argc, argv, a)) return peer::usage(argv[0]);
+  auto* factory = DomainParticipantFactory::get_instance();
+  DomainParticipant* dp = factory->create_participant(a.domain, loopback_qos(a.domain));
+  if (!dp) return std::fprintf(stderr, "fastdds_peer: no participant\n"), 1;
+  TypeSupport odom_t(new nav_msgs::msg::dds_::Odometry_PubSubType());
+  TypeSupport tf_t(new tf2_msgs::msg::dds_::TFMessage_PubSubType());
+  TypeSupport sp_t(new geometry_msgs::msg::dds_::PoseWithCovarianceStamped_PubSubType());
+  odom_t.register_type(dp);
+  tf_t.register_type(dp);
+  sp_t.register_type(dp);
+  Topic* odom_topic =
+      dp->create_topic("rt" + a.ns + "/odom", odom_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  Topic* tf_topic = dp->create_topic("rt/tf", tf_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  Topic* sp_topic =
+      dp->create_topic("rt" + a.ns + "/set_pose", sp_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  // ROS 2 default QoS: reliable, volatile, keep last 10.
+  DataReaderQos rq = DATAREADER_QOS_DEFAULT;
+  rq.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  rq.durability().kind = VOLATILE_DURABILITY_QOS;
+  rq.history().kind = KEEP_LAST_HISTORY_QOS;
+  rq.history().depth = 10;
+  DataWriterQos wq = DATAWRITER_QOS_DEFAULT;
+  wq.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  wq.durability().kind = VOLATILE_DURABILITY_QOS;
+  wq.history().kind = KEEP_LAST_HISTORY_QOS;
+  wq.history().depth = 10;
+  Subscriber* sub = dp->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+  Publisher* pub = dp->create_publisher(PUBLISHER_QOS_DEFAULT);
+  DataReader* odom_r = sub->create_datareader(odom_topic, rq);
+  DataReader* tf_r = sub->create_datareader(tf_topic, rq);
+  DataWriter* sp_w = pub->create_datawriter(sp_topic, wq);
+  if (!odom_r || !tf_r || !sp_w) return std::fprintf(stderr, "fastdds_peer: no endpoints\n"), 1;
+
+  geometry_msgs::msg::dds_::PoseWithCovarianceStamped_ sp;
+  sp.header().frame_id("odom");
+  sp.pose().pose().position().x(a.sp_x);
+  sp.pose().pose().position().y(a.sp_y);
+  sp.pose().pose().orientation().z(std::sin(a.sp_yaw / 2));
+  sp.pose().pose().orientation().w(std::cos(a.sp_yaw / 2));
+  for (int i : {0, 7, 35}) sp.pose().covariance()[i] = a.sp_var;
+
+  peer::Latency lat;
+  lat.skip = a.skip;
+  int n_odom = 0, n_tf = 0;
+  const double end = peer::monotonic_s() + a.timeout_s;
+  double next_sp = 0;
+  nav_msgs::msg::dds_::Odometry_ odom;
+  tf2_msgs::msg::dds_::TFMessage_ tf;
+  SampleInfo info;
+  while ((n_odom < a.odom || n_tf < a.tf) && peer::monotonic_s() < end) {
+    odom_r->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 20000000));
+    while (odom_r->take_next_sample(&odom, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      const std::int64_t recv = peer::realtime_ns();
+      ++n_odom;
+      lat.add(odom.header().stamp().sec(), odom.header().stamp().nanosec(), recv);
+      if (!a.quiet) std::printf("%s\n", odom_line(odom, recv).c_str());
+    }
+    while (tf_r->take_next_sample(&tf, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      ++n_tf;
+      if (!a.quiet) std::printf("%s\n", tf_line(tf, peer::realtime_ns()).c_str());
+    }
+    // set_pose again every 0.2 s while running: the first may go out before discovery matched.
+    if (a.set_pose && peer::monotonic_s() >= next_sp) {
+      sp_w->write(&sp);
+      next_sp = peer::monotonic_s() + 0.2;
+    }
+    std::fflush(stdout);
+  }
+  if (a.quiet) lat.print_summary(n_odom + n_tf);
+  std::printf("done odom=%d tf=%d\n", n_odom, n_tf);
+  dp->delete_contained_entities();
+  factory->delete_participant(dp);
+  return (n_odom >= a.odom && n_tf >= a.tf) ? 0 : 3;
+}
