@@ -30,6 +30,10 @@ dds_qos_t* ros_default_qos() {
   return q;
 }
 
+// Delay from a loop tick's sample time to the publish of its snapshot: the loop publishes the
+// snapshot at the end of the tick (tens of microseconds after the sample).
+constexpr chr::microseconds kPublishDelay{200};
+
 TimeNs now_ns(clockid_t id) {
   timespec ts{};
   clock_gettime(id, &ts);
@@ -91,6 +95,7 @@ struct Bridge::Impl {
   TimeNs last_sample = INT64_MIN;
   std::atomic<std::uint64_t> odom_published{0}, tf_published{0}, unchanged_skipped{0},
       write_errors{0}, set_pose_received{0}, set_pose_rejected{0};
+  std::atomic<std::int64_t> write_age_sum_ns{0}, write_age_max_ns{0};
 
   ~Impl() {
     // Deleting the domain (or the participant) deletes everything created under it.
@@ -101,7 +106,8 @@ struct Bridge::Impl {
     }
   }
   Status open();
-  void publish_once();
+  enum class Published : std::uint8_t { kYes, kUnchanged, kNoSample };
+  Published publish_once();
   void take_set_pose();
   void run();
 };
@@ -145,19 +151,19 @@ Status Bridge::Impl::open() {
   return Ok{};
 }
 
-void Bridge::Impl::publish_once() {
+Bridge::Impl::Published Bridge::Impl::publish_once() {
   OdomSample s;
-  if (!source(s)) return;
+  if (!source(s)) return Published::kNoSample;
   if (s.sample_time == last_sample) {
     unchanged_skipped.fetch_add(1, std::memory_order_relaxed);
-    return;
+    return Published::kUnchanged;
   }
   last_sample = s.sample_time;
   // The offset is read at every publish, so a wall-clock step shows in the next stamp.
   auto f = odometry_fields(s, realtime_minus_monotonic());
   if (!f) {
     write_errors.fetch_add(1, std::memory_order_relaxed);
-    return;
+    return Published::kYes;
   }
   put_stamp(odom.header.stamp, f->stamp);
   odom.pose.pose.position = {f->x, f->y, f->z};
@@ -171,8 +177,14 @@ void Bridge::Impl::publish_once() {
     write_errors.fetch_add(1, std::memory_order_relaxed);
   } else {
     odom_published.fetch_add(1, std::memory_order_relaxed);
+    const TimeNs age = now_ns(CLOCK_MONOTONIC) - s.sample_time;
+    write_age_sum_ns.fetch_add(age, std::memory_order_relaxed);
+    // Only this thread writes the maximum: load and store suffice.
+    if (age > write_age_max_ns.load(std::memory_order_relaxed)) {
+      write_age_max_ns.store(age, std::memory_order_relaxed);
+    }
   }
-  if (!cfg.publish_tf) return;
+  if (!cfg.publish_tf) return Published::kYes;
   transform.header.stamp = odom.header.stamp;
   transform.transform.translation = {f->x, f->y, 0.0};
   transform.transform.rotation = odom.pose.pose.orientation;
@@ -181,6 +193,7 @@ void Bridge::Impl::publish_once() {
   } else {
     tf_published.fetch_add(1, std::memory_order_relaxed);
   }
+  return Published::kYes;
 }
 
 void Bridge::Impl::take_set_pose() {
@@ -215,19 +228,26 @@ void Bridge::Impl::take_set_pose() {
 }
 
 void Bridge::Impl::run() {
+  // steady_clock is CLOCK_MONOTONIC on Linux (libstdc++), the clock of the sample times.
   const auto period =
       chr::duration_cast<chr::steady_clock::duration>(chr::duration<double>(1.0 / cfg.rate_hz));
-  auto next = chr::steady_clock::now();
+  const auto retry = std::max<chr::steady_clock::duration>(kPublishDelay, period / 8);
   std::unique_lock lock(m);
   while (!stopping) {
     lock.unlock();
     take_set_pose();
-    publish_once();
+    const Published p = publish_once();
     lock.lock();
-    next += period;
-    // After a stall (a blocked write), skip the missed ticks instead of publishing in a burst.
     const auto now = chr::steady_clock::now();
-    if (next < now) next = now + period - (now - next) % period;
+    auto next = now + retry;  // no new sample yet: look again soon
+    if (p == Published::kYes) {
+      // Phase-locked to the loop: wake kPublishDelay after the tick one period after the sample
+      // just published, so a sample waits ~kPublishDelay, not up to a loop period, to go out.
+      // Sample times on another clock (replay, a virtual clock) fall back to a free-running
+      // period; so does a wake-up already missed (a stalled write skips ticks, never bursts).
+      next = chr::steady_clock::time_point(chr::nanoseconds(last_sample)) + period + kPublishDelay;
+      if (next <= now || next > now + 2 * period) next = now + period;
+    }
     cv.wait_until(lock, next, [this] { return stopping; });
   }
 }
@@ -273,8 +293,11 @@ void Bridge::stop() {
 BridgeStats Bridge::stats() const {
   const auto& i = *impl_;
   auto r = [](const std::atomic<std::uint64_t>& a) { return a.load(std::memory_order_relaxed); };
-  return BridgeStats{r(i.odom_published), r(i.tf_published),      r(i.unchanged_skipped),
-                     r(i.write_errors),   r(i.set_pose_received), r(i.set_pose_rejected)};
+  BridgeStats st{r(i.odom_published), r(i.tf_published),      r(i.unchanged_skipped),
+                 r(i.write_errors),   r(i.set_pose_received), r(i.set_pose_rejected)};
+  st.write_age_sum_ns = i.write_age_sum_ns.load(std::memory_order_relaxed);
+  st.write_age_max_ns = i.write_age_max_ns.load(std::memory_order_relaxed);
+  return st;
 }
 
 }  // namespace odo::ros2

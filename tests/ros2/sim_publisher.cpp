@@ -46,6 +46,10 @@ int main(int argc, char** argv) {
   getrusage(RUSAGE_SELF, &ru);
   const double cpu_us = 1e6 * static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
                         static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  const double n = static_cast<double>(std::max<std::uint64_t>(1, st.odom_published));
+  std::printf("write age (sample -> dds_write returned): mean_us=%.1f max_us=%.1f\n",
+              static_cast<double>(st.write_age_sum_ns) / n / 1e3,
+              static_cast<double>(st.write_age_max_ns) / 1e3);
   std::printf(
       "published odom=%llu tf=%llu errors=%llu cpu_us_per_msg=%.1f (whole process, sim loop "
       "included)\n",

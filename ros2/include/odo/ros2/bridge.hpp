@@ -30,6 +30,10 @@ struct BridgeStats {
   std::uint64_t write_errors = 0;       // dds_write failures (and stamps out of range)
   std::uint64_t set_pose_received = 0;  // valid set_pose handed to the sink
   std::uint64_t set_pose_rejected = 0;  // set_pose with a wrong frame or invalid values
+  // Age of the samples when their rt/odom write returned (monotonic now - sample time) [ns]:
+  // the bridge's share of the sample-to-receipt latency.
+  std::int64_t write_age_sum_ns = 0;
+  std::int64_t write_age_max_ns = 0;
 };
 
 class Bridge {
