@@ -55,9 +55,9 @@ inline constexpr int kIx = 0, kIy = 1, kIz = 2, kIroll = 3, kIpitch = 4, kIyaw =
 // Variance given to the dimensions wheel odometry does not observe: pose z, roll, pitch and
 // twist vz, roll rate, pitch rate [m^2, rad^2, (m/s)^2, (rad/s)^2]. Large, not 0: the encoders
 // carry no information on them (ramps, bumps, a tilting chassis), so a receiver that fuses them
-// must not be pinned to 0 with false confidence; 1e6 is the value diff_drive_controller's example
-// configurations give these dimensions, and robot_localization (two_d_mode, or *_config false)
-// ignores them anyway. Their cross terms are 0.
+// must not be pinned to 0 with false confidence; 1e6 is the value diff_drive_controller
+// configurations commonly give these dimensions, and robot_localization (two_d_mode, or
+// *_config false) ignores them anyway. Their cross terms are 0.
 inline constexpr double kUnobservedVariance = 1e6;
 
 // Variance of the lateral speed vy [(m/s)^2]. vy = 0 is the differential drive's non-holonomic
