@@ -129,8 +129,20 @@ int main(int argc, char** argv) {
     }
     std::fflush(stdout);
   }
+  // The writes above may all have gone out before the bridge's reader matched: once matched,
+  // write once more and wait until the bridge's reader has acknowledged it.
+  bool acked = !a.set_pose;
+  if (a.set_pose) {
+    dds_publication_matched_status_t st{};
+    while (dds_get_publication_matched_status(sp_w, &st) == DDS_RETCODE_OK &&
+           st.current_count == 0 && peer::monotonic_s() < end) {
+      dds_sleepfor(DDS_MSECS(10));
+    }
+    acked = st.current_count > 0 && dds_write(sp_w, &sp) == DDS_RETCODE_OK &&
+            dds_wait_for_acks(sp_w, DDS_SECS(5)) == DDS_RETCODE_OK;
+  }
   if (a.quiet) lat.print_summary(n_odom + n_tf);
-  std::printf("done odom=%d tf=%d\n", n_odom, n_tf);
+  std::printf("done odom=%d tf=%d set_pose_acked=%d\n", n_odom, n_tf, acked ? 1 : 0);
   dds_delete(dp);
-  return (n_odom >= a.odom && n_tf >= a.tf) ? 0 : 3;
+  return (n_odom >= a.odom && n_tf >= a.tf && acked) ? 0 : 3;
 }

@@ -14,6 +14,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <thread>
@@ -155,9 +156,22 @@ int main(int argc, char** argv) {
     }
     std::fflush(stdout);
   }
+  // The writes above may all have gone out before the bridge's reader matched: once matched,
+  // write once more and wait until the bridge's reader has acknowledged it.
+  bool acked = !a.set_pose;
+  if (a.set_pose) {
+    PublicationMatchedStatus st;
+    while (sp_w->get_publication_matched_status(st) == ReturnCode_t::RETCODE_OK &&
+           st.current_count == 0 && peer::monotonic_s() < end) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    acked = st.current_count > 0 && sp_w->write(&sp) &&
+            sp_w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0)) ==
+                ReturnCode_t::RETCODE_OK;
+  }
   if (a.quiet) lat.print_summary(n_odom + n_tf);
-  std::printf("done odom=%d tf=%d\n", n_odom, n_tf);
+  std::printf("done odom=%d tf=%d set_pose_acked=%d\n", n_odom, n_tf, acked ? 1 : 0);
   dp->delete_contained_entities();
   factory->delete_participant(dp);
-  return (n_odom >= a.odom && n_tf >= a.tf) ? 0 : 3;
+  return (n_odom >= a.odom && n_tf >= a.tf && acked) ? 0 : 3;
 }

@@ -6,12 +6,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "odo/ros2/bridge.hpp"
@@ -86,6 +88,11 @@ class Ros2Loopback : public ::testing::Test {
                       " --set-pose 1.5 -2.5 0.7 0.01 --timeout 30";
     if (!ns.empty()) cmd += " --ns " + ns;
     run_ = run_peer(cmd);
+    // The peer exits once the bridge's reader acknowledged its set_pose; the bridge takes it at
+    // its next tick (10 ms): give it up to 2 s before stopping.
+    for (int i = 0; i < 200 && (*b)->stats().set_pose_received == 0; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
     (*b)->stop();
     loop.stop();
     stats_ = (*b)->stats();
@@ -201,7 +208,8 @@ TEST_F(Ros2Loopback, CyclonePeerDecodesOdomAndTfAndSendsSetPose) {
          "<ParticipantIndex>auto</ParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers>"
          "</Discovery></Domain></CycloneDDS>",
          1);
-  run(ODO_CYCLONE_PEER, "", test_domain(1));
+  const std::string emulator = ODO_PEER_EMULATOR;
+  run(emulator.empty() ? ODO_CYCLONE_PEER : emulator + " " + ODO_CYCLONE_PEER, "", test_domain(1));
   check_all();
 }
 
