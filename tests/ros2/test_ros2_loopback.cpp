@@ -213,5 +213,43 @@ TEST_F(Ros2Loopback, CyclonePeerDecodesOdomAndTfAndSendsSetPose) {
   check_all();
 }
 
+TEST(Ros2Bridge, PublishesEachSampleOnceAndStopsWithoutWaitingForItsPeriod) {
+  // A source that always returns the same sample, stamped 1 ns (not a CLOCK_MONOTONIC phase
+  // the bridge could lock to): one write of odom and tf, then the free-running fallback waits a
+  // whole period (rate 0.5 Hz: 2 s) before it reads again, and stop() must not wait for it.
+  Config c;
+  c.domain_id = static_cast<std::uint32_t>(test_domain(2));
+  c.rate_hz = 0.5;
+  c.interfaces = {"lo"};
+  c.multicast = false;
+  c.peers = {"127.0.0.1"};
+  int calls = 0;
+  auto b = Bridge::create(
+      c, 1000,
+      [&](OdomSample& s) {
+        ++calls;
+        s = sample_k(3, 1);
+        return true;
+      },
+      nullptr);
+  ASSERT_TRUE(b.ok()) << b.error().message;
+  ASSERT_TRUE((*b)->start().ok());
+  EXPECT_FALSE((*b)->start().ok());  // already running
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  const auto t0 = std::chrono::steady_clock::now();
+  (*b)->stop();
+  const auto stop_ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - t0)
+          .count();
+  EXPECT_LT(stop_ms, 200);
+  const BridgeStats st = (*b)->stats();
+  EXPECT_EQ(st.odom_published, 1u);
+  EXPECT_EQ(st.tf_published, 1u);
+  // Read once at t = 0; the next read would have been at t = 2 s.
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(st.unchanged_skipped, 0u);
+  (*b)->stop();  // idempotent
+}
+
 }  // namespace
 }  // namespace odo::ros2

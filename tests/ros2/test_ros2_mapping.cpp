@@ -16,6 +16,17 @@ double at(const Cov6& c, int row, int col) {
   return c[row * 6 + col];
 }
 
+// expect_unobserved: z (14), roll (21) and pitch (28) carry kUnobservedVariance, and m has
+// exactly `nonzero` non-zero entries (nothing placed where it should not be).
+void expect_unobserved(const Cov6& m, int nonzero) {
+  EXPECT_EQ(m[14], kUnobservedVariance);
+  EXPECT_EQ(m[21], kUnobservedVariance);
+  EXPECT_EQ(m[28], kUnobservedVariance);
+  int n = 0;
+  for (double v : m) n += v != 0.0;
+  EXPECT_EQ(n, nonzero);
+}
+
 TEST(Ros2Mapping, PoseCovarianceLayoutFollowsGeometryMsgs) {
   // Distinct entries so that a transposed or shifted placement shows: our 3x3 over (x, y, theta)
   // = [[11 12 13] [21 22 23] [31 32 33]] (not symmetric on purpose, to see row vs column).
@@ -37,13 +48,8 @@ TEST(Ros2Mapping, PoseCovarianceLayoutFollowsGeometryMsgs) {
   EXPECT_EQ(m[35], 33);
   EXPECT_EQ(m[5], 13);
   EXPECT_EQ(m[30], 31);
-  // z (14), roll (21) and pitch (28) are unobserved: large variance, no correlation.
-  EXPECT_EQ(m[14], kUnobservedVariance);
-  EXPECT_EQ(m[21], kUnobservedVariance);
-  EXPECT_EQ(m[28], kUnobservedVariance);
-  int nonzero = 0;
-  for (double v : m) nonzero += v != 0.0;
-  EXPECT_EQ(nonzero, 9 + 3);
+  // z, roll and pitch are unobserved: large variance, no correlation.
+  expect_unobserved(m, 9 + 3);
 }
 
 TEST(Ros2Mapping, TwistCovarianceLayout) {
@@ -54,12 +60,7 @@ TEST(Ros2Mapping, TwistCovarianceLayout) {
   EXPECT_EQ(m[30], 3.5);                   // wz vx
   EXPECT_EQ(m[35], 4.5);                   // wz wz
   EXPECT_EQ(m[7], kLateralSpeedVariance);  // vy: the non-holonomic constraint, small
-  EXPECT_EQ(m[14], kUnobservedVariance);
-  EXPECT_EQ(m[21], kUnobservedVariance);
-  EXPECT_EQ(m[28], kUnobservedVariance);
-  int nonzero = 0;
-  for (double v : m) nonzero += v != 0.0;
-  EXPECT_EQ(nonzero, 4 + 4);
+  expect_unobserved(m, 4 + 4);
 }
 
 TEST(Ros2Mapping, TwistCovarianceFromWheels) {
