@@ -190,15 +190,24 @@ int test_domain(int offset) {
   return 100 + (static_cast<int>(getpid()) * 2 + offset) % 120;
 }
 
+// Native builds only (tests/ros2/CMakeLists.txt: Fast DDS under qemu-user received nothing).
+#if ODO_FASTDDS_INTEROP
 TEST_F(Ros2Loopback, FastDdsPeerDecodesOdomAndTfAndSendsSetPose) {
   const std::string peer = ODO_FASTDDS_PEER;
   if (peer.empty()) {
     GTEST_SKIP() << "Fast DDS peer not built: libfastrtps-dev and fastddsgen (tools/setup.sh "
-                    "--tests) are needed for the build's target";
+                    "--tests) are needed";
   }
-  run(peer, "/robot7", test_domain(0));
+  // Debian's libfastrtps 2.9 deletes its StatisticsReaderImpl (64 bytes) as an RTPSReader (56)
+  // when the participant is torn down: ASan builds report new-delete-type-mismatch inside the
+  // library at the peer's exit. That one check is off for the peer process only.
+  const char* asan = std::getenv("ASAN_OPTIONS");
+  const std::string env = std::string("ASAN_OPTIONS=") + (asan ? asan : "") +
+                          (asan && *asan ? ":" : "") + "new_delete_type_mismatch=0 ";
+  run(env + peer, "/robot7", test_domain(0));
   check_all();
 }
+#endif
 
 TEST_F(Ros2Loopback, CyclonePeerDecodesOdomAndTfAndSendsSetPose) {
   // The peer takes its network set-up from CYCLONEDDS_URI: loopback, unicast discovery.
