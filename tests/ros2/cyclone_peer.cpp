@@ -7,6 +7,7 @@
 
 #include "peer_common.hpp"
 #include "ros2_msgs.h"
+#include "tsan_suppressions.hpp"
 
 namespace {
 

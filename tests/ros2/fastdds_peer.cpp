@@ -22,6 +22,7 @@
 #include "peer_common.hpp"
 #include "ros2_msgs.h"
 #include "ros2_msgsPubSubTypes.h"
+#include "tsan_suppressions.hpp"
 
 using namespace eprosima::fastdds::dds;
 using eprosima::fastdds::rtps::UDPv4TransportDescriptor;
