@@ -83,43 +83,88 @@ std::string tf_line(const tf2_msgs::msg::dds_::TFMessage_& m, std::int64_t recv)
   return s;
 }
 
+// ros_default: ROS 2's default QoS (reliable, volatile, keep last 10) on a reader or writer QoS.
+template <class Q>
+Q ros_default(Q q) {
+  q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  q.durability().kind = VOLATILE_DURABILITY_QOS;
+  q.history().kind = KEEP_LAST_HISTORY_QOS;
+  q.history().depth = 10;
+  return q;
+}
+
+struct Endpoints {
+  DomainParticipant* dp = nullptr;
+  TypeSupport odom_t{new nav_msgs::msg::dds_::Odometry_PubSubType()};
+  TypeSupport tf_t{new tf2_msgs::msg::dds_::TFMessage_PubSubType()};
+  TypeSupport sp_t{new geometry_msgs::msg::dds_::PoseWithCovarianceStamped_PubSubType()};
+  DataReader* odom_r = nullptr;
+  DataReader* tf_r = nullptr;
+  DataWriter* sp_w = nullptr;
+};
+
+// open: loopback participant, the two readers and the set_pose writer; false (message printed)
+// on failure.
+bool open(const peer::Args& a, Endpoints& e) {
+  e.dp = DomainParticipantFactory::get_instance()->create_participant(a.domain,
+                                                                      loopback_qos(a.domain));
+  if (!e.dp) return std::fprintf(stderr, "fastdds_peer: no participant\n"), false;
+  e.odom_t.register_type(e.dp);
+  e.tf_t.register_type(e.dp);
+  e.sp_t.register_type(e.dp);
+  Topic* odom_topic =
+      e.dp->create_topic("rt" + a.ns + "/odom", e.odom_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  Topic* tf_topic = e.dp->create_topic("rt/tf", e.tf_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  Topic* sp_topic =
+      e.dp->create_topic("rt" + a.ns + "/set_pose", e.sp_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  Subscriber* sub = e.dp->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+  Publisher* pub = e.dp->create_publisher(PUBLISHER_QOS_DEFAULT);
+  const DataReaderQos rq = ros_default(DATAREADER_QOS_DEFAULT);
+  e.odom_r = sub->create_datareader(odom_topic, rq);
+  e.tf_r = sub->create_datareader(tf_topic, rq);
+  e.sp_w = pub->create_datawriter(sp_topic, ros_default(DATAWRITER_QOS_DEFAULT));
+  if (!e.odom_r || !e.tf_r || !e.sp_w) {
+    return std::fprintf(stderr, "fastdds_peer: no endpoints\n"), false;
+  }
+  return true;
+}
+
+// take_all: takes every sample of r, calling f(sample, receipt time) for valid ones; returns
+// how many.
+template <class T, class F>
+int take_all(DataReader* r, F f) {
+  T sample;
+  SampleInfo info;
+  int count = 0;
+  while (r->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+    if (!info.valid_data) continue;
+    ++count;
+    f(sample, peer::realtime_ns());
+  }
+  return count;
+}
+
+// ack_set_pose: the writes during the run may all have gone out before the bridge's reader
+// matched: once matched, write once more and wait until the bridge's reader acknowledged it.
+bool ack_set_pose(const Endpoints& e, geometry_msgs::msg::dds_::PoseWithCovarianceStamped_& sp,
+                  double end) {
+  PublicationMatchedStatus st;
+  while (e.sp_w->get_publication_matched_status(st) == ReturnCode_t::RETCODE_OK &&
+         st.current_count == 0 && peer::monotonic_s() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return st.current_count > 0 && e.sp_w->write(&sp) &&
+         e.sp_w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0)) ==
+             ReturnCode_t::RETCODE_OK;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   peer::Args a;
   if (!peer::parse(argc, argv, a)) return peer::usage(argv[0]);
-  auto* factory = DomainParticipantFactory::get_instance();
-  DomainParticipant* dp = factory->create_participant(a.domain, loopback_qos(a.domain));
-  if (!dp) return std::fprintf(stderr, "fastdds_peer: no participant\n"), 1;
-  TypeSupport odom_t(new nav_msgs::msg::dds_::Odometry_PubSubType());
-  TypeSupport tf_t(new tf2_msgs::msg::dds_::TFMessage_PubSubType());
-  TypeSupport sp_t(new geometry_msgs::msg::dds_::PoseWithCovarianceStamped_PubSubType());
-  odom_t.register_type(dp);
-  tf_t.register_type(dp);
-  sp_t.register_type(dp);
-  Topic* odom_topic =
-      dp->create_topic("rt" + a.ns + "/odom", odom_t.get_type_name(), TOPIC_QOS_DEFAULT);
-  Topic* tf_topic = dp->create_topic("rt/tf", tf_t.get_type_name(), TOPIC_QOS_DEFAULT);
-  Topic* sp_topic =
-      dp->create_topic("rt" + a.ns + "/set_pose", sp_t.get_type_name(), TOPIC_QOS_DEFAULT);
-  // ROS 2 default QoS: reliable, volatile, keep last 10.
-  DataReaderQos rq = DATAREADER_QOS_DEFAULT;
-  rq.reliability().kind = RELIABLE_RELIABILITY_QOS;
-  rq.durability().kind = VOLATILE_DURABILITY_QOS;
-  rq.history().kind = KEEP_LAST_HISTORY_QOS;
-  rq.history().depth = 10;
-  DataWriterQos wq = DATAWRITER_QOS_DEFAULT;
-  wq.reliability().kind = RELIABLE_RELIABILITY_QOS;
-  wq.durability().kind = VOLATILE_DURABILITY_QOS;
-  wq.history().kind = KEEP_LAST_HISTORY_QOS;
-  wq.history().depth = 10;
-  Subscriber* sub = dp->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
-  Publisher* pub = dp->create_publisher(PUBLISHER_QOS_DEFAULT);
-  DataReader* odom_r = sub->create_datareader(odom_topic, rq);
-  DataReader* tf_r = sub->create_datareader(tf_topic, rq);
-  DataWriter* sp_w = pub->create_datawriter(sp_topic, wq);
-  if (!odom_r || !tf_r || !sp_w) return std::fprintf(stderr, "fastdds_peer: no endpoints\n"), 1;
-
+  Endpoints e;
+  if (!open(a, e)) return 1;
   geometry_msgs::msg::dds_::PoseWithCovarianceStamped_ sp;
   sp.header().frame_id("odom");
   sp.pose().pose().position().x(a.sp_x);
@@ -133,46 +178,26 @@ int main(int argc, char** argv) {
   int n_odom = 0, n_tf = 0;
   const double end = peer::monotonic_s() + a.timeout_s;
   double next_sp = 0;
-  nav_msgs::msg::dds_::Odometry_ odom;
-  tf2_msgs::msg::dds_::TFMessage_ tf;
-  SampleInfo info;
   while ((n_odom < a.odom || n_tf < a.tf) && peer::monotonic_s() < end) {
-    odom_r->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 20000000));
-    while (odom_r->take_next_sample(&odom, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
-      const std::int64_t recv = peer::realtime_ns();
-      ++n_odom;
-      lat.add(odom.header().stamp().sec(), odom.header().stamp().nanosec(), recv);
-      if (!a.quiet) std::printf("%s\n", odom_line(odom, recv).c_str());
-    }
-    while (tf_r->take_next_sample(&tf, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
-      ++n_tf;
-      if (!a.quiet) std::printf("%s\n", tf_line(tf, peer::realtime_ns()).c_str());
-    }
+    e.odom_r->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 20000000));
+    n_odom += take_all<nav_msgs::msg::dds_::Odometry_>(e.odom_r, [&](const auto& o, auto recv) {
+      lat.add(o.header().stamp().sec(), o.header().stamp().nanosec(), recv);
+      if (!a.quiet) std::printf("%s\n", odom_line(o, recv).c_str());
+    });
+    n_tf += take_all<tf2_msgs::msg::dds_::TFMessage_>(e.tf_r, [&](const auto& m, auto recv) {
+      if (!a.quiet) std::printf("%s\n", tf_line(m, recv).c_str());
+    });
     // set_pose again every 0.2 s while running: the first may go out before discovery matched.
     if (a.set_pose && peer::monotonic_s() >= next_sp) {
-      sp_w->write(&sp);
+      e.sp_w->write(&sp);
       next_sp = peer::monotonic_s() + 0.2;
     }
     std::fflush(stdout);
   }
-  // The writes above may all have gone out before the bridge's reader matched: once matched,
-  // write once more and wait until the bridge's reader has acknowledged it.
-  bool acked = !a.set_pose;
-  if (a.set_pose) {
-    PublicationMatchedStatus st;
-    while (sp_w->get_publication_matched_status(st) == ReturnCode_t::RETCODE_OK &&
-           st.current_count == 0 && peer::monotonic_s() < end) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    acked = st.current_count > 0 && sp_w->write(&sp) &&
-            sp_w->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0)) ==
-                ReturnCode_t::RETCODE_OK;
-  }
+  const bool acked = !a.set_pose || ack_set_pose(e, sp, end);
   if (a.quiet) lat.print_summary(n_odom + n_tf);
   std::printf("done odom=%d tf=%d set_pose_acked=%d\n", n_odom, n_tf, acked ? 1 : 0);
-  dp->delete_contained_entities();
-  factory->delete_participant(dp);
+  e.dp->delete_contained_entities();
+  DomainParticipantFactory::get_instance()->delete_participant(e.dp);
   return (n_odom >= a.odom && n_tf >= a.tf && acked) ? 0 : 3;
 }
