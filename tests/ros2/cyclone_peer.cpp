@@ -155,8 +155,7 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   }
   const bool acked = !a.set_pose || ack_set_pose(e, &sp, end);
-  if (a.quiet) lat.print_summary(n_odom + n_tf);
-  std::printf("done odom=%d tf=%d set_pose_acked=%d\n", n_odom, n_tf, acked ? 1 : 0);
+  const int status = peer::finish(a, lat, n_odom, n_tf, acked);
   dds_delete(e.dp);
-  return (n_odom >= a.odom && n_tf >= a.tf && acked) ? 0 : 3;
+  return status;
 }

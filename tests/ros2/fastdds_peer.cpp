@@ -195,9 +195,8 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   }
   const bool acked = !a.set_pose || ack_set_pose(e, sp, end);
-  if (a.quiet) lat.print_summary(n_odom + n_tf);
-  std::printf("done odom=%d tf=%d set_pose_acked=%d\n", n_odom, n_tf, acked ? 1 : 0);
+  const int status = peer::finish(a, lat, n_odom, n_tf, acked);
   e.dp->delete_contained_entities();
   DomainParticipantFactory::get_instance()->delete_participant(e.dp);
-  return (n_odom >= a.odom && n_tf >= a.tf && acked) ? 0 : 3;
+  return status;
 }

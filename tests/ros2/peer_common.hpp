@@ -115,4 +115,12 @@ struct Latency {
   }
 };
 
+// finish: the closing lines (latency summary with --quiet, then "done ..."); returns the exit
+// status: 0 when every expected message arrived and the set_pose (if any) was acknowledged.
+inline int finish(const Args& a, Latency& lat, int n_odom, int n_tf, bool acked) {
+  if (a.quiet) lat.print_summary(n_odom + n_tf);
+  std::printf("done odom=%d tf=%d set_pose_acked=%d\n", n_odom, n_tf, acked ? 1 : 0);
+  return (n_odom >= a.odom && n_tf >= a.tf && acked) ? 0 : 3;
+}
+
 }  // namespace peer
