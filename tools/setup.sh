@@ -9,11 +9,13 @@
 set -euo pipefail
 
 build_pkgs=(g++ cmake make pkg-config python3 libeigen3-dev libgpiod-dev libtomlplusplus-dev
-  libcli11-dev nlohmann-json3-dev)
+  libcli11-dev nlohmann-json3-dev
+  cyclonedds-dev cyclonedds-tools)  # ROS 2 output (ros2/, -DODO_ROS2=OFF without): idlc, libddsc
 test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind
   can-utils python3-can iproute2  # CAN kernel tests in the VM (candump, cansend, ip, tc)
   rt-tests stress-ng systemd  # cyclictest + load for tools/jitter.sh; systemd-analyze verify
-  clang-14 libclang-rt-14-dev libfuzzer-14-dev)  # fuzz preset: clang-14 + libFuzzer (TESTING.md)
+  clang-14 libclang-rt-14-dev libfuzzer-14-dev  # fuzz preset: clang-14 + libFuzzer (TESTING.md)
+  libfastrtps-dev fastddsgen)  # the independent Fast DDS peer of the ROS 2 tests (fastddsgen: Java)
 # Cross builds (toolchains/, presets cross-aarch64 and cross-armhf) and the package checks
 # (tests/package/: check_deb.sh uses dpkg-shlibdeps, file, systemd-analyze; fresh_install.sh
 # uses debootstrap).
@@ -22,7 +24,11 @@ cross_pkgs=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user dpkg-dev fil
 cross_archs=(arm64 armhf)
 # Target libraries linked into the binaries or tests (Multi-Arch: same; one per architecture).
 # Eigen, CLI11 and nlohmann-json are Architecture: all headers: the native package serves all.
-cross_arch_pkgs=(libgpiod-dev libtomlplusplus-dev libgtest-dev libgmock-dev)
+# cyclonedds-dev:<arch> needs libssl3:<arch> of exactly the native libssl3's version: a native
+# libssl3 from bookworm-security with no security list for the foreign architecture makes apt
+# refuse ("held broken packages"); `apt-get install libssl3=V libssl3:arm64=V libssl3:armhf=V`
+# with a version all three lists have (3.0.20-1~deb12u2 on bookworm 12.15) resolves it.
+cross_arch_pkgs=(libgpiod-dev libtomlplusplus-dev libgtest-dev libgmock-dev cyclonedds-dev)
 
 want=("${build_pkgs[@]}")
 add_archs=()
