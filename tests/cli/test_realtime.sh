@@ -24,10 +24,13 @@ if [ "$(id -u)" = 0 ]; then
   unpriv=(setpriv --reuid=65534 --regid=65534 --clear-groups --inh-caps=-all --bounding-set=-all
     "${unpriv[@]}")
 fi
+# The unprivileged user must reach the binary: the build tree may sit below a directory only
+# root can enter (a clone in /root, as on a fresh CI machine), so it runs a copy from $tmp.
+cp "$ODOMETRYD" "$tmp/odometryd" && chmod 755 "$tmp/odometryd"
 printf '[realtime]\npriority = 50\nlock_memory = true\n' >"$tmp/rt.toml"
 printf '[realtime]\npriority = 50\nlock_memory = true\nrequired = true\n' >"$tmp/rtreq.toml"
 chmod 644 "$tmp"/*.toml
-"${unpriv[@]}" ${CROSS_EMULATOR:-} "$ODOMETRYD" --config "$tmp/rt.toml" --duration 0.3 --quiet \
+"${unpriv[@]}" ${CROSS_EMULATOR:-} "$tmp/odometryd" --config "$tmp/rt.toml" --duration 0.3 --quiet \
   >"$tmp/out" 2>"$tmp/err"
 rc=$?; [ $rc = 0 ]; check "unprivileged carries on: exit 0 (got $rc)" $?
 grep -q "SCHED_FIFO priority 50: NOT APPLIED: not permitted.*CAP_SYS_NICE.*; continuing" "$tmp/out"
@@ -36,7 +39,7 @@ grep -Eq "mlockall: NOT APPLIED: (not permitted.*CAP_IPC_LOCK|.*(Address|Thread)
   "$tmp/out"
 check "unprivileged: mlockall not permitted, said clearly" $?
 grep -q "odometryd: stopped after" "$tmp/out"; check "unprivileged: the loop ran" $?
-"${unpriv[@]}" ${CROSS_EMULATOR:-} "$ODOMETRYD" --config "$tmp/rtreq.toml" --duration 0.3 --quiet \
+"${unpriv[@]}" ${CROSS_EMULATOR:-} "$tmp/odometryd" --config "$tmp/rtreq.toml" --duration 0.3 --quiet \
   >"$tmp/out" 2>"$tmp/err"
 rc=$?; [ $rc = 1 ]; check "required = true refuses: exit 1 (got $rc)" $?
 grep -q "required = true: refusing to start" "$tmp/err"; check "refusal reason on stderr" $?
