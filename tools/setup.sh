@@ -9,11 +9,13 @@
 set -euo pipefail
 
 build_pkgs=(g++ cmake make pkg-config python3 libeigen3-dev libgpiod-dev libtomlplusplus-dev
-  libcli11-dev nlohmann-json3-dev)
+  libcli11-dev nlohmann-json3-dev
+  cyclonedds-dev cyclonedds-tools)  # ROS 2 output (ros2/, -DODO_ROS2=OFF without): idlc, libddsc
 test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind
   can-utils python3-can iproute2  # CAN kernel tests in the VM (candump, cansend, ip, tc)
   rt-tests stress-ng systemd  # cyclictest + load for tools/jitter.sh; systemd-analyze verify
   clang-14 libclang-rt-14-dev libfuzzer-14-dev  # fuzz preset: clang-14 + libFuzzer (TESTING.md)
+  libfastrtps-dev fastddsgen  # the independent Fast DDS peer of the ROS 2 tests (fastddsgen: Java)
   nodejs npm)  # cli_can: the DBC read by the npm library candied (tests/tools/dbc_candied.cjs)
 # npm packages of the tests, installed into tools/node/ (not committed; cli_can looks there).
 npm_test_pkgs=(candied@2.2.0)
@@ -25,6 +27,11 @@ cross_pkgs=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user dpkg-dev fil
 cross_archs=(arm64 armhf)
 # Target libraries linked into the binaries or tests (Multi-Arch: same; one per architecture).
 # Eigen, CLI11 and nlohmann-json are Architecture: all headers: the native package serves all.
+# No cyclonedds-dev here: the cross presets build with ODO_ROS2=OFF. cyclonedds-dev:<arch> needs
+# libssl3:<arch> of exactly the native libssl3's version, and the native one comes from
+# bookworm-security, whose armhf list is the one that fails to download on our machines
+# (README, Cross builds): apt then refuses with "held broken packages", so CI would depend on a
+# mirror's sync state.
 cross_arch_pkgs=(libgpiod-dev libtomlplusplus-dev libgtest-dev libgmock-dev)
 
 want=("${build_pkgs[@]}")

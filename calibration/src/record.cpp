@@ -28,6 +28,7 @@ constexpr std::uint32_t kFlagDiameter = 1U << 2;
 constexpr std::uint32_t kFlagScaling = 1U << 3;
 constexpr std::uint32_t kFlagEmaxBefore = 1U << 4;
 constexpr std::uint32_t kFlagEmaxAfter = 1U << 5;
+constexpr std::uint32_t kFlagFit = 1U << 6;  // version 2: the fit fields at 104 .. 143
 
 // Little-endian field access, independent of the host's byte order.
 template <class T>
@@ -65,6 +66,23 @@ Status check_range(const char* field, double v, double lo, double hi, const char
   return make_error(Errc::kInvalidArgument, m.str());
 }
 
+Status validate_fit(const FixFitProvenance& f) {
+  using L = RecordLimits;
+  for (auto [field, v] : {std::pair{"fit residual", f.residual},
+                          {"sigma_c_l", f.sigma_c_l},
+                          {"sigma_c_r", f.sigma_c_r}})
+    if (auto s = check_range(field, v, 0.0, 1e9, ""); !s) return s;
+  if (auto s = check_range("sigma_wheelbase", f.sigma_wheelbase, 0.0, L::kWheelbaseMax, "m"); !s)
+    return s;
+  for (auto [field, v] :
+       {std::pair{"fixes_used", f.fixes_used}, {"fixes_rejected", f.fixes_rejected}})
+    if (v > L::kRunsMax)
+      return make_error(Errc::kInvalidArgument, std::string(field) + " = " + std::to_string(v) +
+                                                    " is outside the allowed range [0, " +
+                                                    std::to_string(L::kRunsMax) + "]");
+  return Ok{};
+}
+
 }  // namespace
 
 std::uint32_t crc32(std::span<const std::uint8_t> data) noexcept {
@@ -93,19 +111,29 @@ Result<std::vector<std::uint8_t>> encode_record(const CalibrationRecord& r) {
   if (r.e_s) flags |= kFlagScaling;
   if (r.e_max_before) flags |= kFlagEmaxBefore;
   if (r.e_max_after) flags |= kFlagEmaxAfter;
+  if (r.fit) flags |= kFlagFit;
 
-  std::vector<std::uint8_t> b(kRecordV1Bytes, 0);
+  const std::size_t len = r.fit ? kRecordV2Bytes : kRecordV1Bytes;
+  std::vector<std::uint8_t> b(len, 0);
   put<std::uint32_t>(b, 0, kRecordMagic);
-  put<std::uint16_t>(b, 4, kRecordVersion);
-  put<std::uint16_t>(b, 6, static_cast<std::uint16_t>(kRecordV1Bytes));
+  put<std::uint16_t>(b, 4, r.fit ? kRecordVersionFit : kRecordVersion);
+  put<std::uint16_t>(b, 6, static_cast<std::uint16_t>(len));
   put<std::uint64_t>(b, 8, r.sequence);
   put<std::uint32_t>(b, 16, flags);
   put<std::uint32_t>(b, 20, r.runs);
   put<std::int64_t>(b, 24, r.time);
   for (std::size_t i = 0; i < 7; ++i) put<double>(b, 32 + 8 * i, values[i]);
   std::memcpy(b.data() + 88, r.method.data(), r.method.size());
-  put<std::uint32_t>(b, kRecordV1Bytes - 4,
-                     crc32(std::span<const std::uint8_t>(b.data(), kRecordV1Bytes - 4)));
+  if (r.fit) {
+    const FixFitProvenance& f = *r.fit;
+    const double fv[] = {f.residual, f.sigma_c_l, f.sigma_c_r, f.sigma_wheelbase};
+    for (double v : fv)
+      if (!std::isfinite(v)) return make_error(Errc::kInvalidArgument, "a fit value is not finite");
+    put<std::uint32_t>(b, 104, f.fixes_used);
+    put<std::uint32_t>(b, 108, f.fixes_rejected);
+    for (std::size_t i = 0; i < 4; ++i) put<double>(b, 112 + 8 * i, fv[i]);
+  }
+  put<std::uint32_t>(b, len - 4, crc32(std::span<const std::uint8_t>(b.data(), len - 4)));
   return b;
 }
 
@@ -150,6 +178,21 @@ Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
   if (flags & kFlagEmaxAfter) r.e_max_after = v[6];
   const auto* m = reinterpret_cast<const char*>(bytes.data() + 88);
   r.method.assign(m, strnlen(m, kMethodBytes - 1));
+  if (flags & kFlagFit) {
+    if (version < kRecordVersionFit || length < kRecordV2Bytes)
+      return corrupt("fit fields flagged in a record of version " + std::to_string(version) +
+                     " and length " + std::to_string(length) +
+                     " (needs >= 2 and >= " + std::to_string(kRecordV2Bytes) + ")");
+    FixFitProvenance f;
+    f.fixes_used = get<std::uint32_t>(bytes, 104);
+    f.fixes_rejected = get<std::uint32_t>(bytes, 108);
+    double* fv[] = {&f.residual, &f.sigma_c_l, &f.sigma_c_r, &f.sigma_wheelbase};
+    for (std::size_t i = 0; i < 4; ++i) {
+      *fv[i] = get<double>(bytes, 112 + 8 * i);
+      if (!std::isfinite(*fv[i])) return corrupt("a stored fit value is not finite");
+    }
+    r.fit = f;
+  }
   return r;
 }
 
@@ -185,6 +228,7 @@ Status validate_record(const CalibrationRecord& r) {
   if (r.method.size() >= kMethodBytes)
     return make_error(Errc::kInvalidArgument, "method \"" + r.method + "\" is longer than " +
                                                   std::to_string(kMethodBytes - 1) + " bytes");
+  if (r.fit) return validate_fit(*r.fit);
   return Ok{};
 }
 

@@ -116,6 +116,12 @@ Status CalibrationStore::write_slot(int slot, const std::vector<std::uint8_t>& b
   const std::size_t off = layout_.slot_offset[static_cast<std::size_t>(slot)];
   std::vector<std::uint8_t> padded = bytes;
   padded.resize(round_up(bytes.size(), std::max<std::size_t>(g.write_unit, 1)), 0xFF);
+  // A version-2 record (148 bytes) on a medium planned for version 1 (slots >= 108 bytes): never
+  // write into the other slot.
+  if (padded.size() > layout_.slot_size)
+    return make_error(Errc::kUnsupported, "a record of " + std::to_string(bytes.size()) +
+                                              " bytes does not fit a slot of " +
+                                              std::to_string(layout_.slot_size) + " bytes");
   if (g.erase_block > 0) {
     if (auto s = medium_->erase(off, layout_.slot_size); !s) return s;
   }

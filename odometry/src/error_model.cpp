@@ -215,6 +215,31 @@ inline Mat3 local_input_covariance(double d_left, double d_right, double b,
 
 }  // namespace
 
+namespace {
+
+// propagate_local_impl: cov <- F cov F^T + R Q R^T for a step with displacement (lx, ly) and
+// input covariance Q (its six distinct entries) in the frame of its start heading (s0, c0).
+inline void propagate_local_impl(Cov3& cov, double s0, double c0, double lx, double ly, double q00,
+                                 double q01, double q02, double q11, double q12,
+                                 double q22) noexcept {
+  const double dx = c0 * lx - s0 * ly, dy = s0 * lx + c0 * ly;
+  // Written out on the six distinct entries (both terms are symmetric by construction, so the
+  // result stays exactly symmetric). F is the identity except F(0,2) = -dy, F(1,2) = dx (Eq. 16:
+  // the start heading moves x by -dy and y by +dx); R is the rotation by theta0 about z.
+  const double p00 = cov[0], p01 = cov[1], p02 = cov[2], p11 = cov[4], p12 = cov[5], p22 = cov[8];
+  const double fa = -dy, fc = dx;
+  const double cc = c0 * c0, ss = s0 * s0, cs = c0 * s0;
+  const double n00 = p00 + fa * (2.0 * p02 + fa * p22) + cc * q00 - 2.0 * cs * q01 + ss * q11;
+  const double n11 = p11 + fc * (2.0 * p12 + fc * p22) + ss * q00 + 2.0 * cs * q01 + cc * q11;
+  const double n01 = p01 + fa * p12 + fc * p02 + fa * fc * p22 + cs * (q00 - q11) + (cc - ss) * q01;
+  const double n02 = p02 + fa * p22 + c0 * q02 - s0 * q12;
+  const double n12 = p12 + fc * p22 + s0 * q02 + c0 * q12;
+  const double n22 = p22 + q22;
+  cov = {n00, n01, n02, n01, n11, n12, n02, n12, n22};
+}
+
+}  // namespace
+
 Cov3 arc_input_covariance(double d_left, double d_right, double b,
                           const ErrorModelParams& k) noexcept {
   Cov3 out{};
@@ -242,26 +267,15 @@ void propagate_arc(Cov3& cov, double sin_theta0, double cos_theta0, double d_lef
   }
   const ArcTerms t = arc_terms((d_right - d_left) / b);
   const Mat3 q = local_input_covariance(d_left, d_right, b, k, t);
-  const double s0 = sin_theta0, c0 = cos_theta0;
-  // Displacement of the arc: D (I_c, I_s) in the start frame, rotated by theta0.
+  // Displacement of the arc: D (I_c, I_s) in the start frame.
   const double d = 0.5 * (d_left + d_right);
-  const double lx = d * t.i_c, ly = d * t.i_s;
-  const double dx = c0 * lx - s0 * ly, dy = s0 * lx + c0 * ly;
-  // cov <- F P F^T + R Q R^T written out on the six distinct entries (both terms are symmetric
-  // by construction, so the result stays exactly symmetric). F is the identity except
-  // F(0,2) = -dy, F(1,2) = dx (Eq. 16: the start heading moves x by -dy and y by +dx); R is the
-  // rotation by theta0 about the z axis.
-  const double p00 = cov[0], p01 = cov[1], p02 = cov[2], p11 = cov[4], p12 = cov[5], p22 = cov[8];
-  const double fa = -dy, fc = dx;
-  const double q00 = q(0, 0), q01 = q(0, 1), q02 = q(0, 2), q11 = q(1, 1), q12 = q(1, 2);
-  const double cc = c0 * c0, ss = s0 * s0, cs = c0 * s0;
-  const double n00 = p00 + fa * (2.0 * p02 + fa * p22) + cc * q00 - 2.0 * cs * q01 + ss * q11;
-  const double n11 = p11 + fc * (2.0 * p12 + fc * p22) + ss * q00 + 2.0 * cs * q01 + cc * q11;
-  const double n01 = p01 + fa * p12 + fc * p02 + fa * fc * p22 + cs * (q00 - q11) + (cc - ss) * q01;
-  const double n02 = p02 + fa * p22 + c0 * q02 - s0 * q12;
-  const double n12 = p12 + fc * p22 + s0 * q02 + c0 * q12;
-  const double n22 = p22 + q(2, 2);
-  cov = {n00, n01, n02, n01, n11, n12, n02, n12, n22};
+  propagate_local_impl(cov, sin_theta0, cos_theta0, d * t.i_c, d * t.i_s, q(0, 0), q(0, 1), q(0, 2),
+                       q(1, 1), q(1, 2), q(2, 2));
+}
+
+void propagate_local(Cov3& cov, double sin_theta0, double cos_theta0, double lx, double ly,
+                     const Cov3& q) noexcept {
+  propagate_local_impl(cov, sin_theta0, cos_theta0, lx, ly, q[0], q[1], q[2], q[4], q[5], q[8]);
 }
 
 }  // namespace odo

@@ -43,9 +43,7 @@ void PoseIntegrator::reset(const Pose2& p) noexcept {
   steps_since_sync_ = 0;
 }
 
-void PoseIntegrator::step(double d_left, double d_right, double b) noexcept {
-  const double ds = 0.5 * (d_left + d_right);
-  const double dth = (d_right - d_left) / b;
+void PoseIntegrator::step_arc(double ds, double dth) noexcept {
   const HalfAngle h = half_angle(0.5 * dth);
   // cos/sin of the mean heading theta + h by the angle-sum identities.
   const double cm = c_ * h.c - s_ * h.s;
@@ -67,16 +65,27 @@ void PoseIntegrator::step(double d_left, double d_right, double b) noexcept {
 }
 
 void Odometry::update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
-  d_left_ = static_cast<double>(dn_left) * k_.metres_per_count_left();  // Eq. 6.35
-  d_right_ = static_cast<double>(dn_right) * k_.metres_per_count_right();
-  const double b = k_.wheelbase();
-  integ_.step(d_left_, d_right_, b);
-  const double ds = 0.5 * (d_left_ + d_right_);
+  const double d_l = static_cast<double>(dn_left) * k_.metres_per_count_left();  // Eq. 6.35
+  const double d_r = static_cast<double>(dn_right) * k_.metres_per_count_right();
+  integrate(d_l, d_r, (d_r - d_l) / k_.wheelbase(), dt);
+}
+
+void Odometry::update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt,
+                            double dtheta) noexcept {
+  integrate(static_cast<double>(dn_left) * k_.metres_per_count_left(),
+            static_cast<double>(dn_right) * k_.metres_per_count_right(), dtheta, dt);
+}
+
+void Odometry::integrate(double d_l, double d_r, double dth, double dt) noexcept {
+  d_left_ = d_l;
+  d_right_ = d_r;
+  const double ds = 0.5 * (d_l + d_r);
+  integ_.step_arc(ds, dth);
   distance_ += std::fabs(ds);
   if (dt > 0.0) {
     const double inv_dt = 1.0 / dt;
     v_ = ds * inv_dt;
-    w_ = (d_right_ - d_left_) / b * inv_dt;
+    w_ = dth * inv_dt;
   }
 }
 

@@ -15,6 +15,19 @@
 
 namespace odo::calib {
 
+// Provenance of a record fitted from absolute fixes (self-calibration, issue 18): format
+// version 2. Records without it are written as version 1, byte for byte as before.
+struct FixFitProvenance {
+  std::uint32_t fixes_used = 0;      // fixes the fit used
+  std::uint32_t fixes_rejected = 0;  // outlier fixes it rejected
+  double residual = 0.0;             // held-out mean chi2 per degree of freedom of the values
+  double sigma_c_l = 0.0;            // standard deviations of the values
+  double sigma_c_r = 0.0;
+  double sigma_wheelbase = 0.0;  // [m]
+
+  bool operator==(const FixFitProvenance&) const = default;
+};
+
 struct CalibrationRecord {
   std::uint64_t sequence = 0;       // assigned by the store: newer records have larger numbers
   bool cleared = false;             // a reset marker: "no calibration" (written by `calib reset`)
@@ -24,11 +37,12 @@ struct CalibrationRecord {
   std::optional<double> wheel_diameter;  // corrected nominal wheel diameter Dn* [m] (App. B)
   std::optional<double> e_s;             // scaling error E_s = L_calc / L_actual (Eq. B.1)
   // Provenance.
-  std::int64_t time = 0;               // when the values were obtained [s since 1970, UTC]
-  std::string method;                  // how: "umbmark", "set", "import", ... (<= 15 bytes)
-  std::optional<double> e_max_before;  // E_max,syst before the calibration [m] (Eq. 3.4)
-  std::optional<double> e_max_after;   // E_max,syst after (measured or predicted) [m]
-  std::uint32_t runs = 0;              // number of UMBmark runs (cw + ccw) behind the values
+  std::int64_t time = 0;                // when the values were obtained [s since 1970, UTC]
+  std::string method;                   // how: "umbmark", "set", "import", ... (<= 15 bytes)
+  std::optional<double> e_max_before;   // E_max,syst before the calibration [m] (Eq. 3.4)
+  std::optional<double> e_max_after;    // E_max,syst after (measured or predicted) [m]
+  std::uint32_t runs = 0;               // number of UMBmark runs (cw + ccw) behind the values
+  std::optional<FixFitProvenance> fit;  // self-calibration provenance (method "online", ...)
 
   bool operator==(const CalibrationRecord&) const = default;
 };
@@ -41,16 +55,25 @@ struct CalibrationRecord {
 // Extension rule: a later version appends its fields after byte 104 and raises version and
 // length; every reader decodes the version-1 fields of any record with version >= 1 and
 // length >= 108 and skips (but CRC-checks) the rest, so no record is ever lost to an upgrade.
+//
+// Version 2 (records with `fit`, flag bit 6): the version-1 fields, then 104 fixes_used u32
+// 108 fixes_rejected u32  112 residual  120 sigma_c_l  128 sigma_c_r  136 sigma_wheelbase (f64),
+// CRC at 144, length 148. A record without `fit` is still written as version 1, so media and
+// readers of version 1 see no change; a version-1 reader reads a version-2 record's version-1
+// fields by the rule above. Flag bit 6 in a record of version < 2 or length < 148 is corrupt.
 inline constexpr std::uint32_t kRecordMagic = 0x4C43444FU;  // bytes 'O' 'D' 'C' 'L'
 inline constexpr std::uint16_t kRecordVersion = 1;
+inline constexpr std::uint16_t kRecordVersionFit = 2;
 inline constexpr std::size_t kRecordV1Bytes = 108;
+inline constexpr std::size_t kRecordV2Bytes = 148;
 inline constexpr std::size_t kMethodBytes = 16;
 
 // crc32: CRC-32/ISO-HDLC (zlib's crc32; "123456789" -> 0xCBF43926).
 std::uint32_t crc32(std::span<const std::uint8_t> data) noexcept;
 
-// encode_record: the version-1 bytes of `r` (kRecordV1Bytes long). Fails when the method text
-// is longer than 15 bytes or a value is not finite.
+// encode_record: the bytes of `r`: version 1 (kRecordV1Bytes) without `fit`, version 2
+// (kRecordV2Bytes) with it. Fails when the method text is longer than 15 bytes or a value is
+// not finite.
 Result<std::vector<std::uint8_t>> encode_record(const CalibrationRecord& r);
 
 // decode_record: parses a record at the start of `bytes` (a slot). Errc::kCorrupt with the

@@ -62,6 +62,12 @@ void propagate_arc(Cov3& cov, double theta0, double d_left, double d_right, doub
 void propagate_arc(Cov3& cov, double sin_theta0, double cos_theta0, double d_left, double d_right,
                    double b, const ErrorModelParams& k) noexcept;
 
+// propagate_local: cov <- F cov F^T + R q R^T for any step whose displacement in the frame of
+// its start heading (sin_theta0, cos_theta0) is (lx, ly) [m] and whose input covariance in that
+// frame is q (e.g. a tick whose heading came from a gyro, odometry/gyrodometry.hpp).
+void propagate_local(Cov3& cov, double sin_theta0, double cos_theta0, double lx, double ly,
+                     const Cov3& q) noexcept;
+
 // PoseCovariance: the running covariance of the integrated pose; starts at zero.
 class PoseCovariance {
  public:

@@ -59,7 +59,12 @@ class PoseIntegrator {
   // reset: set the pose (e.g. at start or on a set-pose command).
   void reset(const Pose2& p) noexcept;
   // step: advance by wheel travels d_left, d_right [m] with wheelbase b [m].
-  void step(double d_left, double d_right, double b) noexcept;
+  void step(double d_left, double d_right, double b) noexcept {
+    step_arc(0.5 * (d_left + d_right), (d_right - d_left) / b);
+  }
+  // step_arc: advance along an arc of centre travel ds [m] and heading change dtheta [rad] (a
+  // heading from elsewhere, e.g. the gyrodometry fusion; step() is step_arc of the wheels').
+  void step_arc(double ds, double dtheta) noexcept;
   const Pose2& pose() const noexcept { return pose_; }
   double sin_theta() const noexcept { return s_; }
   double cos_theta() const noexcept { return c_; }
@@ -93,6 +98,10 @@ class Odometry {
     integ_.reset(p);
     cov_.reset();
   }
+  // update_fused: the same with the heading changing by dtheta [rad] instead of
+  // (d_R - d_L) / b (the gyrodometry fusion's FusedTick::dtheta); bit-identical to update()
+  // when dtheta is odometry's own increment.
+  void update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta) noexcept;
   // set_kinematics: swap in new calibration (e.g. after SIGHUP); the pose is kept.
   void set_kinematics(const Kinematics& k) noexcept { k_ = k; }
 
@@ -109,6 +118,8 @@ class Odometry {
   const Cov3& covariance() const noexcept { return cov_.cov(); }
 
  private:
+  // integrate: one tick of wheel travels d_l, d_r [m] and heading change dth [rad].
+  void integrate(double d_l, double d_r, double dth, double dt) noexcept;
   Kinematics k_;
   PoseCovariance cov_;
   PoseIntegrator integ_;

@@ -1,0 +1,148 @@
+// Self-calibration from absolute fixes (issue 18): every excursion between two absolute pose
+// fixes is a calibration run, since the odometry between them is a known function of
+// p = (c_L, c_R, b). Pure math: inputs as arguments, no I/O, no exceptions; runs off the loop
+// thread (it allocates) in the daemon and in `odomctl calib fit-fixes`.
+//
+// Model: a segment with counts (n_L, n_R) moves the wheels d_L = c_L c_m n_L, d_R = c_R c_m n_R
+// (UMBmark Eq. 6.35, c_m the nominal metres per count) and is one exact arc (odo::arc_step).
+// Pipeline (fit_fixes):
+//  1. Initial value, Antonelli, Chiaverini & Fusco 2005: the heading change of an excursion
+//     between two heading fixes is linear in (u_R, u_L) = (c_R/b, c_L/b); with those the
+//     position change is linear in (c_L, c_R); b = LS fit of (c_L, c_R) = b (u_L, u_R).
+//  2. Gauss-Newton on the exact model with analytic Jacobians, residual = fix - prediction.
+//     An excursion's residual covariance is S = Sigma_end + G Sigma_start G^T + Sigma_odo: the
+//     end fix's covariance, the start fix's propagated through the excursion (G = d end /
+//     d start) and the Chong-Kleeman wheel noise along the excursion. Consecutive excursions
+//     share a fix, so their residuals correlate: Cov(r_k, r_k+1) = -Sigma_fix G_k+1^T. The fit
+//     is weighted by that joint (block-tridiagonal) covariance, frozen at the start value (with
+//     per-excursion weights the reported sigma was 19 % too small against a Monte Carlo), plus a
+//     prior N(calibration in use, sigma_prior) that keeps unobservable directions (spins only,
+//     straights only) finite. A step that would leave the plausible box (factors 0.5 .. 1.5,
+//     b within 0.5 .. 2 times the in-use b) is halved until it does not.
+//  3. Outliers: a fix's score is the mean over the (at most two) excursions touching it of
+//     chi2 / gate(dof), chi2 = r^T S^-1 r of the fitted estimate, gate = chi-square 99.9 %
+//     quantile (13.82 for x, y; 16.27 for x, y, theta). While the largest score exceeds 1, that
+//     fix is rejected (its two excursions merge into one) and the fit is redone. Robust
+//     re-check: each rejected fix is tested again against the final estimate (both of its
+//     excursions within the gate, with the parameter uncertainty added to S) and re-admitted
+//     if it passes, followed by one more fit.
+//  4. Scale: excursions that end where they started (a dock) cannot see the distance scale:
+//     multiplying c_L, c_R and b by one factor scales the closed path about its start. When the
+//     standard deviation of m = (c_L + c_R)/2 exceeds max_sigma_factor, the estimate and its
+//     covariance are conditioned on m = m_in_use (scale_held): what the data determine (the
+//     ratio c_R/c_L and the turn rates c/b) is kept, the scale stays as it was.
+//  5. Acceptance: every hold_out_every-th excursion (in time order, after rejection) is held
+//     out of the fit; the score of a parameter set is the mean chi2 per degree of freedom of
+//     its predictions of the held-out excursions (same S for both). The candidate is accepted
+//     only when every standard deviation is below its bound AND its score is lower than the
+//     score of the calibration in use.
+// Fix headings are used where present. A fix without heading contributes x, y only; the next
+// excursion then starts with the heading predicted by the previous one (its derivative carried
+// along, its variance taken as that of the last heading fix: that heading's correlation with
+// the previous excursion's residual is neglected). An excursion whose start heading is unknown altogether is skipped.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "odo/calibration/count_recorder.hpp"
+#include "odo/calibration/umbmark.hpp"
+#include "odo/hal/result.hpp"
+#include "odo/hal/time.hpp"
+#include "odo/odometry/error_model.hpp"
+#include "odo/odometry/pose.hpp"
+
+namespace odo::calib {
+
+// An absolute pose fix in the odometry's world frame, for the instant t.
+struct PoseFix {
+  TimeNs t = 0;                 // the time the fix refers to, on the loop's clock [ns]
+  double x = 0.0;               // [m]
+  double y = 0.0;               // [m]
+  std::optional<double> theta;  // [rad]; nullopt: heading unknown
+  double sigma_xy = 0.0;        // standard deviation of x and of y [m], > 0
+  double sigma_theta = 0.0;     // [rad], > 0 when theta is given
+};
+
+// Counts of one segment of an excursion (fractional after a split at a fix time).
+struct LegCounts {
+  double n_left = 0.0;
+  double n_right = 0.0;
+};
+
+// The data of a fit: fixes in time order and the segments between consecutive fixes
+// (legs[i] lies between fixes[i] and fixes[i + 1]).
+struct FixTrack {
+  std::vector<PoseFix> fixes;
+  std::vector<std::vector<LegCounts>> legs;
+};
+
+// build_track: assigns recorded segments (time order, contiguous or with standstill gaps) to
+// the intervals between the fixes (time order, strictly increasing t); a segment straddling a
+// fix time is split in proportion to time. Errors name the fix or segment out of order.
+Result<FixTrack> build_track(std::span<const CountSegment> segments,
+                             std::span<const PoseFix> fixes);
+
+// Covariance of (c_L, c_R, b), row-major [-, -, m; ...; m^2].
+using ParamCov = std::array<double, 9>;
+
+struct SelfCalConfig {
+  double metres_per_count = 0.0;     // c_m, nominal [m/count] (Kinematics::metres_per_count)
+  Factors in_use{1.0, 1.0, 0.0};     // calibration in use: prior mean and the acceptance baseline
+  double prior_sigma_factor = 0.05;  // prior standard deviation of c_L, c_R
+  double prior_sigma_wheelbase = 0.02;  // [m]
+  ErrorModelParams odometry_noise{};    // wheel noise k_L, k_R [m^(1/2)] in S
+  int max_iterations = 20;              // Gauss-Newton
+  int hold_out_every = 4;               // every 4th excursion held out; 0: none (no decision)
+  double max_sigma_factor = 2e-4;       // acceptance bound on sigma(c_L), sigma(c_R)
+  double max_sigma_wheelbase = 2e-4;    // [m] acceptance bound on sigma(b)
+};
+
+// check_selfcal_config: every field finite and in range; the message names the field.
+Status check_selfcal_config(const SelfCalConfig& c);
+
+// Why a candidate was or was not accepted.
+enum class Verdict : std::uint8_t {
+  kAccepted = 0,
+  kTooUncertain = 1,  // a standard deviation above its bound
+  kNotBetter = 2,     // held-out score not lower than the calibration in use
+  kNoHeldOut = 3,     // nothing held out (hold_out_every = 0 or too few excursions)
+};
+
+// verdict_name: "accepted", "too-uncertain", "not-better", "no-held-out".
+const char* verdict_name(Verdict v) noexcept;
+
+struct SelfCalResult {
+  Factors initial;                // Antonelli et al. linear estimate (in_use where not observable)
+  Factors estimate;               // Gauss-Newton on the training excursions (scale: below)
+  Factors free_scale;             // the same before the scale was held
+  bool scale_held = false;        // sigma((c_L + c_R)/2) was above max_sigma_factor: estimate
+                                  // and covariance are conditioned on the in-use value
+  ParamCov covariance{};          // of estimate
+  std::array<double, 3> sigma{};  // sqrt of the diagonal: c_L, c_R, b [-, -, m]
+  int iterations = 0;             // Gauss-Newton iterations of the last fit
+  int fixes_used = 0;             // accepted fixes
+  int fixes_rejected = 0;
+  std::vector<int> rejected;  // indices into FixTrack::fixes
+  int excursions_fit = 0;
+  int excursions_held_out = 0;
+  int excursions_skipped = 0;    // start heading unknown
+  double chi2_per_dof = 0.0;     // of the fit on its own excursions
+  double score_candidate = 0.0;  // held-out mean chi2 per dof
+  double score_in_use = 0.0;
+  Verdict verdict = Verdict::kNoHeldOut;
+};
+
+// fit_fixes: the whole pipeline above. Errors: invalid config, a fix with a non-positive or
+// non-finite sigma, fewer than two fixes, a diverging fit (factors outside [0.5, 1.5]).
+Result<SelfCalResult> fit_fixes(const FixTrack& track, const SelfCalConfig& cfg);
+
+// predict_excursion: the pose at the end of `legs` from `start` [m, m, rad] with parameters f
+// (exact arcs); for tests and tools.
+Pose2 predict_excursion(const Pose2& start, std::span<const LegCounts> legs, const Factors& f,
+                        double metres_per_count);
+
+}  // namespace odo::calib

@@ -1,0 +1,298 @@
+#include "odo/calibration/selfcal.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "selfcal_model.hpp"
+
+namespace odo::calib {
+namespace {
+
+using detail::Eval;
+using detail::Mat3;
+using detail::Vec3;
+using Vec2 = Eigen::Vector2d;
+using Mat2 = Eigen::Matrix2d;
+
+Error bad(const std::string& field, double v, const std::string& range) {
+  std::ostringstream m;
+  m << field << " = " << v << " is outside the allowed range " << range;
+  return make_error(Errc::kInvalidArgument, m.str());
+}
+
+Status check_fixes(std::span<const PoseFix> fixes) {
+  for (std::size_t i = 0; i < fixes.size(); ++i) {
+    const PoseFix& f = fixes[i];
+    const std::string n = "fix " + std::to_string(i + 1) + " ";
+    if (!(std::isfinite(f.x) && std::isfinite(f.y) && (!f.theta || std::isfinite(*f.theta))))
+      return make_error(Errc::kInvalidArgument, n + "x, y, theta must be finite");
+    if (!(std::isfinite(f.sigma_xy) && f.sigma_xy > 0.0))
+      return bad(n + "sigma_xy", f.sigma_xy, "(0, inf) m");
+    if (f.theta && !(std::isfinite(f.sigma_theta) && f.sigma_theta > 0.0))
+      return bad(n + "sigma_theta", f.sigma_theta, "(0, inf) rad");
+    if (i > 0 && f.t <= fixes[i - 1].t)
+      return make_error(Errc::kInvalidArgument, n + "time is not after the previous fix's");
+  }
+  return Ok{};
+}
+
+Mat3 prior_information(const SelfCalConfig& c) {
+  const double sf = c.prior_sigma_factor, sb = c.prior_sigma_wheelbase;
+  return Vec3(1.0 / (sf * sf), 1.0 / (sf * sf), 1.0 / (sb * sb)).asDiagonal();
+}
+
+// Sums of the counts of an excursion (legs[from .. to)).
+Vec2 total_counts(const FixTrack& t, int from, int to) {
+  Vec2 n = Vec2::Zero();
+  for (int leg = from; leg < to; ++leg)
+    for (const LegCounts& s : t.legs[static_cast<std::size_t>(leg)]) n += Vec2(s.n_left, s.n_right);
+  return n;
+}
+
+// Step 1 of Antonelli et al.: heading change c_m (u_R N_R - u_L N_L) between heading fixes,
+// least squares in u = (u_L, u_R) with a prior at the calibration in use.
+Vec2 linear_heading(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c) {
+  const double b0 = c.in_use.wheelbase, su = c.prior_sigma_factor / b0;
+  const Vec2 u0(c.in_use.c_l / b0, c.in_use.c_r / b0);
+  Mat2 h = Mat2::Identity() / (su * su);
+  Vec2 g = h * u0;
+  for (std::size_t k = 0; k + 1 < acc.size(); ++k) {
+    const PoseFix &fs = t.fixes[acc[k]], &fe = t.fixes[acc[k + 1]];
+    if (!fs.theta || !fe.theta) continue;
+    const Vec2 n = total_counts(t, acc[k], acc[k + 1]);
+    const Vec2 a(-c.metres_per_count * n(0), c.metres_per_count * n(1));
+    // Whole turns are not visible in a wrapped heading: take them from the in-use prediction.
+    const double pred = a.dot(u0);
+    const double meas = pred + wrap_angle(*fe.theta - *fs.theta - pred);
+    const double w = 1.0 / (fs.sigma_theta * fs.sigma_theta + fe.sigma_theta * fe.sigma_theta);
+    h += w * a * a.transpose();
+    g += w * meas * a;
+  }
+  return h.ldlt().solve(g);
+}
+
+// Step 2: with u known every segment's heading is known, so the position change is
+// c_L a_L + c_R a_R; least squares in (c_L, c_R) with the prior, over heading-fix starts.
+Vec2 linear_position(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c,
+                     const Vec2& u) {
+  const double sf = c.prior_sigma_factor, c_m = c.metres_per_count;
+  Mat2 h = Mat2::Identity() / (sf * sf);
+  Vec2 g = h * Vec2(c.in_use.c_l, c.in_use.c_r);
+  for (std::size_t k = 0; k + 1 < acc.size(); ++k) {
+    const PoseFix &fs = t.fixes[acc[k]], &fe = t.fixes[acc[k + 1]];
+    if (!fs.theta) continue;
+    double th = *fs.theta;
+    Mat2 a = Mat2::Zero();  // columns: c_L, c_R; rows: x, y
+    for (int leg = acc[k]; leg < acc[k + 1]; ++leg) {
+      for (const LegCounts& s : t.legs[static_cast<std::size_t>(leg)]) {
+        const double turn = c_m * (u(1) * s.n_right - u(0) * s.n_left);
+        const HalfAngle ha = half_angle(0.5 * turn);
+        const Vec2 dir(std::cos(th + 0.5 * turn), std::sin(th + 0.5 * turn));
+        a.col(0) += 0.5 * c_m * s.n_left * ha.sinc * dir;
+        a.col(1) += 0.5 * c_m * s.n_right * ha.sinc * dir;
+        th += turn;
+      }
+    }
+    const double w = 1.0 / (fs.sigma_xy * fs.sigma_xy + fe.sigma_xy * fe.sigma_xy);
+    h += w * a.transpose() * a;
+    g += w * a.transpose() * Vec2(fe.x - fs.x, fe.y - fs.y);
+  }
+  return h.ldlt().solve(g);
+}
+
+bool plausible(const Vec3& p, double b0) {
+  return p.allFinite() && p(0) > 0.5 && p(0) < 1.5 && p(1) > 0.5 && p(1) < 1.5 && p(2) > 0.5 * b0 &&
+         p(2) < 2.0 * b0;
+}
+
+Vec3 linear_initial(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c) {
+  const Vec2 u = linear_heading(t, acc, c);
+  const Vec2 cf = linear_position(t, acc, c, u);
+  // (c_L, c_R) = b (u_L, u_R) in the least-squares sense.
+  const Vec3 p(cf(0), cf(1), cf.dot(u) / u.squaredNorm());
+  return plausible(p, c.in_use.wheelbase) ? p : detail::to_vec(c.in_use);
+}
+
+// The stacked residual rows of the excursions a fit uses, and their joint covariance: each
+// excursion's S on the diagonal, and between consecutive excursions that share a fix the
+// covariance its error creates, Cov(r_k, r_k+1) = -Sigma_fix G_k+1^T (it ends r_k and starts
+// r_k+1; an unknown heading of the fix is not shared).
+struct Joint {
+  std::vector<std::size_t> index;  // eval index of each used excursion
+  Eigen::LLT<Eigen::MatrixXd> llt;
+  int rows = 0;
+};
+
+Joint joint_covariance(const FixTrack& t, const std::vector<Eval>& s0,
+                       const std::vector<bool>& train) {
+  Joint j;
+  std::vector<int> offset;
+  for (std::size_t k = 0; k < s0.size(); ++k) {
+    if (!s0[k].usable || (!train.empty() && !train[k])) continue;
+    j.index.push_back(k);
+    offset.push_back(j.rows);
+    j.rows += s0[k].dof;
+  }
+  Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(j.rows, j.rows);
+  for (std::size_t i = 0; i < j.index.size(); ++i) {
+    const Eval& e = s0[j.index[i]];
+    sigma.block(offset[i], offset[i], e.dof, e.dof) = e.s.topLeftCorner(e.dof, e.dof);
+    if (i + 1 == j.index.size() || s0[j.index[i + 1]].from != e.to) continue;
+    const Eval& n = s0[j.index[i + 1]];
+    const PoseFix& f = t.fixes[static_cast<std::size_t>(e.to)];
+    const double v = f.sigma_xy * f.sigma_xy;
+    const Vec3 d(v, v, f.theta ? f.sigma_theta * f.sigma_theta : 0.0);
+    const Mat3 off = -(d.asDiagonal() * n.g.transpose());
+    sigma.block(offset[i], offset[i + 1], e.dof, n.dof) = off.topLeftCorner(e.dof, n.dof);
+    sigma.block(offset[i + 1], offset[i], n.dof, e.dof) =
+        off.topLeftCorner(e.dof, n.dof).transpose();
+  }
+  j.llt.compute(sigma);
+  return j;
+}
+
+// gauss_newton: exact-model refinement over the excursions of `acc` that `train` admits
+// (train empty: all), weighted by the joint covariance frozen at the start value.
+detail::FitOut gauss_newton(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c,
+                            Vec3 p, const std::vector<bool>& train) {
+  const Mat3 p_inf = prior_information(c);
+  const Vec3 prior = detail::to_vec(c.in_use);
+  const Joint jc = joint_covariance(t, detail::evaluate_chain(t, acc, p, c, true), train);
+  Eigen::MatrixXd jac(jc.rows, 3);
+  Eigen::VectorXd res(jc.rows);
+  detail::FitOut f;
+  Mat3 h = p_inf;
+  for (f.iterations = 1; f.iterations <= c.max_iterations; ++f.iterations) {
+    const std::vector<Eval> ev = detail::evaluate_chain(t, acc, p, c, false);
+    int row = 0;
+    for (std::size_t k : jc.index) {
+      jac.middleRows(row, ev[k].dof) = ev[k].j.topRows(ev[k].dof);
+      res.segment(row, ev[k].dof) = ev[k].r.head(ev[k].dof);
+      row += ev[k].dof;
+    }
+    // Whitened: A = L^-1 J, b = L^-1 r with Sigma = L L^T.
+    const Eigen::MatrixXd a = jc.llt.matrixL().solve(jac);
+    const Eigen::VectorXd b = jc.llt.matrixL().solve(res);
+    h = p_inf + a.transpose() * a;
+    Vec3 step = h.ldlt().solve(p_inf * (prior - p) + a.transpose() * b);
+    // Outliers not yet rejected can pull the estimate far out (along the scale, which closed
+    // excursions barely see): shorten the step to stay in the plausible box and stop there;
+    // the rejection that follows needs an estimate to score the fixes with, not a failure.
+    int halve = 0;
+    for (; halve < 40 && !plausible(p + step, c.in_use.wheelbase); ++halve) step *= 0.5;
+    if (!plausible(p + step, c.in_use.wheelbase)) break;
+    f.bounded = f.bounded || halve > 0;
+    p += step;
+    if (step.cwiseAbs().maxCoeff() < 1e-13) break;
+  }
+  f.iterations = std::min(f.iterations, c.max_iterations);
+  f.p = p;
+  f.cov = h.inverse();
+  f.ok = true;
+  return f;
+}
+
+}  // namespace
+
+namespace detail {
+
+FitOut fit_once(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c,
+                const std::vector<bool>& train) {
+  const Vec3 p0 = linear_initial(t, acc, c);
+  FitOut f = gauss_newton(t, acc, c, p0, train);
+  f.initial = p0;
+  return f;
+}
+
+Status check_track(const FixTrack& t) {
+  if (t.fixes.size() < 2)
+    return make_error(Errc::kInvalidArgument,
+                      "at least two fixes are needed, got " + std::to_string(t.fixes.size()));
+  if (t.legs.size() + 1 != t.fixes.size())
+    return make_error(Errc::kInvalidArgument, "a track needs one leg between every two fixes");
+  return check_fixes(t.fixes);
+}
+
+}  // namespace detail
+
+const char* verdict_name(Verdict v) noexcept {
+  switch (v) {
+    case Verdict::kAccepted:
+      return "accepted";
+    case Verdict::kTooUncertain:
+      return "too-uncertain";
+    case Verdict::kNotBetter:
+      return "not-better";
+    case Verdict::kNoHeldOut:
+      break;
+  }
+  return "no-held-out";
+}
+
+Status check_selfcal_config(const SelfCalConfig& c) {
+  if (!(std::isfinite(c.metres_per_count) && c.metres_per_count > 0.0))
+    return bad("metres_per_count", c.metres_per_count, "(0, inf) m");
+  if (!(c.in_use.c_l >= 0.5 && c.in_use.c_l <= 1.5)) return bad("c_l", c.in_use.c_l, "[0.5, 1.5]");
+  if (!(c.in_use.c_r >= 0.5 && c.in_use.c_r <= 1.5)) return bad("c_r", c.in_use.c_r, "[0.5, 1.5]");
+  if (!(std::isfinite(c.in_use.wheelbase) && c.in_use.wheelbase > 0.0))
+    return bad("wheelbase", c.in_use.wheelbase, "(0, inf) m");
+  for (auto [f, v] : {std::pair{"prior_sigma_factor", c.prior_sigma_factor},
+                      {"prior_sigma_wheelbase", c.prior_sigma_wheelbase},
+                      {"max_sigma_factor", c.max_sigma_factor},
+                      {"max_sigma_wheelbase", c.max_sigma_wheelbase}}) {
+    if (!(std::isfinite(v) && v > 0.0)) return bad(f, v, "(0, inf)");
+  }
+  if (auto s = check_error_model(c.odometry_noise); !s) return s;
+  if (c.max_iterations < 1 || c.max_iterations > 100)
+    return bad("max_iterations", c.max_iterations, "[1, 100]");
+  if (c.hold_out_every < 0 || c.hold_out_every == 1 || c.hold_out_every > 1000)
+    return bad("hold_out_every", c.hold_out_every, "0 or [2, 1000]");
+  return Ok{};
+}
+
+Pose2 predict_excursion(const Pose2& start, std::span<const LegCounts> legs, const Factors& f,
+                        double metres_per_count) {
+  Pose2 q = start;
+  for (const LegCounts& s : legs)
+    q = arc_step(q, f.c_l * metres_per_count * s.n_left, f.c_r * metres_per_count * s.n_right,
+                 f.wheelbase);
+  return q;
+}
+
+Result<FixTrack> build_track(std::span<const CountSegment> segments,
+                             std::span<const PoseFix> fixes) {
+  FixTrack t;
+  t.fixes.assign(fixes.begin(), fixes.end());
+  if (fixes.size() < 2) return t;
+  t.legs.resize(fixes.size() - 1);
+  for (std::size_t i = 1; i < fixes.size(); ++i)
+    if (fixes[i].t <= fixes[i - 1].t)
+      return make_error(Errc::kInvalidArgument,
+                        "fix " + std::to_string(i + 1) + ": time is not after the previous fix's");
+  TimeNs prev_end = segments.empty() ? 0 : segments.front().t_start;
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    const CountSegment& s = segments[k];
+    if (s.t_end < s.t_start || s.t_start < prev_end)
+      return make_error(Errc::kInvalidArgument,
+                        "segment " + std::to_string(k + 1) + " is out of time order");
+    prev_end = s.t_end;
+    // First fix interval that can overlap (t_start, t_end]: the last fix at or before t_start.
+    auto it = std::upper_bound(fixes.begin(), fixes.end(), s.t_start,
+                               [](TimeNs v, const PoseFix& f) { return v < f.t; });
+    std::size_t i = it == fixes.begin() ? 0 : static_cast<std::size_t>(it - fixes.begin()) - 1;
+    const double dur = static_cast<double>(s.t_end - s.t_start);
+    for (; i + 1 < fixes.size() && fixes[i].t < s.t_end; ++i) {
+      const TimeNs lo = std::max(s.t_start, fixes[i].t), hi = std::min(s.t_end, fixes[i + 1].t);
+      if (hi <= lo) continue;
+      // Constant wheel speeds inside a segment: counts in proportion to time.
+      const double frac = static_cast<double>(hi - lo) / dur;
+      t.legs[i].push_back({frac * s.dn_left, frac * s.dn_right});
+    }
+  }
+  return t;
+}
+
+}  // namespace odo::calib

@@ -1,0 +1,75 @@
+// YawRateSource: where the loop gets the robot's rate of turn about its z axis (a MEMS rate gyro
+// through Linux IIO in drivers/, a simulated gyro with its error terms in sim_hal/).
+#pragma once
+
+#include <cstdint>
+
+#include "odo/hal/time.hpp"
+
+namespace odo {
+
+// Health flags of one gyro sample; several may be set at once. Any of them means the rate must
+// not be used (the fusion falls back to odometry for that tick).
+enum GyroFlag : std::uint32_t {
+  kGyroOk = 0,
+  kGyroStale = 1u << 0,      // no new device sample within the source's timeout
+  kGyroSaturated = 1u << 1,  // a sample reached the end of the measuring range
+  kGyroInvalid = 1u << 2,    // the rate is not a finite number (NaN, inf) or undecodable
+  kGyroReadError = 1u << 3,  // the backend could not read the device this tick
+};
+
+// Cumulative event counters of a gyro backend since start; they only grow.
+struct GyroCounters {
+  std::uint64_t samples = 0;       // device samples received
+  std::uint64_t stale_events = 0;  // transitions into the stale state
+  std::uint64_t saturated = 0;     // samples at the end of the range
+  std::uint64_t invalid = 0;       // samples that were not finite or not decodable
+  std::uint64_t read_errors = 0;   // reads the operating system refused
+};
+
+// One reading: the mean yaw rate over the device samples that arrived since the previous read.
+struct GyroSample {
+  double rate_z = 0.0;        // [rad/s] about the robot's z axis (CCW positive), mounting applied
+  TimeNs stamp = 0;           // time of the newest device sample [ns, clock of the loop]
+  std::uint32_t samples = 0;  // device samples averaged into rate_z (0: rate_z is the last one)
+  std::uint32_t flags = 0;    // GyroFlag bits
+  GyroCounters counters;
+};
+
+// GyroReadBook: the bookkeeping every gyro source does at the end of a read, shared by the IIO
+// backend (drivers/) and the simulated gyro (sim_hal/) so that both flag and count alike.
+struct GyroReadBook {
+  TimeNs stale_timeout = 0;  // no sample for longer than this: kGyroStale [ns]
+  TimeNs last_stamp = 0;     // time of the newest sample [ns]
+  double last_rate = 0.0;    // newest mean rate [rad/s]
+  bool stale = false;
+  GyroCounters counters;
+
+  // close: s.samples samples of mean rate `mean` [rad/s] arrived in this read; fills rate_z (the
+  // previous mean when none arrived), stamp, the stale flag (one stale event per transition into
+  // the stale state) and the counters.
+  void close(GyroSample& s, TimeNs now, double mean) noexcept {
+    counters.samples += s.samples;
+    if (s.samples > 0) last_rate = mean;
+    const bool now_stale = now - last_stamp > stale_timeout;
+    if (now_stale) {
+      s.flags |= kGyroStale;
+      if (!stale) ++counters.stale_events;
+    }
+    stale = now_stale;
+    s.rate_z = last_rate;
+    s.stamp = last_stamp;
+    s.counters = counters;
+  }
+};
+
+class YawRateSource {
+ public:
+  virtual ~YawRateSource() = default;
+  // read: everything the device delivered up to `now` [ns]; never blocks.
+  virtual GyroSample read(TimeNs now) noexcept = 0;
+  // full_scale: the measuring range, |rate| [rad/s] at which samples saturate.
+  virtual double full_scale() const noexcept = 0;
+};
+
+}  // namespace odo

@@ -1,0 +1,215 @@
+// Gyrodometry (Borenstein & Feng, ICRA 1996) made robust to coarse encoders: odometry's heading
+// increment on every tick, except over the intervals where gyro and odometry disagree (a bump, a
+// crack, a slip) or the wheels do what the robot cannot; there the gyro's increment. Pure math:
+// time and inputs are arguments; configure allocates, step() never does and never throws.
+//
+// Why a window and not tick by tick. With 2048 counts per revolution on a direct-drive 0.15 m
+// wheel read at 200 Hz a wheel moves one or two counts a tick: odometry's heading increment of a
+// tick is quantised to q_tick = (m_L + m_R)/b = 1.35 mrad (m = pi D / 2048 = 0.23 mm, b = 0.34 m),
+// 5x the whole increment of a 0.05 rad/s turn. A tick-by-tick comparison sees that as
+// disagreement, and choosing per tick biases the heading (it picks the ticks where the counts
+// happened to lead). But the error of a count difference does not grow with the interval: the
+// heading increment over ANY window, from two cumulative readings, is off by less than one count
+// on each wheel, i.e. by less than q = (m_L + m_R)/b, however long the window. The gyro's angle
+// noise over a window of T_w seconds grows as N sqrt(T_w). So the comparison is made on the sum of
+// the increments over the last n = T_w / tick ticks, E = sum (dtheta_gyro - dtheta_odo), against
+//
+//   T = q + k_sigma * N sqrt(T_w) + B_res T_w + s_tol |sum dtheta_odo| + d |delta omega|
+//
+// (N rate noise density [rad/s/sqrt(Hz)], B_res the residual bias [rad/s], s_tol the residual
+// scale-factor error, d the gyro's delay [s] and delta omega the change of odometry's rate of
+// turn across the window: a delayed gyro's window sum is theta(t - d) - theta(t - T_w - d), off
+// by d (omega(t) - omega(t - T_w)) while the turn rate changes). When |E| > T, or a wheel's speed
+// or acceleration exceeds the configured limits, a flagged interval begins: the heading takes the
+// gyro's increments for every tick of the window that odometry had supplied (one correction, so the
+// whole disturbance is replaced, not just the part after detection), then the gyro's increment
+// every tick until the window is quiet again. The quantisation error introduced is below q once per
+// interval and has no sign preference; nothing is chosen per tick.
+//
+// Thresholds for the two reference set-ups (T_w = 0.1 s, k_sigma = 5, consumer gyro of the
+// BMI088 class: N = 0.014 deg/s/sqrt(Hz) = 2.4435e-4 rad/s/sqrt(Hz), bias instability 2 deg/h =
+// 9.70e-6 rad/s; bias averaged over the default still_time of 0.5 s, so
+// B_res = 9.70e-6 + N / sqrt(0.5 s) = 3.5525e-4 rad/s; a straight leg, so the scale term is 0):
+//   noise term  5 * 2.4435e-4 * sqrt(0.1)                 = 3.8635e-4 rad
+//   bias term   3.5525e-4 * 0.1                           = 3.5525e-5 rad
+//   LabMate (2048 cpr x 16 gear, D = 0.15 m, b = 0.34 m): q = 2 (pi 0.15 / 32768) / 0.34
+//                                                         = 8.4595e-5 rad -> T = 5.0647e-4 rad
+//   direct drive (2048 cpr, D = 0.15 m, b = 0.34 m):     q = 1.3535e-3 rad -> T = 1.7754e-3 rad
+// (tests/unit/test_gyrodometry.cpp checks both). The per-tick noise term would be only
+// 5 N sqrt(0.005 s) = 8.64e-5 rad: a sixteenth of the direct drive's count quantum.
+// A 10 mm bump under one LabMate wheel turns odometry's heading by 0.44 deg = 7.7e-3 rad within
+// the 0.1-0.2 s the wheel needs to cross it: 15x (LabMate) and 4.3x (direct drive) the
+// threshold. As rates: T / T_w = 5 mrad/s and 18 mrad/s against the bump's apparent 40-77 mrad/s.
+// Gyro noise alone exceeds 5 sigma with probability 5.7e-7 per window (Gaussian); windows that
+// overlap are strongly correlated, so an hour holds about 3600 s / 0.1 s = 3.6e4 independent
+// ones: one false alarm in about 50 h from noise alone, before the quantisation margin q.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "odo/hal/gyro.hpp"
+#include "odo/hal/result.hpp"
+#include "odo/odometry/error_model.hpp"
+
+namespace odo {
+
+// The gyro's noise model (see the parameter sets in sim_hal/sim_gyro.hpp for datasheet figures).
+struct GyroNoiseModel {
+  double rate_noise_density = 2.443e-4;  // N [rad/s/sqrt(Hz)]; angle std after T s: N sqrt(T)
+  double bias_instability = 9.7e-6;      // in-run bias drift [rad/s] (BMI088: 2 deg/h)
+  double scale_tolerance = 0.01;         // |scale-factor error| left in use (fraction)
+};
+
+// Configuration of the fusion; every field is checked by Gyrodometry::create().
+struct GyrodometryParams {
+  GyroNoiseModel noise;
+  double tick = 0.005;            // nominal loop period [s]
+  double window = 0.1;            // comparison window T_w [s] (rounded to whole ticks)
+  double k_sigma = 5.0;           // noise multiples in the threshold
+  double gyro_delay = 0.0025;     // the gyro's delay behind the encoders [s] (filter + transport)
+  double heading_quantum = 0.0;   // q = (m_L + m_R)/b [rad]: one count on each wheel
+  double max_wheel_speed = 2.0;   // |wheel speed| the robot cannot exceed [m/s]
+  double max_wheel_accel = 10.0;  // |wheel acceleration| the robot cannot exceed [m/s^2]
+  double still_time = 0.5;        // [s] of unchanged counts before the gyro's mean is its bias
+  double bias_tau = 60.0;         // averaging horizon of the bias estimate [s]
+  double turn_rate_min = 0.1;     // [rad/s]: ticks turning at least this fast calibrate the scale
+  double scale_angle = 6.283185307179586;  // [rad] of such turns before the scale is applied
+  double scale_max_error = 0.05;           // scale estimates beyond 1 +- this are rejected
+};
+
+// check_gyrodometry: every field finite and in range; the error names the field and the range.
+Status check_gyrodometry(const GyrodometryParams& p);
+
+// What happened on one tick (several bits may be set).
+enum FusionFlag : std::uint32_t {
+  kFusionGyroUsed = 1u << 0,    // the heading increment is the gyro's (a flagged interval)
+  kFusionDisagree = 1u << 1,    // |E| > T on this tick's window
+  kFusionSpeedLimit = 1u << 2,  // a wheel faster than max_wheel_speed
+  kFusionAccelLimit = 1u << 3,  // a wheel accelerating beyond max_wheel_accel
+  kFusionGyroFault = 1u << 4,   // the gyro sample was flagged or not finite: odometry used
+  kFusionNoBias = 1u << 5,      // no bias estimate yet: odometry only, no detection
+  kFusionStill = 1u << 6,       // the encoders say the robot stands still
+  kFusionEventStart = 1u << 7,  // a flagged interval started on this tick
+};
+
+// Events since start; they only grow.
+struct FusionCounters {
+  std::uint64_t disagreements = 0;  // flagged intervals started by gyro/odometry disagreement
+  std::uint64_t speed_events = 0;   // ... by a wheel speed beyond the limit
+  std::uint64_t accel_events = 0;   // ... by a wheel acceleration beyond the limit
+  std::uint64_t gyro_faults = 0;    // transitions of the gyro into a faulty state
+  std::uint64_t flagged_ticks = 0;  // ticks whose heading came from the gyro
+};
+
+// One tick's input: the wheels' travels and the gyro's reading.
+struct FusionInput {
+  double dt = 0.0;         // tick length [s]
+  double d_left = 0.0;     // left wheel travel of the tick [m] (calibrated)
+  double d_right = 0.0;    // right wheel travel [m]
+  double wheelbase = 0.0;  // b [m]
+  GyroSample gyro;         // rate_z: mean rate over the tick [rad/s]
+};
+
+// One tick's output.
+struct FusedTick {
+  double dtheta = 0.0;       // heading increment to integrate this tick [rad]
+  double dtheta_odo = 0.0;   // odometry's own increment (d_R - d_L)/b [rad]
+  double var_heading = 0.0;  // heading variance the gyro adds when kFusionGyroUsed [rad^2]
+  std::uint32_t flags = 0;   // FusionFlag bits
+};
+
+class Gyrodometry {
+ public:
+  // create: validates the parameters and sizes the window (the only allocation).
+  static Result<Gyrodometry> create(const GyrodometryParams& p);
+
+  // step: fuse one tick; never allocates, never throws, never returns a non-finite dtheta for
+  // finite travels.
+  FusedTick step(const FusionInput& in) noexcept;
+  // reset: forget the window and any flagged interval (a set-pose); bias and scale are kept.
+  void reset() noexcept;
+  // set_scale_estimation: estimate the gyro's scale factor from turns (once odometry is
+  // calibrated: the estimate trusts odometry's heading on clean turns).
+  void set_scale_estimation(bool on) noexcept { scale_estimation_ = on; }
+
+  // threshold: T of the current window [rad] (see the top of this file).
+  double threshold() const noexcept;
+  double bias() const noexcept { return bias_; }  // [rad/s]
+  bool bias_valid() const noexcept { return bias_time_ >= p_.still_time; }
+  double scale() const noexcept { return scale_; }  // multiplies the bias-corrected rate
+  bool scale_valid() const noexcept { return scale_valid_; }
+  bool in_interval() const noexcept { return in_interval_; }
+  const FusionCounters& counters() const noexcept { return counters_; }
+  const GyrodometryParams& params() const noexcept { return p_; }
+  std::size_t window_ticks() const noexcept { return ring_.size(); }
+
+ private:
+  struct Entry {
+    double odo = 0.0;   // odometry's heading increment [rad]
+    double gyro = 0.0;  // the gyro's (bias- and scale-corrected) increment [rad]
+    double d_left = 0.0, d_right = 0.0;
+    bool gyro_ok = false;
+    bool replaced = false;  // already integrated with the gyro's increment
+  };
+  explicit Gyrodometry(const GyrodometryParams& p);
+  void update_bias(const FusionInput& in, bool rate_ok, bool still, double dt) noexcept;
+  void update_scale(double odo, double raw_gyro, double dt) noexcept;
+  void update_b_res() noexcept;
+  void push(const Entry& e) noexcept;
+  void resum() noexcept;
+  std::uint32_t limit_flags() const noexcept;
+  double begin_interval() noexcept;
+  Entry& at(std::size_t age) noexcept;  // age 0: the newest entry
+
+  GyrodometryParams p_;
+  std::vector<Entry> ring_;
+  std::size_t head_ = 0;         // index of the newest entry
+  std::size_t filled_ = 0;       // entries in use (<= ring size)
+  std::size_t half_ = 1;         // ticks in each half of the window (accelerations)
+  double noise_term_ = 0.0;      // k_sigma N sqrt(T_w) [rad]
+  double wheelbase_ = 1.0;       // of the last tick [m], for the delay term
+  double inv_t_h_ = 1.0;         // 1 / duration of half the window [1/s]
+  double b_res_ = 0.0;           // residual bias B_res [rad/s], updated with the estimate
+  double base_threshold_ = 0.0;  // q + k_sigma N sqrt(T_w) + B_res T_w [rad]
+  double v_max_tick_ = 0.0;      // max_wheel_speed * tick [m]
+  double dv_max_ = 0.0;          // max_wheel_accel * T_h^2 [m]
+  std::uint32_t wraps_ = 0;      // passes of the ring (for the periodic re-sum)
+  // Running sums over the window (re-summed from the ring every time it wraps).
+  double sum_err_ = 0.0;                      // sum (gyro - odo) of entries with gyro_ok
+  double sum_odo_ = 0.0;                      // sum odo
+  std::size_t bad_ = 0;                       // entries without a usable gyro increment
+  double sum_new_l_ = 0.0, sum_new_r_ = 0.0;  // travels of the newer half [m]
+  double sum_old_l_ = 0.0, sum_old_r_ = 0.0;  // travels of the older half [m]
+  // Bias and scale.
+  double still_for_ = 0.0;  // duration of the current run of zero travel [s]
+  double bias_ = 0.0;
+  double bias_time_ = 0.0;  // seconds of standstill averaged into bias_ (capped at bias_tau)
+  double scale_ = 1.0;
+  bool scale_valid_ = false;
+  bool scale_estimation_ = false;
+  double scale_odo_ = 0.0, scale_gyro_ = 0.0;  // sign-weighted sums over clean turns [rad]
+  // Flagged interval.
+  bool in_interval_ = false;
+  std::uint64_t interval_ticks_ = 0;
+  bool gyro_was_ok_ = true;
+  FusionCounters counters_;
+};
+
+// propagate_gyro_arc: the pose covariance of a tick whose heading came from the gyro: the same
+// state Jacobian as the wheels' arc (heading theta0, centre travel ds [m], turn dtheta [rad]),
+// the along-track noise of the wheels (variance var_ds [m^2], see wheel_travel_variance) and the
+// gyro's heading noise var_heading [rad^2] spread evenly along the arc, instead of the wheels'
+// differential noise (Chong-Kleeman's W+/b^2). Derivation in gyrodometry.cpp.
+void propagate_gyro_arc(Cov3& cov, double sin_theta0, double cos_theta0, double ds, double dtheta,
+                        double var_ds, double var_heading) noexcept;
+
+// along_track_variance: var_ds of the centre travel (d_L + d_R)/2 under the Chong-Kleeman wheel
+// noise (variance k^2 |d| per wheel): (k_L^2 |d_L| + k_R^2 |d_R|) / 4 [m^2].
+inline double along_track_variance(double d_left, double d_right,
+                                   const ErrorModelParams& k) noexcept {
+  return 0.25 * (k.k_left * k.k_left * (d_left < 0 ? -d_left : d_left) +
+                 k.k_right * k.k_right * (d_right < 0 ? -d_right : d_right));
+}
+
+}  // namespace odo

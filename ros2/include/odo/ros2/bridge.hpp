@@ -1,0 +1,70 @@
+// The ROS 2 output over DDS (Cyclone DDS, not ROS): one DDS participant publishing
+// nav_msgs/Odometry on rt<ns>/odom and tf2_msgs/TFMessage on rt/tf, and taking
+// geometry_msgs/PoseWithCovarianceStamped from rt<ns>/set_pose. Everything DDS runs on the
+// bridge's own thread (and Cyclone's): the loop thread only publishes snapshots that the
+// SampleSource reads, so a stalled network slows nothing but this thread. No Cyclone type
+// appears in this header.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "odo/hal/result.hpp"
+#include "odo/ros2/config.hpp"
+#include "odo/ros2/mapping.hpp"
+
+namespace odo::ros2 {
+
+// Called on the bridge thread at every publish tick: fills the newest sample and returns true,
+// or false when there is none yet. Must not block (e.g. read a triple buffer's front slot).
+using SampleSource = std::function<bool(OdomSample&)>;
+// Called on the bridge thread for every valid set_pose received (e.g. post it to the loop).
+using SetPoseSink = std::function<void(const SetPose&)>;
+
+struct BridgeStats {
+  std::uint64_t odom_published = 0;     // rt/odom samples written
+  std::uint64_t tf_published = 0;       // rt/tf samples written
+  std::uint64_t unchanged_skipped = 0;  // ticks whose sample had been published already
+  std::uint64_t write_errors = 0;       // dds_write failures (and stamps out of range)
+  std::uint64_t set_pose_received = 0;  // valid set_pose handed to the sink
+  std::uint64_t set_pose_rejected = 0;  // set_pose with a wrong frame or invalid values
+  // Age of the samples when their rt/odom write returned (monotonic now - sample time) [ns]:
+  // the bridge's share of the sample-to-receipt latency.
+  std::int64_t write_age_sum_ns = 0;
+  std::int64_t write_age_max_ns = 0;
+};
+
+class Bridge {
+ public:
+  // create: validates c (against loop_rate_hz), creates the DDS domain, participant, topics,
+  // writers and reader (allocates; configure time). Error names the field or the DDS call.
+  static Result<std::unique_ptr<Bridge>> create(const Config& c, double loop_rate_hz,
+                                                SampleSource source, SetPoseSink sink);
+  ~Bridge();
+  Bridge(const Bridge&) = delete;
+  Bridge& operator=(const Bridge&) = delete;
+
+  // start: runs the publish thread (rate_hz); error if it is running already.
+  Status start();
+  // stop: ends and joins the thread; idempotent. The destructor stops too.
+  void stop();
+  // stats: counters so far (any thread).
+  BridgeStats stats() const;
+
+ private:
+  struct Impl;
+  explicit Bridge(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+// cyclone_config_xml: the Cyclone DDS configuration the bridge uses for c (interfaces,
+// multicast, peers); "" when c leaves everything to Cyclone's defaults.
+std::string cyclone_config_xml(const Config& c);
+
+// realtime_minus_monotonic: CLOCK_REALTIME - CLOCK_MONOTONIC [ns], read between two monotonic
+// reads (the midpoint; error below half their distance, tens of ns).
+TimeNs realtime_minus_monotonic();
+
+}  // namespace odo::ros2

@@ -1,0 +1,53 @@
+// Configuration of the ROS 2 output ([ros2] in odometryd.toml) and its validation. Errors name
+// the field, the value and the allowed range; the config reader prefixes file and line.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "odo/hal/result.hpp"
+
+namespace odo::ros2 {
+
+// DDS port mapping (RTPS 9.6.1.1, PB 7400 + DG 250 * domain + offsets up to 11 + 2 * participant)
+// must stay below 65536: domains 0..232, the range ROS 2 documents for ROS_DOMAIN_ID.
+inline constexpr std::uint32_t kDomainIdMax = 232;
+inline constexpr std::size_t kNameLengthMax = 255;  // frame ids and the namespace [characters]
+inline constexpr double kRateMinHz = 0.1;
+
+struct Config {
+  bool enabled = false;
+  std::uint32_t domain_id = 0;           // ROS_DOMAIN_ID of the ROS 2 computer
+  std::string ns;                        // topic namespace: "" or "/robot1" -> rt/robot1/odom
+  std::string odom_frame = "odom";       // header.frame_id of /odom and of the transform
+  std::string base_frame = "base_link";  // child_frame_id
+  double rate_hz = 50.0;                 // publish rate, kRateMinHz .. the loop rate [Hz]
+  bool publish_tf = true;                // also publish odom -> base_link on rt/tf
+  std::vector<std::string> interfaces;   // network interfaces DDS may use ({} = DDS's choice)
+  std::vector<std::string> peers;        // unicast discovery peers ({} = multicast only)
+  bool multicast = true;                 // SPDP multicast discovery (false: peers only)
+};
+
+// validate_domain_id: domain_id in [0, kDomainIdMax].
+Status validate_domain_id(std::int64_t domain_id, std::string_view field);
+
+// validate_frame_id: a tf2 frame id: 1..255 characters of [A-Za-z0-9_/], not starting with a
+// digit or '/' (tf2 rejects a leading slash), no "//", no trailing '/', no "__".
+Status validate_frame_id(std::string_view id, std::string_view field);
+
+// validate_namespace: "" or a ROS 2 absolute namespace "/a/b" whose tokens follow the frame id
+// rules.
+Status validate_namespace(std::string_view ns, std::string_view field);
+
+// validate: every field of c; loop_rate_hz bounds rate_hz. Field names are "<prefix>.<key>".
+Status validate(const Config& c, double loop_rate_hz, std::string_view prefix = "ros2");
+
+// Topic names on the wire (ROS 2 prefixes "rt" to topics): rt<ns>/odom, rt<ns>/set_pose and
+// rt/tf (tf2_ros listens on the absolute /tf whatever the namespace).
+std::string odom_topic(const Config& c);
+std::string set_pose_topic(const Config& c);
+std::string tf_topic();
+
+}  // namespace odo::ros2

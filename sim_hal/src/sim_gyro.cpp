@@ -1,0 +1,169 @@
+#include "odo/sim/sim_gyro.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+namespace odo::sim {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kPerHour = 1.0 / 3600.0;
+
+}  // namespace
+
+GyroModel consumer_gyro() {
+  GyroModel m;
+  m.full_scale = 2000.0 * kDeg;
+  m.bits = 16;
+  m.noise_density = 0.014 * kDeg;                          // 2.443e-4 rad/s/sqrt(Hz)
+  m.bias_offset = 1.0 * kDeg;                              // 1.745e-2 rad/s
+  m.bias_walk = 2.0 * kDeg * kPerHour / std::sqrt(100.0);  // 9.70e-7 rad/s/sqrt(s)
+  m.scale_error = 0.005;
+  m.odr = 1000.0;
+  m.delay = 0.002;
+  return m;
+}
+
+GyroModel industrial_gyro() {
+  GyroModel m;
+  m.full_scale = 2000.0 * kDeg;
+  m.bits = 16;
+  m.noise_density = 0.34 / 60.0 * kDeg;                    // 9.89e-5 rad/s/sqrt(Hz)
+  m.bias_offset = 0.2 * kDeg;                              // 3.49e-3 rad/s
+  m.bias_walk = 8.0 * kDeg * kPerHour / std::sqrt(100.0);  // 3.88e-6 rad/s/sqrt(s)
+  m.scale_error = 0.002;
+  m.odr = 2000.0;
+  m.delay = 0.001;
+  return m;
+}
+
+Status check_gyro_model(const GyroModel& m) {
+  struct Row {
+    const char* field;
+    double v, lo, hi;
+  };
+  const Row rows[] = {
+      {"full_scale", m.full_scale, 1e-3, 1e3},
+      {"bits", double(m.bits), 8, 32},
+      {"noise_density", m.noise_density, 0, 1},
+      {"bias_offset", m.bias_offset, -10, 10},
+      {"bias_walk", m.bias_walk, 0, 1},
+      {"scale_error", m.scale_error, -0.5, 0.5},
+      {"odr", m.odr, 1, 100000},
+      {"delay", m.delay, 0, 1},
+  };
+  for (const Row& r : rows) {
+    if (std::isfinite(r.v) && r.v >= r.lo && r.v <= r.hi) continue;
+    std::ostringstream s;
+    s << "sim gyro " << r.field << " = " << r.v << " is outside [" << r.lo << ", " << r.hi << "]";
+    return make_error(Errc::kInvalidArgument, s.str());
+  }
+  return Ok{};
+}
+
+Result<SimGyro> SimGyro::create(SimRobot& robot, const GyroModel& m, std::uint64_t seed,
+                                TimeNs stale_timeout) {
+  if (auto s = check_gyro_model(m); !s) return std::move(s).error();
+  if (stale_timeout <= 0)
+    return make_error(Errc::kInvalidArgument, "sim gyro stale_timeout must be > 0 ns");
+  return SimGyro(robot, m, seed, stale_timeout);
+}
+
+SimGyro::SimGyro(SimRobot& robot, const GyroModel& m, std::uint64_t seed, TimeNs stale_timeout)
+    : robot_(robot), m_(m), normal_(seed) {
+  raw_max_ = (std::int64_t{1} << (m.bits - 1)) - 1;
+  lsb_ = m.full_scale / static_cast<double>(raw_max_ + 1);
+  period_ = from_seconds(1.0 / m.odr);
+  delay_ = from_seconds(m.delay);
+  // White rate noise of density N sampled at f: per-sample sigma N sqrt(f), so that the mean of
+  // the f T samples of T seconds, times T, has the angle random walk's sigma N sqrt(T).
+  sigma_ = m.noise_density * std::sqrt(1.0 / to_seconds(period_));
+  walk_step_ = m.bias_walk * std::sqrt(to_seconds(period_));
+  next_t_ = robot.time() + period_;
+  last_theta_ = robot.true_pose().theta;
+  book_.stale_timeout = stale_timeout;
+  book_.last_stamp = robot.time();
+  hist_[0] = {robot.time(), last_theta_};
+  hist_n_ = 1;
+}
+
+double SimGyro::heading_at(TimeNs t) const noexcept {
+  // Newest first: the wanted time is almost always between the last two reads.
+  const Past* newer = &hist_[hist_head_];
+  for (std::size_t i = 1; i < hist_n_; ++i) {
+    const Past& older = hist_[(hist_head_ + kHistory - i) % kHistory];
+    if (older.t <= t) {
+      const double span = static_cast<double>(newer->t - older.t);
+      if (span <= 0.0) return newer->theta;
+      const double f = static_cast<double>(t - older.t) / span;
+      return older.theta + f * (newer->theta - older.theta);
+    }
+    newer = &older;
+  }
+  return newer->theta;  // older than the history: the oldest known heading
+}
+
+double SimGyro::sample(double true_rate, bool& saturated) noexcept {
+  double r = (1.0 + m_.scale_error) * true_rate + m_.bias_offset + walk_ + sigma_ * normal_();
+  if (saturate_left_ > 0) {
+    --saturate_left_;
+    ++injected_.saturated_samples;
+    r = 2.0 * m_.full_scale;
+  }
+  const double q = std::nearbyint(r / lsb_);
+  const double hi = static_cast<double>(raw_max_), lo = -hi - 1.0;
+  saturated = q >= hi || q <= lo;
+  return (q > hi ? hi : (q < lo ? lo : q)) * lsb_;
+}
+
+GyroSample SimGyro::read(TimeNs now) noexcept {
+  robot_.advance_to(now);
+  hist_head_ = (hist_head_ + 1) % kHistory;
+  hist_[hist_head_] = {robot_.time(), robot_.true_pose().theta};
+  if (hist_n_ < kHistory) ++hist_n_;
+  if (silence_ > 0) {
+    silent_until_ = now + silence_;
+    silence_ = 0;
+  }
+  GyroSample s;
+  double sum = 0.0;
+  const double inv_period = 1.0 / to_seconds(period_);
+  // Every sample whose motion ended at next_t_ is available delay_ later.
+  while (next_t_ + delay_ <= now) {
+    const double theta = heading_at(next_t_);
+    const double true_rate = (theta - last_theta_) * inv_period;
+    last_theta_ = theta;
+    const TimeNs avail = next_t_ + delay_;
+    next_t_ += period_;
+    if (avail < silent_until_) {
+      ++injected_.silent_samples;
+      continue;
+    }
+    bool sat = false;
+    sum += sample(true_rate, sat);
+    ++s.samples;
+    book_.last_stamp = avail;
+    if (sat) {
+      s.flags |= kGyroSaturated;
+      ++book_.counters.saturated;
+    }
+  }
+  // The bias walks once per read by the samples' combined step (sigma K sqrt(n T_s)), drawn
+  // uniform with that sigma (sqrt(3) (2u - 1)): summed over many reads it is the same Brownian
+  // walk (central limit), at a fraction of a Gaussian draw's cost.
+  if (s.samples > 0 && walk_step_ > 0.0) {
+    const double u = normal_.uniform();
+    walk_ += walk_step_ * std::sqrt(3.0 * static_cast<double>(s.samples)) * (2.0 * u - 1.0);
+  }
+  book_.close(s, now, s.samples > 0 ? sum / s.samples : 0.0);
+  if (nan_left_ > 0) {
+    --nan_left_;
+    ++injected_.nan_reads;
+    s.rate_z = std::numeric_limits<double>::quiet_NaN();
+  }
+  return s;
+}
+
+}  // namespace odo::sim

@@ -1,0 +1,363 @@
+// Gyrodometry fusion: hand-derived thresholds, bias and scale estimation, coarse-encoder
+// quantisation, bump replacement, kinematic limits, gyro faults and the gyro covariance.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "odo/odometry/error_model.hpp"
+#include "odo/odometry/gyrodometry.hpp"
+#include "odo/odometry/pose.hpp"
+
+namespace odo {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kB = 0.34;      // wheelbase [m]
+constexpr double kTick = 0.005;  // 200 Hz
+// LabMate: 2048 cpr x 16 gear on a 0.15 m wheel: m = pi 0.15 / 32768 = 1.43811e-5 m;
+// q = 2 m / b = 8.459453e-5 rad. Direct drive (no gear): m = 2.300971e-4 m, q = 1.353512e-3 rad.
+constexpr double kQLabMate = 8.459452874369344e-05;
+constexpr double kMDirect = 2.3009711818284618e-04;
+constexpr double kQDirect = 1.353512459899095e-03;
+
+GyrodometryParams params(double q) {
+  GyrodometryParams p;
+  p.noise.rate_noise_density = 0.014 * kPi / 180.0;       // 2.443461e-4 rad/s/sqrt(Hz)
+  p.noise.bias_instability = 2.0 * kPi / 180.0 / 3600.0;  // 9.696274e-6 rad/s
+  p.noise.scale_tolerance = 0.01;
+  p.tick = kTick;
+  p.window = 0.1;
+  p.k_sigma = 5.0;
+  p.heading_quantum = q;
+  p.still_time = 0.5;
+  return p;
+}
+
+FusionInput input(double d_left, double d_right, double rate, std::uint32_t flags = kGyroOk) {
+  FusionInput in;
+  in.dt = kTick;
+  in.d_left = d_left;
+  in.d_right = d_right;
+  in.wheelbase = kB;
+  in.gyro.rate_z = rate;
+  in.gyro.flags = flags;
+  in.gyro.samples = 5;
+  return in;
+}
+
+// learn_bias: 201 ticks of standstill at gyro rate `bias`: still_time = 0.5 s is reached on the
+// 100th tick (100 additions of 0.005 give 0.5000000000000003), so ticks 100..201 are averaged:
+// bias_time = 102 * 0.005 = 0.51 s.
+void learn_bias(Gyrodometry& g, double bias) {
+  for (int i = 0; i < 201; ++i) g.step(input(0.0, 0.0, bias));
+  ASSERT_TRUE(g.bias_valid());
+}
+
+TEST(Gyrodometry, WindowIsTwentyTicksAndThresholdIsHandDerived) {
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  EXPECT_EQ(g.window_ticks(), 20u);  // 0.1 s / 0.005 s
+  learn_bias(g, 0.0);
+  // T = q + k N sqrt(T_w) + (B + N / sqrt(0.51 s)) T_w + s_tol |sum odo| with sum odo = 0:
+  //   5 * 2.443461e-4 * sqrt(0.1)                 = 3.863451e-4
+  //   (9.696274e-6 + 2.443461e-4 / 0.7141428) 0.1 = (9.696274e-6 + 3.421536e-4) 0.1 = 3.518499e-5
+  //   LabMate: 8.459453e-5 + 3.863451e-4 + 3.518499e-5 = 5.061246e-4
+  EXPECT_NEAR(g.threshold(), 5.061246e-4, 1e-9);
+  auto d = Gyrodometry::create(params(kQDirect)).value();
+  learn_bias(d, 0.0);
+  // Direct drive: 1.353512e-3 + 3.863451e-4 + 3.518499e-5 = 1.775042e-3
+  EXPECT_NEAR(d.threshold(), 1.775042e-3, 1e-9);
+}
+
+TEST(Gyrodometry, BiasLearnedAtStandstillOnly) {
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  // 1 deg/s offset = 0.01745329 rad/s. The first 99 ticks only confirm the standstill (still_time
+  // is reached on the 100th, see learn_bias).
+  const double bias = kPi / 180.0;
+  for (int i = 0; i < 99; ++i) {
+    const FusedTick t = g.step(input(0.0, 0.0, bias));
+    EXPECT_TRUE(t.flags & kFusionNoBias);
+    EXPECT_TRUE(t.flags & kFusionStill);
+    EXPECT_EQ(t.dtheta, 0.0);
+  }
+  EXPECT_EQ(g.bias(), 0.0);
+  // Averaging: the first averaged sample sets b = 0 + (r - 0) dt / dt = r exactly; a running
+  // mean of a constant stays it.
+  for (int i = 0; i < 99; ++i) {
+    g.step(input(0.0, 0.0, bias));
+    EXPECT_FALSE(g.bias_valid()) << i;  // 0.5 s of averaging are needed
+  }
+  g.step(input(0.0, 0.0, bias));  // the 100th averaged tick (0.5000000000000003 s again)
+  EXPECT_TRUE(g.bias_valid());
+  EXPECT_NEAR(g.bias(), bias, 1e-17);
+  // Moving: the bias is not touched even though the gyro reads something else.
+  for (int i = 0; i < 50; ++i) g.step(input(0.001, 0.001, 5.0 * bias));
+  EXPECT_NEAR(g.bias(), bias, 1e-17);
+}
+
+TEST(Gyrodometry, NoBiasMeansOdometryOnly) {
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  // Moving from the start: no standstill, no bias, so odometry's increment even when the gyro
+  // disagrees by a lot (it could be its 5 deg/s offset).
+  for (int i = 0; i < 100; ++i) {
+    const FusedTick t = g.step(input(0.001, 0.0011, 0.0));
+    EXPECT_EQ(t.dtheta, (0.0011 - 0.001) / kB);
+    EXPECT_EQ(t.flags & kFusionGyroUsed, 0u);
+    EXPECT_TRUE(t.flags & kFusionNoBias);
+  }
+  EXPECT_EQ(g.counters().disagreements, 0u);
+}
+
+TEST(Gyrodometry, CoarseEncoderTurnIsNeverFlagged) {
+  // Direct drive, 2048 cpr, turning on the spot at 0.05 rad/s: each wheel moves
+  // 0.05 * 0.34/2 = 0.0085 m/s = 4.25e-5 m = 0.1847 counts a tick. Odometry's heading comes in
+  // steps of m/b = 6.767e-4 rad (one wheel's count) while the gyro says 2.5e-4 rad every tick.
+  auto g = Gyrodometry::create(params(kQDirect)).value();
+  learn_bias(g, 0.003);
+  const double w = 0.05, v = w * kB / 2.0;
+  double fused = 0.0, odo = 0.0, max_tick_gap = 0.0;
+  std::int64_t prev_l = 0, prev_r = 0;
+  for (int i = 1; i <= 4000; ++i) {  // 20 s
+    const double travel = v * kTick * i;
+    // Both wheels' encoders start half a count from a boundary (as SimRobot's do).
+    const auto cl = static_cast<std::int64_t>(std::floor(-travel / kMDirect + 0.5));
+    const auto cr = static_cast<std::int64_t>(std::floor(travel / kMDirect + 0.5));
+    const double dl = static_cast<double>(cl - prev_l) * kMDirect;
+    const double dr = static_cast<double>(cr - prev_r) * kMDirect;
+    prev_l = cl;
+    prev_r = cr;
+    const FusedTick t = g.step(input(dl, dr, w + 0.003));
+    ASSERT_EQ(t.flags & kFusionGyroUsed, 0u) << "tick " << i;
+    fused += t.dtheta;
+    odo += t.dtheta_odo;
+    max_tick_gap = std::max(max_tick_gap, std::fabs(t.dtheta_odo - w * kTick));
+  }
+  // The window never flags, so the fused heading is odometry's, to the last bit.
+  EXPECT_EQ(fused, odo);
+  EXPECT_EQ(g.counters().disagreements, 0u);
+  // Per tick the disagreement reaches m/b - w dt = 6.767e-4 - 2.5e-4 = 4.27e-4 rad (a count
+  // arriving) while the per-tick gyro noise term is 5 N sqrt(0.005) = 8.64e-5: a tick-by-tick
+  // rule would have flagged it, a window of counts does not.
+  EXPECT_GT(max_tick_gap, 4.2e-4);
+  EXPECT_GT(max_tick_gap, 4.0 * 8.64e-5);
+}
+
+TEST(Gyrodometry, BumpReplacedOverTheWholeInterval) {
+  // LabMate at 0.2 m/s: 1 mm per tick on both wheels, heading 0, gyro exact (bias 0.01 rad/s).
+  // A bump under the left wheel over 20 ticks (0.1 s) over-counts 0.13 mm a tick: odometry's
+  // heading drops by 20 * 1.3e-4 / 0.34 = 7.647059e-3 rad (0.44 deg). Per tick the disagreement
+  // is 3.8235e-4, so the window crosses T = 5.0646e-4 on the bump's second tick; the correction
+  // then replaces both ticks, the interval runs until the window holds at most one bump tick,
+  // and every bump tick ends up with the gyro's increment 0: the fused heading stays 0.
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  learn_bias(g, 0.01);
+  double fused = 0.0, odo = 0.0, var = 0.0;
+  int used = 0, starts = 0;
+  for (int i = 0; i < 200; ++i) {
+    const bool bump = i >= 50 && i < 70;
+    const FusedTick t = g.step(input(bump ? 0.00113 : 0.001, 0.001, 0.01));
+    fused += t.dtheta;
+    odo += t.dtheta_odo;
+    var += t.var_heading;
+    used += (t.flags & kFusionGyroUsed) != 0;
+    starts += (t.flags & kFusionEventStart) != 0;
+    if (i == 51) EXPECT_TRUE(t.flags & kFusionEventStart);
+  }
+  EXPECT_NEAR(odo, -7.647059e-3, 1e-9);
+  EXPECT_NEAR(fused, 0.0, 1e-15);
+  EXPECT_EQ(starts, 1);
+  EXPECT_EQ(g.counters().disagreements, 1u);
+  // Interval: from tick 51 while the window holds 2+ bump ticks (2 * 3.8235e-4 > T), i.e. up to
+  // tick 87 (window 68..87): ticks 51..87 are flagged, 37 of them. On tick 51 the whole window
+  // (ticks 32..51) takes the gyro's increments, identical to odometry's on the 18 ticks before the
+  // bump: 20 + 36 = 56 ticks of gyro heading.
+  EXPECT_EQ(used, 37);
+  EXPECT_EQ(g.counters().flagged_ticks, 56u);
+  EXPECT_FALSE(g.in_interval());
+  // Heading variance of 56 gyro ticks, T = 0.28 s: N^2 T + b_res^2 T^2 (the per-tick bias terms
+  // b_res^2 dt^2 (2k + 1) add up to b_res^2 (n dt)^2), b_res = 3.518499e-4 (learn_bias):
+  //   5.970501e-8 * 0.28 + 1.237983e-7 * 0.0784 = 1.671740e-8 + 9.705787e-9 = 2.642319e-8
+  EXPECT_NEAR(var, 2.642319e-8, 1e-13);
+}
+
+TEST(Gyrodometry, WheelSpeedBeyondLimitFlagsASlip) {
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  learn_bias(g, 0.0);
+  for (int i = 0; i < 40; ++i) g.step(input(0.001, 0.001, 0.0));
+  // One tick with the left wheel at 0.012 m / 0.005 s = 2.4 m/s (limit 2 m/s): the heading of
+  // that tick is the gyro's 0 instead of odometry's -0.011/0.34.
+  const FusedTick t = g.step(input(0.012, 0.001, 0.0));
+  EXPECT_TRUE(t.flags & kFusionSpeedLimit);
+  EXPECT_TRUE(t.flags & kFusionGyroUsed);
+  EXPECT_NEAR(t.dtheta, 0.0, 1e-18);
+  EXPECT_EQ(g.counters().speed_events, 1u);
+}
+
+TEST(Gyrodometry, AccelerationFromHalfWindows) {
+  // Accelerating both wheels at 12 m/s^2 (limit 10): the halves' mean speeds differ by
+  // a T_h = 12 * 0.05 = 0.6 m/s, i.e. 0.03 m of half-window travel > 10 * 0.05^2 = 0.025 m.
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  learn_bias(g, 0.0);
+  bool flagged = false;
+  for (int i = 1; i <= 20 && !flagged; ++i) {
+    const double d = 12.0 * kTick * kTick * i;  // v = a t, d = v dt
+    flagged = (g.step(input(d, d, 0.0)).flags & kFusionAccelLimit) != 0;
+  }
+  EXPECT_TRUE(flagged);
+  EXPECT_EQ(g.counters().accel_events, 1u);
+  // 8 m/s^2 stays quiet.
+  auto h = Gyrodometry::create(params(kQLabMate)).value();
+  learn_bias(h, 0.0);
+  for (int i = 1; i <= 60; ++i) {
+    const double d = 8.0 * kTick * kTick * i;
+    EXPECT_EQ(h.step(input(d, d, 0.0)).flags & kFusionAccelLimit, 0u) << i;
+  }
+}
+
+TEST(Gyrodometry, FaultyGyroFallsBackToOdometry) {
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  learn_bias(g, 0.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  struct Case {
+    double rate;
+    std::uint32_t flags;
+  };
+  // NaN without a flag, a stale sample, a saturated one, a read error.
+  const Case cases[] = {{nan, kGyroOk},
+                        {0.0, kGyroStale},
+                        {34.9, kGyroSaturated},
+                        {0.0, kGyroReadError},
+                        {std::numeric_limits<double>::infinity(), 0}};
+  std::uint64_t faults = 0;
+  for (const Case& c : cases) {
+    // In the middle of a bump (odometry turning, gyro quiet) and for 5 ticks.
+    for (int i = 0; i < 5; ++i) {
+      const FusedTick t = g.step(input(0.0012, 0.001, c.rate, c.flags));
+      EXPECT_TRUE(t.flags & kFusionGyroFault);
+      EXPECT_EQ(t.flags & kFusionGyroUsed, 0u);
+      EXPECT_EQ(t.dtheta, (0.001 - 0.0012) / kB);
+      EXPECT_TRUE(std::isfinite(t.dtheta));
+    }
+    ++faults;
+    EXPECT_EQ(g.counters().gyro_faults, faults);  // one event per run of faulty samples
+    // Back to good samples: windows holding a faulty tick are not compared, so nothing is
+    // flagged for 20 ticks even though odometry disagrees with the gyro by 5.9e-4 a tick.
+    for (int i = 0; i < 19; ++i) {
+      EXPECT_EQ(g.step(input(0.0012, 0.001, 0.0)).flags & kFusionGyroUsed, 0u) << i;
+    }
+    // Once the faulty ticks have left the window, the 19 good disagreeing ticks in it are
+    // detected (19 * 5.88e-4 rad > T) and replaced: one event per case.
+    for (int i = 0; i < 40; ++i) g.step(input(0.001, 0.001, 0.0));
+    EXPECT_EQ(g.counters().disagreements, faults);
+  }
+}
+
+TEST(Gyrodometry, FaultDuringIntervalEndsIt) {
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  learn_bias(g, 0.0);
+  for (int i = 0; i < 40; ++i) g.step(input(0.001, 0.001, 0.0));
+  for (int i = 0; i < 3; ++i) g.step(input(0.0015, 0.001, 0.0));
+  ASSERT_TRUE(g.in_interval());
+  const FusedTick t = g.step(input(0.0015, 0.001, 0.0, kGyroStale));
+  EXPECT_FALSE(g.in_interval());
+  EXPECT_EQ(t.dtheta, (0.001 - 0.0015) / kB);
+}
+
+TEST(Gyrodometry, ScaleFactorFromTurns) {
+  // The gyro reads 0.5 % high: while turning at 0.5 rad/s its window exceeds odometry's by
+  // 0.005 * 0.05 = 2.5e-4 rad, under T = 5.06e-4 + 0.01 * 0.05, so nothing is flagged. After
+  // 2 pi of turns the estimate is sum odo / sum gyro = 1/1.005 (exact inputs: no quantisation).
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  g.set_scale_estimation(true);
+  learn_bias(g, 0.02);
+  const double w = 0.5, d = w * kB / 2.0 * kTick;
+  for (int i = 0; i < 2600 && !g.scale_valid(); ++i) {  // 2 pi at 0.5 rad/s: 12.57 s, 2514 ticks
+    g.step(input(-d, d, 1.005 * w + 0.02));
+  }
+  ASSERT_TRUE(g.scale_valid());
+  EXPECT_NEAR(g.scale(), 1.0 / 1.005, 1e-12);
+  EXPECT_EQ(g.counters().disagreements, 0u);
+}
+
+TEST(Gyrodometry, RejectsBadParameters) {
+  GyrodometryParams p = params(kQLabMate);
+  p.window = std::numeric_limits<double>::quiet_NaN();
+  auto r = Gyrodometry::create(p);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("window"), std::string::npos) << r.error().message;
+  p = params(kQLabMate);
+  p.bias_tau = 0.1;  // shorter than still_time
+  r = Gyrodometry::create(p);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("bias_tau"), std::string::npos) << r.error().message;
+}
+
+TEST(Gyrodometry, FusedUpdateIsOdometryWhenNothingIsFlagged) {
+  // The loop integrates FusedTick::dtheta with Odometry::update_fused. When the fusion passes
+  // odometry's own increment through, the pose must be bit-identical to update()'s.
+  const Kinematics k = Kinematics::create({0.15, 2048, 16, 0.34, 0.34, 1.0, 1.0}).value();
+  Odometry plain(k), fused(k);
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  std::uint64_t x = 12345;
+  for (int i = 0; i < 5000; ++i) {
+    x = x * 6364136223846793005ull + 1442695040888963407ull;  // LCG: counts -3..+12 per tick
+    const std::int64_t dl = static_cast<std::int64_t>((x >> 33) % 16) - 3;
+    const std::int64_t dr = static_cast<std::int64_t>((x >> 45) % 16) - 3;
+    FusionInput in = input(static_cast<double>(dl) * k.metres_per_count_left(),
+                           static_cast<double>(dr) * k.metres_per_count_right(), 0.0);
+    in.gyro.flags = kGyroStale;  // odometry only
+    const FusedTick t = g.step(in);
+    plain.update(dl, dr, kTick);
+    fused.update_fused(dl, dr, kTick, t.dtheta);
+  }
+  EXPECT_EQ(plain.pose().x, fused.pose().x);
+  EXPECT_EQ(plain.pose().y, fused.pose().y);
+  EXPECT_EQ(plain.pose().theta, fused.pose().theta);
+  EXPECT_EQ(plain.angular_velocity(), fused.angular_velocity());
+  // Another heading: straight counts, 1e-3 rad per tick from elsewhere: 100 ticks turn 0.1 rad.
+  Odometry turn(k);
+  for (int i = 0; i < 100; ++i) turn.update_fused(70, 70, kTick, 1e-3);
+  EXPECT_NEAR(turn.pose().theta, 0.1, 1e-15);
+  EXPECT_NEAR(turn.angular_velocity(), 0.2, 1e-15);
+}
+
+enum { XX = 0, XY = 1, XT = 2, YY = 4, YT = 5, TT = 8 };
+
+TEST(GyroCovariance, StraightLineHandValues) {
+  // ds = 2 m, no turn, var_ds = 1e-6 m^2, var_heading = 4e-6 rad^2 (derivation in
+  // gyrodometry.cpp): xx = var_ds = 1e-6, yy = v D^2 / 3 = 4e-6 * 4 / 3 = 5.333333e-6,
+  // yt = v D / 2 = 4e-6, tt = 4e-6, xy = xt = 0.
+  Cov3 p{};
+  propagate_gyro_arc(p, 0.0, 1.0, 2.0, 0.0, 1e-6, 4e-6);
+  EXPECT_NEAR(p[XX], 1e-6, 1e-21);
+  EXPECT_NEAR(p[YY], 16e-6 / 3.0, 1e-20);
+  EXPECT_NEAR(p[YT], 4e-6, 1e-20);
+  EXPECT_NEAR(p[TT], 4e-6, 1e-21);
+  EXPECT_EQ(p[XY], 0.0);
+  EXPECT_EQ(p[XT], 0.0);
+}
+
+TEST(GyroCovariance, EqualsChongKleemanForEqualWheels) {
+  // With k_L^2 |d_L| = k_R^2 |d_R| the wheels' cross terms W- vanish, and the wheels' heading
+  // noise is W+/b^2 with W+ = 2 k_L^2 |d_L|: giving the gyro exactly that heading variance must
+  // reproduce Chong-Kleeman on any arc (here 0.3 m and 0.5 m: phi = 0.5882 rad, series branch;
+  // and 0.1 m / 0.9 m: phi = 2.353 rad, closed forms), from any start heading.
+  for (const auto& [dl, dr] : {std::pair{0.3, 0.5}, std::pair{0.1, 0.9}, std::pair{-0.2, 0.2}}) {
+    // k_R^2 |d_R| = k_L^2 |d_L| makes W- = 0 on this arc.
+    const ErrorModelParams k{0.0005, 0.0005 * std::sqrt(std::fabs(dl) / std::fabs(dr))};
+    Cov3 ck{}, gy{};
+    const double th = 0.7;
+    for (int i = 0; i < 3; ++i) {  // three arcs, so the F P F^T part is exercised too
+      const double t0 = th + i * (dr - dl) / kB;
+      propagate_arc(ck, t0, dl, dr, kB, k);
+      const double wp = 2.0 * k.k_left * k.k_left * std::fabs(dl);
+      propagate_gyro_arc(gy, std::sin(t0), std::cos(t0), 0.5 * (dl + dr), (dr - dl) / kB,
+                         along_track_variance(dl, dr, k), wp / (kB * kB));
+    }
+    for (int i = 0; i < 9; ++i) EXPECT_NEAR(gy[i], ck[i], 1e-15 * std::fabs(ck[8]) + 1e-18) << i;
+  }
+}
+
+}  // namespace
+}  // namespace odo
