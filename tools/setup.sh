@@ -15,8 +15,12 @@ test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind
   can-utils python3-can iproute2  # CAN kernel tests in the VM (candump, cansend, ip, tc)
   rt-tests stress-ng systemd  # cyclictest + load for tools/jitter.sh; systemd-analyze verify
   clang-14 libclang-rt-14-dev libfuzzer-14-dev  # fuzz preset: clang-14 + libFuzzer (TESTING.md)
-  libfastrtps-dev fastddsgen  # the independent Fast DDS peer of the ROS 2 tests (fastddsgen: Java)
-  nodejs npm)  # cli_can: the DBC read by the npm library candied (tests/tools/dbc_candied.cjs)
+  libfastrtps-dev fastddsgen)  # the independent Fast DDS peer of the ROS 2 tests (fastddsgen: Java)
+# cli_can reads the DBC with the npm library candied (tests/tools/dbc_candied.cjs): node and npm.
+# Only when the machine has no node/npm commands: our machine image ships Node.js from
+# NodeSource, whose nodejs package bundles npm and Conflicts: npm, so asking apt for Debian's
+# npm there fails the whole install ("held broken packages").
+node_pkgs=(nodejs npm)
 # npm packages of the tests, installed into tools/node/ (not committed; cli_can looks there).
 npm_test_pkgs=(candied@2.2.0)
 # Cross builds (toolchains/, presets cross-aarch64 and cross-armhf) and the package checks
@@ -39,7 +43,10 @@ add_archs=()
 npm_want=()
 for arg in "$@"; do
   case $arg in
-    --tests) want+=("${test_pkgs[@]}"); npm_want+=("${npm_test_pkgs[@]}") ;;
+    --tests)
+      want+=("${test_pkgs[@]}"); npm_want+=("${npm_test_pkgs[@]}")
+      if ! command -v node >/dev/null || ! command -v npm >/dev/null; then want+=("${node_pkgs[@]}"); fi
+      ;;
     --cross)
       want+=("${cross_pkgs[@]}")
       for a in "${cross_archs[@]}"; do
