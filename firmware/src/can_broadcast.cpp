@@ -82,7 +82,8 @@ void CanLogWriter::drain() noexcept {
   while (ring_.pop(f)) {
     const std::size_t n =
         protocol::format_candump_line(line, sizeof line, epoch_ns_ + f.stamp, iface_.c_str(), f);
-    if (n > 0 && std::fwrite(line, 1, n, file_) == n) ++written_;
+    if (n > 0 && std::fwrite(line, 1, n, file_) == n)
+      written_.fetch_add(1, std::memory_order_relaxed);
   }
 }
 

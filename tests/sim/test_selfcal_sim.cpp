@@ -13,10 +13,10 @@
 #include <set>
 #include <vector>
 
+#include "odo/analysis/umbmark_tools.hpp"
 #include "odo/calibration/count_recorder.hpp"
 #include "odo/calibration/selfcal.hpp"
 #include "odo/calibration/umbmark.hpp"
-#include "odo/analysis/umbmark_tools.hpp"
 #include "odo/odometry/pose.hpp"
 #include "odo/sim/floor.hpp"
 #include "odo/sim/robot.hpp"

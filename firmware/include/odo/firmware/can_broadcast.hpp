@@ -61,7 +61,8 @@ class CanLogWriter {
   void start(std::int64_t epoch_ns);
   // stop: joins the thread after writing everything queued; closes the file.
   void stop();
-  std::uint64_t written() const noexcept { return written_; }
+  // written: lines written so far; safe to read from any thread while the writer runs.
+  std::uint64_t written() const noexcept { return written_.load(std::memory_order_relaxed); }
 
  private:
   CanLogWriter(std::FILE* f, std::string iface) : file_(f), iface_(std::move(iface)) {}
@@ -73,7 +74,9 @@ class CanLogWriter {
   std::int64_t epoch_ns_ = 0;
   std::atomic<bool> stop_{false};
   std::thread thread_;
-  std::uint64_t written_ = 0;
+  // Atomic: the writer thread counts, the status side may read while it runs (a plain
+  // counter was only safe to read after stop(); ThreadSanitizer found the mid-run read).
+  std::atomic<std::uint64_t> written_{0};
 };
 
 // Transmit and command counters; written by the loop thread, read after the run (or for the
