@@ -143,19 +143,7 @@ for f in "$clidir"/../fuzz/corpus/calibjson/*.json; do
 done
 
 # --- odomctl umbmark ---
-cat >runs.csv <<'CSV'
-direction,ex,ey
-cw,-0.096,-0.096
-cw,-0.094,-0.096
-cw,-0.098,-0.096
-cw,-0.096,-0.094
-cw,-0.096,-0.098
-ccw,-0.064,0.064
-ccw,-0.062,0.064
-ccw,-0.066,0.064
-ccw,-0.064,0.062
-ccw,-0.064,0.066
-CSV
+cp "$clidir/umbmark_runs.csv" runs.csv  # the hand-made set of test_umbmark.sh
 case_ c_umb_compute_json $C umbmark compute --runs runs.csv --side 4 --wheelbase 0.34 --json
 case_ c_umb_compute_text $C umbmark compute --runs runs.csv --side 4 --wheelbase 0.34
 case_ c_umb_compute_missing $C umbmark compute --runs nonexistent.csv --side 4 --wheelbase 0.34

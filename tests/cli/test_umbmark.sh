@@ -7,19 +7,7 @@ set -u
 # A hand-made data set: alpha = 0.01 rad, beta = 0.002 rad on a 4 m square (Eq. 6.19/6.20):
 # c.g. cw (-96, -96) mm, ccw (-64, 64) mm; each cluster 5 runs at the c.g. and +-2 mm in x or y,
 # so sigma = sqrt(8 * (2 mm)^2 / (10 - 2)) = 2 mm exactly.
-cat >"$tmp/runs.csv" <<'CSV'
-direction,ex,ey
-cw,-0.096,-0.096
-cw,-0.094,-0.096
-cw,-0.098,-0.096
-cw,-0.096,-0.094
-cw,-0.096,-0.098
-ccw,-0.064,0.064
-ccw,-0.062,0.064
-ccw,-0.066,0.064
-ccw,-0.064,0.062
-ccw,-0.064,0.066
-CSV
+cp "$(dirname "$0")/umbmark_runs.csv" "$tmp/runs.csv"
 run "$ODOMCTL" umbmark compute --runs "$tmp/runs.csv" --side 4 --wheelbase 0.34 --json \
   >"$tmp/r.json" 2>"$tmp/err"
 st=$?; check "compute exit 0 $(cat "$tmp/err")" $st
