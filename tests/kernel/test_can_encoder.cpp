@@ -28,6 +28,7 @@ using drivers::CanEncoderSource;
 using drivers::SocketCanBus;
 
 constexpr TimeNs kMs = 1'000'000;
+constexpr TimeNs kS = 1'000'000'000;
 
 struct Vcan {
   std::string name;
@@ -108,7 +109,10 @@ CanEncoderConfig odrive_config() {
   CanEncoderConfig c;
   c.left = drivers::odrive_count_layout(0);   // 0x00A
   c.right = drivers::odrive_count_layout(1);  // 0x02A
-  c.timeout = 100 * kMs;
+  // The decoding tests send single frames and read them back after settle(); under emulation on a
+  // loaded host those 50 one-millisecond sleeps have taken over 100 ms, and a frame that old is
+  // (rightly) stale. Staleness has its own test with its own timeout; here it must not interfere.
+  c.timeout = 10 * kS;
   c.max_counts_per_s = 1e9;  // these hand-made steps are not physical motion
   return c;
 }
@@ -265,8 +269,10 @@ TEST(CanEncoderKernel, ReceiveFloodDecoderKeepsUpLoopNeverBlocks) {
   ODO_REQUIRE_VM();
   Vcan v("vcce3");
   ASSERT_TRUE(v.ok);
+  CanEncoderConfig c = odrive_config();
+  c.timeout = 100 * kMs;  // a wheel that the flood starves for 100 ms must show as stale here
   Rig r;
-  ASSERT_TRUE(r.open(v.name, odrive_config()));
+  ASSERT_TRUE(r.open(v.name, c));
   // The loop runs SCHED_FIFO, else the busy senders on the VM's single CPU would preempt it
   // and the test would measure the scheduler.
   const FifoScope fifo;
