@@ -38,7 +38,51 @@ struct ValidateOpts {
   analysis::McOptions mc;
   std::string plot, csv;
   bool json = false;
+  bool twist = false;  // --twist: the ROS 2 twist covariance instead of the pose's
 };
+
+// run_validate_twist: `validate --twist`: the twist covariance the ROS 2 output publishes against
+// a Monte Carlo of one tick (analysis::run_twist_monte_carlo); sets exit_code.
+void run_validate_twist(const ValidateOpts& o, int& exit_code) {
+  auto r = analysis::run_twist_monte_carlo(o.mc);
+  if (!r) {
+    std::cerr << "odomctl errormodel validate: " << r.error().message << "\n";
+    exit_code = r.error().code == Errc::kInvalidArgument ? kExitBadInput : kExitFailed;
+    return;
+  }
+  const auto& p = r->predicted;
+  const auto& s = r->sample;
+  if (o.json) {
+    nlohmann::json j{{"runs", r->runs},
+                     {"twist", true},
+                     {"speed", o.mc.speed},
+                     {"wheelbase", o.mc.wheelbase},
+                     {"k_left", o.mc.k.k_left},
+                     {"k_right", o.mc.k.k_right},
+                     {"seed", o.mc.seed},
+                     {"predicted", {{p[0], p[1]}, {p[2], p[3]}}},
+                     {"sample", {{s[0], s[1]}, {s[2], s[3]}}},
+                     {"mean", r->mean},
+                     {"rel_error_diag", r->rel_error},
+                     {"max_rel_error_diag", r->max_rel_error_diag}};
+    std::cout << j.dump() << "\n";
+  } else {
+    std::cout << "twist over one tick, " << r->runs << " runs, circle of 2 m radius at "
+              << o.mc.speed << " m/s\n"
+              << "entry          predicted        sample           predicted/sample\n";
+    const char* names[3] = {"var(v)", "cov(v,omega)", "var(omega)"};
+    for (int i : {0, 1, 3}) {
+      std::cout << std::left << std::setw(15) << names[i == 3 ? 2 : i] << std::right
+                << std::scientific << std::setprecision(6) << std::setw(14) << p[i] << "   "
+                << std::setw(14) << s[i] << "   " << std::defaultfloat << std::setprecision(4)
+                << (s[i] != 0.0 ? p[i] / s[i] : 0.0) << "\n";
+    }
+    std::cout << "units: (m/s)^2, m rad/s^2, (rad/s)^2 (SI)\n"
+              << "max |pred - sample| / sample over the variances: " << r->max_rel_error_diag
+              << "\n";
+  }
+  exit_code = kExitOk;
+}
 
 // run_validate: `odomctl ... validate` once its options are parsed; sets exit_code.
 void run_validate(const ValidateOpts& o, int& exit_code) {
@@ -47,6 +91,7 @@ void run_validate(const ValidateOpts& o, int& exit_code) {
     exit_code = kExitBadInput;
     return;
   }
+  if (o.twist) return run_validate_twist(o, exit_code);
   std::cerr << "errormodel validate: " << o.mc.runs << " runs, "
             << analysis::path_description(o.mc.path) << ", k_L " << o.mc.k.k_left << ", k_R "
             << o.mc.k.k_right << " m^(1/2), b " << o.mc.wheelbase << " m, seed " << o.mc.seed
@@ -118,6 +163,8 @@ void add_validate(CLI::App& parent, int& exit_code) {
   c->add_option("--plot", o->plot, "write an SVG of the 95% error ellipses");
   c->add_option("--csv", o->csv, "write every run's error in the CSV format of `fit`");
   c->add_flag("--json", o->json, "print one JSON object on stdout");
+  c->add_flag("--twist", o->twist,
+              "the twist covariance of the ROS 2 output (one tick on a 2 m circle) instead");
   c->callback([o, &exit_code] { run_validate(*o, exit_code); });
 }
 

@@ -4,6 +4,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "mc_robot.hpp"
 #include "odo/analysis/error_model_tools.hpp"
 #include "odo/analysis/seed.hpp"
 #include "odo/hal/field_range.hpp"
@@ -79,18 +80,10 @@ Cov3 sample_covariance(const std::vector<PoseError>& e, PoseError* mean) {
 Result<McResult> run_error_monte_carlo(const McOptions& o,
                                        const std::function<void(int, int)>& progress) {
   if (auto s = check_mc_options(o); !s) return std::move(s).error();
-  KinematicParams p;
-  p.wheel_diameter = o.wheel_diameter;
-  p.counts_per_rev = 2048;
-  p.gear_ratio = 16;
-  p.wheelbase_nominal = p.wheelbase = o.wheelbase;
-  auto k = Kinematics::create(p);
-  if (!k) return std::move(k).error();
-  sim::RobotGeometry g;  // true geometry = believed: no systematic error, only the noise
-  g.wheel_diameter_left = g.wheel_diameter_right = o.wheel_diameter;
-  g.wheelbase = o.wheelbase;
-  g.counts_per_rev = p.counts_per_rev;
-  g.gear_ratio = p.gear_ratio;
+  auto robot = mc_robot(o);  // true geometry = believed: no systematic error, only the noise
+  if (!robot) return std::move(robot).error();
+  const sim::RobotGeometry& g = robot->truth;
+  const Kinematics* k = &robot->believed;
   const sim::Scenario path = make_path(o);
   // Two periods of standstill after the path so that the last reading sees the robot stopped.
   const double standstill = 2.0 / o.rate_hz;

@@ -7,6 +7,7 @@
 
 #include "odo/firmware/toml_reader.hpp"
 #include "odo/protocol/can_protocol.hpp"
+#include "odo/ros2/config.hpp"
 
 namespace odo::fw {
 
@@ -190,6 +191,28 @@ void read_can(TableReader t, CanSection& s, double loop_hz) {
   t.finish();
 }
 
+// ---- [ros2] (ROS 2 output; ranges and name rules are the ros2 library's) ----
+void read_ros2(TableReader t, ros2::Config& c, double loop_hz) {
+  c.enabled = t.boolean("enabled", c.enabled);
+  c.domain_id =
+      static_cast<std::uint32_t>(t.integer("domain_id", c.domain_id, 0, ros2::kDomainIdMax));
+  c.ns = t.string("namespace", c.ns);
+  c.odom_frame = t.string("odom_frame", c.odom_frame);
+  c.base_frame = t.string("base_frame", c.base_frame);
+  c.rate_hz = t.number("rate_hz", c.rate_hz, ros2::kRateMinHz, loop_hz, "Hz");
+  c.publish_tf = t.boolean("publish_tf", c.publish_tf);
+  c.interfaces = t.strings("interfaces", c.interfaces);
+  c.peers = t.strings("peers", c.peers);
+  c.multicast = t.boolean("multicast", c.multicast);
+  if (!t.ok()) return;
+  if (auto p = ros2::check(c, loop_hz)) t.reject(p->key, p->what);
+  if (c.enabled && !ros2::kBuiltWithDds)
+    t.reject("enabled",
+             "= true, but this odometryd was built without the ROS 2 output (-DODO_ROS2=OFF, no "
+             "Cyclone DDS): set enabled = false or use a build with -DODO_ROS2=ON");
+  t.finish();
+}
+
 // first_non_ascii: the first byte >= 0x80 as "line N, column C (byte 0xXX)", or "" if none.
 // The config is plain ASCII: toml++ 3.3 (Debian 12) reaches __builtin_unreachable() on some
 // non-ASCII characters (upstream issues #190 and #295; found here by fuzz_config), so such a
@@ -244,6 +267,9 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_can_encoder(root.sub("can_encoder"), c.can_encoder);
   read_error_model(root.sub("error_model"), c.error_model);
   read_can(root.sub("can"), c.can, c.loop.rate_hz);
+  ros2::Config ros2_cfg;
+  read_ros2(root.sub("ros2"), ros2_cfg, c.loop.rate_hz);
+  c.ros2 = std::make_shared<const ros2::Config>(std::move(ros2_cfg));
   root.finish();
   if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
   return c;

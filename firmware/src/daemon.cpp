@@ -24,6 +24,7 @@
 #include "odo/firmware/watchdog.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/sim/truth.hpp"
+#include "ros2_output.hpp"
 
 namespace odo::fw {
 namespace {
@@ -236,6 +237,11 @@ int Daemon::configure() {
   auto can = CanLink::create(cfg_->can, cfg_->loop.rate_hz, *loop_, o_.can_log, o_.virtual_time);
   if (!can) return fail(cfg_->source + ": " + can.error().message);
   can_ = std::move(can).value();
+  // ROS 2 output ([ros2] enabled): an observer of the loop plus the DDS thread.
+  auto ros2 = Ros2Output::create(cfg_->ros2.get(), cfg_->loop.rate_hz,
+                                 calibrated->params().wheelbase, cfg_->error_model, *loop_);
+  if (!ros2) return fail(cfg_->source + ": " + ros2.error().message);
+  ros2_ = std::move(ros2).value();
   reloader_ = std::make_unique<CalibrationReloader>(
       loop_->commands(), cfg_->robot, cfg_->calibration.store, cfg_->calibration.backend, log_);
   if (o_.reload != nullptr) reloader_->start(*o_.reload);
@@ -252,6 +258,7 @@ void Daemon::report_start(const KinematicParams& p) {
        << (cal_->state == calib::StoreStatus::kOk ? " (calibrated)\n"
                                                   : " (nominal values from the config)\n")
        << "odometryd: can: " << (can_ ? can_->describe() : std::string("off")) << "\n"
+       << (ros2_ ? "odometryd: ros2: " + ros2_->describe() + "\n" : std::string())
        << "odometryd: loop " << cfg_->loop.rate_hz << " Hz on "
        << (o_.virtual_time ? "virtual time" : "CLOCK_MONOTONIC") << std::endl;
 }
@@ -271,6 +278,11 @@ int Daemon::run(std::atomic<bool>& stop) {
                                       : std::string("off"))
          << std::endl;
   }
+  // The DDS thread, like the status thread, starts before the real-time set-up (normal
+  // scheduling); it only reads the loop's snapshots.
+  if (ros2_) {
+    if (auto started = ros2_->start(); !started) return fail(started.error().message, 1);
+  }
   // The loop runs on this thread: real-time set-up after the status thread started, so that
   // thread keeps normal scheduling.
   if (!setup_realtime(cfg_->realtime, o_.virtual_time, log_, err_)) return 1;
@@ -283,6 +295,7 @@ int Daemon::run(std::atomic<bool>& stop) {
   loop_->run(from_seconds(duration), stop);
   // Clean stop (signal or end of --duration): the final pose and a status frame that says so.
   if (can_) can_->finish(loop_->snapshot());
+  if (ros2_) ros2_->stop();
   watchdog->stop();
   reloader_->stop();
   return 0;
@@ -306,7 +319,11 @@ void Daemon::report() {
   }
   log_ << std::defaultfloat << std::setprecision(6) << std::endl;
   if (o_.stats) print_timing_stats(log_, st, loop_->period());
-  if (o_.json) out_ << report_json(s, st, truth, can_.get()).dump() << std::endl;
+  if (o_.json) {
+    nlohmann::json j = report_json(s, st, truth, can_.get());
+    if (ros2_) j["ros2"] = ros2_->json();
+    out_ << j.dump() << std::endl;
+  }
 }
 
 int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& out,

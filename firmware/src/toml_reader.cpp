@@ -96,6 +96,23 @@ std::string TableReader::string(std::string_view key, std::string def) {
   return *s;
 }
 
+std::vector<std::string> TableReader::strings(std::string_view key, std::vector<std::string> def) {
+  const toml::node* n = get(key);
+  if (n == nullptr) return def;
+  const toml::array* a = n->as_array();
+  std::vector<std::string> v;
+  for (std::size_t i = 0; a != nullptr && i < a->size(); ++i) {
+    auto s = a->get(i)->value_exact<std::string>();
+    if (!s) break;
+    v.push_back(*s);
+  }
+  if (a == nullptr || v.size() != a->size()) {
+    fail(n, key, "must be an array of strings, e.g. [\"eth0\"]");
+    return def;
+  }
+  return v;
+}
+
 void TableReader::reject_choice(std::string_view key, const std::string& v,
                                 const std::string& list) {
   const toml::node* n = table_ != nullptr ? table_->get(key) : nullptr;

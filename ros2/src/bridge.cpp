@@ -47,36 +47,6 @@ void put_stamp(builtin_interfaces_msg_dds__Time_& t, const RosTime& r) {
 
 }  // namespace
 
-TimeNs realtime_minus_monotonic() {
-  const TimeNs m0 = now_ns(CLOCK_MONOTONIC);
-  const TimeNs r = now_ns(CLOCK_REALTIME);
-  const TimeNs m1 = now_ns(CLOCK_MONOTONIC);
-  return r - (m0 + (m1 - m0) / 2);
-}
-
-std::string cyclone_config_xml(const Config& c) {
-  if (c.interfaces.empty() && c.peers.empty() && c.multicast) return "";
-  // Validated text only (config.cpp: address_text), so nothing here needs XML escaping.
-  std::string x = "<CycloneDDS><Domain Id=\"any\"><General>";
-  if (!c.interfaces.empty()) {
-    x += "<Interfaces>";
-    for (const auto& i : c.interfaces) {
-      x += "<NetworkInterface name=\"" + i + "\"" + (c.multicast ? " multicast=\"true\"" : "") +
-           "/>";
-    }
-    x += "</Interfaces>";
-  }
-  x += std::string("<AllowMulticast>") + (c.multicast ? "true" : "false") + "</AllowMulticast>";
-  x += "</General>";
-  if (!c.peers.empty()) {
-    x += "<Discovery><ParticipantIndex>auto</ParticipantIndex><Peers>";
-    for (const auto& p : c.peers) x += "<Peer address=\"" + p + "\"/>";
-    x += "</Peers></Discovery>";
-  }
-  x += "</Domain></CycloneDDS>";
-  return x;
-}
-
 struct Bridge::Impl {
   Config cfg;
   SampleSource source;
@@ -250,6 +220,10 @@ void Bridge::Impl::run() {
     }
     cv.wait_until(lock, next, [this] { return stopping; });
   }
+  // The newest sample once more before the thread ends: after the loop stopped it is the final
+  // pose, so a subscriber's last message equals the daemon's final report.
+  lock.unlock();
+  publish_once();
 }
 
 Bridge::Bridge(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

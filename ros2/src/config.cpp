@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 namespace odo::ros2 {
 namespace {
@@ -52,62 +53,92 @@ std::string join(std::string_view prefix, std::string_view key) {
   return std::string(prefix) + "." + std::string(key);
 }
 
-}  // namespace
-
-Status validate_domain_id(std::int64_t domain_id, std::string_view field) {
-  if (domain_id < 0 || domain_id > kDomainIdMax) {
-    return reject(field, "= " + std::to_string(domain_id) + " is outside [0, " +
-                             std::to_string(kDomainIdMax) + "] (DDS port mapping)");
-  }
-  return Ok{};
+std::string domain_id_problem(std::int64_t domain_id) {
+  if (domain_id >= 0 && domain_id <= kDomainIdMax) return "";
+  return "= " + std::to_string(domain_id) + " is outside [0, " + std::to_string(kDomainIdMax) +
+         "] (DDS port mapping)";
 }
 
-Status validate_frame_id(std::string_view id, std::string_view field) {
+std::string frame_id_problem(std::string_view id) {
   const std::string p = name_problem(id);
-  if (!p.empty()) return reject(field, "= " + quoted(id) + " " + p + " (a tf2 frame id)");
-  return Ok{};
+  return p.empty() ? "" : "= " + quoted(id) + " " + p + " (a tf2 frame id)";
 }
 
-Status validate_namespace(std::string_view ns, std::string_view field) {
-  if (ns.empty()) return Ok{};
+std::string namespace_problem(std::string_view ns) {
+  if (ns.empty()) return "";
   const std::string p = ns.front() == '/' ? name_problem(ns.substr(1)) : "must start with '/'";
-  if (!p.empty()) return reject(field, "= " + quoted(ns) + " " + p + " (\"\" or \"/name\")");
-  return Ok{};
+  return p.empty() ? "" : "= " + quoted(ns) + " " + p + " (\"\" or \"/name\")";
 }
 
-Status validate(const Config& c, double loop_rate_hz, std::string_view prefix) {
-  if (auto s = validate_domain_id(c.domain_id, join(prefix, "domain_id")); !s) return s;
-  if (auto s = validate_namespace(c.ns, join(prefix, "namespace")); !s) return s;
-  if (auto s = validate_frame_id(c.odom_frame, join(prefix, "odom_frame")); !s) return s;
-  if (auto s = validate_frame_id(c.base_frame, join(prefix, "base_frame")); !s) return s;
-  if (c.odom_frame == c.base_frame) {
-    return reject(join(prefix, "base_frame"),
-                  "= " + quoted(c.base_frame) + " must differ from odom_frame");
-  }
-  if (!(c.rate_hz >= kRateMinHz && c.rate_hz <= loop_rate_hz)) {
-    std::ostringstream m;
-    m << "= " << c.rate_hz << " Hz is outside [" << kRateMinHz << ", " << loop_rate_hz
-      << "] (up to loop.rate_hz)";
-    return reject(join(prefix, "rate_hz"), m.str());
-  }
-  for (const auto& i : c.interfaces) {
+std::string rate_problem(double rate_hz, double loop_rate_hz) {
+  if (rate_hz >= kRateMinHz && rate_hz <= loop_rate_hz) return "";
+  std::ostringstream m;
+  m << "= " << rate_hz << " Hz is outside [" << kRateMinHz << ", " << loop_rate_hz
+    << "] (up to loop.rate_hz)";
+  return m.str();
+}
+
+std::string interfaces_problem(const std::vector<std::string>& interfaces) {
+  for (const auto& i : interfaces) {
     if (i.empty() || i.size() > 15 || !address_text(i)) {
-      return reject(join(prefix, "interfaces"), "entry " + quoted(i) +
-                                                    " must be 1..15 characters of A-Z a-z 0-9 . _ "
-                                                    "- : (a network interface)");
+      return "entry " + quoted(i) +
+             " must be 1..15 characters of A-Z a-z 0-9 . _ - : (a network interface)";
     }
   }
+  return "";
+}
+
+std::string peers_problem(const Config& c) {
   for (const auto& p : c.peers) {
     if (p.empty() || p.size() > kNameLengthMax || !address_text(p)) {
-      return reject(join(prefix, "peers"), "entry " + quoted(p) +
-                                               " must be a host name or address (A-Z a-z 0-9 . _ "
-                                               "- : [ ])");
+      return "entry " + quoted(p) + " must be a host name or address (A-Z a-z 0-9 . _ - : [ ])";
     }
   }
   if (!c.multicast && c.peers.empty()) {
-    return reject(join(prefix, "peers"),
-                  "must name at least one peer when multicast = false (nothing to discover)");
+    return "must name at least one peer when multicast = false (nothing to discover)";
   }
+  return "";
+}
+
+Status as_status(std::string_view field, const std::string& problem) {
+  if (problem.empty()) return Ok{};
+  return reject(field, problem);
+}
+
+}  // namespace
+
+Status validate_domain_id(std::int64_t domain_id, std::string_view field) {
+  return as_status(field, domain_id_problem(domain_id));
+}
+
+Status validate_frame_id(std::string_view id, std::string_view field) {
+  return as_status(field, frame_id_problem(id));
+}
+
+Status validate_namespace(std::string_view ns, std::string_view field) {
+  return as_status(field, namespace_problem(ns));
+}
+
+std::optional<ConfigProblem> check(const Config& c, double loop_rate_hz) {
+  const std::pair<std::string_view, std::string> checks[] = {
+      {"domain_id", domain_id_problem(c.domain_id)},
+      {"namespace", namespace_problem(c.ns)},
+      {"odom_frame", frame_id_problem(c.odom_frame)},
+      {"base_frame", frame_id_problem(c.base_frame)},
+      {"base_frame", c.odom_frame == c.base_frame
+                         ? "= " + quoted(c.base_frame) + " must differ from odom_frame"
+                         : ""},
+      {"rate_hz", rate_problem(c.rate_hz, loop_rate_hz)},
+      {"interfaces", interfaces_problem(c.interfaces)},
+      {"peers", peers_problem(c)}};
+  for (const auto& [key, what] : checks) {
+    if (!what.empty()) return ConfigProblem{std::string(key), what};
+  }
+  return std::nullopt;
+}
+
+Status validate(const Config& c, double loop_rate_hz, std::string_view prefix) {
+  if (auto p = check(c, loop_rate_hz)) return reject(join(prefix, p->key), p->what);
   return Ok{};
 }
 

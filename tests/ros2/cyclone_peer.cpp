@@ -137,8 +137,9 @@ int main(int argc, char** argv) {
   lat.skip = a.skip;
   int n_odom = 0, n_tf = 0;
   const double end = peer::monotonic_s() + a.timeout_s;
+  peer::Running running{end};
   double next_sp = 0;
-  while ((n_odom < a.odom || n_tf < a.tf) && peer::monotonic_s() < end) {
+  while (running.more(a, n_odom, n_tf)) {
     // 20 ms at most, to publish set_pose on time.
     dds_waitset_wait(e.ws, nullptr, 0, DDS_MSECS(20));
     n_odom += take_all<nav_msgs_msg_dds__Odometry_>(e.odom_r, [&](const auto& o, auto recv) {
@@ -154,7 +155,7 @@ int main(int argc, char** argv) {
     }
     std::fflush(stdout);
   }
-  const bool acked = !a.set_pose || ack_set_pose(e, &sp, end);
+  const bool acked = !a.set_pose || a.idle_s > 0 || ack_set_pose(e, &sp, end);
   const int status = peer::finish(a, lat, n_odom, n_tf, acked);
   dds_delete(e.dp);
   return status;

@@ -177,8 +177,9 @@ int main(int argc, char** argv) {
   lat.skip = a.skip;
   int n_odom = 0, n_tf = 0;
   const double end = peer::monotonic_s() + a.timeout_s;
+  peer::Running running{end};
   double next_sp = 0;
-  while ((n_odom < a.odom || n_tf < a.tf) && peer::monotonic_s() < end) {
+  while (running.more(a, n_odom, n_tf)) {
     e.odom_r->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 20000000));
     n_odom += take_all<nav_msgs::msg::dds_::Odometry_>(e.odom_r, [&](const auto& o, auto recv) {
       lat.add(o.header().stamp().sec(), o.header().stamp().nanosec(), recv);
@@ -194,7 +195,7 @@ int main(int argc, char** argv) {
     }
     std::fflush(stdout);
   }
-  const bool acked = !a.set_pose || ack_set_pose(e, sp, end);
+  const bool acked = !a.set_pose || a.idle_s > 0 || ack_set_pose(e, sp, end);
   const int status = peer::finish(a, lat, n_odom, n_tf, acked);
   e.dp->delete_contained_entities();
   DomainParticipantFactory::get_instance()->delete_participant(e.dp);

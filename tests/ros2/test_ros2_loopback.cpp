@@ -17,40 +17,17 @@
 #include <vector>
 
 #include "odo/ros2/bridge.hpp"
+#include "peer_run.hpp"
 #include "sim_source.hpp"
 #include "tsan_suppressions.hpp"
 
 namespace odo::ros2 {
 namespace {
 
+using test::PeerRun;
+using test::run_peer;
 using test::sample_k;
-
-struct PeerRun {
-  std::vector<std::string> lines;
-  int status = -1;
-};
-
-// run_peer: runs cmd, collects its stdout lines, returns them with the exit status.
-PeerRun run_peer(const std::string& cmd) {
-  PeerRun r;
-  FILE* f = popen(cmd.c_str(), "r");
-  if (!f) return r;
-  char buf[8192];
-  while (std::fgets(buf, sizeof buf, f)) {
-    std::string l(buf);
-    if (!l.empty() && l.back() == '\n') l.pop_back();
-    r.lines.push_back(l);
-  }
-  r.status = pclose(f);
-  return r;
-}
-
-std::vector<std::string> split(const std::string& l) {
-  std::istringstream in(l);
-  std::vector<std::string> t;
-  for (std::string w; in >> w;) t.push_back(w);
-  return t;
-}
+using test::split;
 
 TimeNs realtime_now() {
   timespec ts{};
@@ -188,7 +165,7 @@ class Ros2Loopback : public ::testing::Test {
 };
 
 int test_domain(int offset) {
-  return 100 + (static_cast<int>(getpid()) * 2 + offset) % 120;
+  return test::test_domain(offset, static_cast<int>(getpid()));
 }
 
 // Native builds only (tests/ros2/CMakeLists.txt: Fast DDS under qemu-user received nothing).
@@ -199,30 +176,14 @@ TEST_F(Ros2Loopback, FastDdsPeerDecodesOdomAndTfAndSendsSetPose) {
     GTEST_SKIP() << "Fast DDS peer not built: libfastrtps-dev and fastddsgen (tools/setup.sh "
                     "--tests) are needed";
   }
-  // Sanitizer builds: Debian's libfastrtps 2.9 deletes its StatisticsReaderImpl (64 bytes) as an
-  // RTPSReader (56) when the participant is torn down (ASan new-delete-type-mismatch inside the
-  // library), and ThreadSanitizer, blind to the uninstrumented library's locking, reports an
-  // unlock by a wrong thread inside it. Those checks are off for the peer process only (a test
-  // tool; the bridge's process keeps them all).
-  auto with = [](const char* var, const char* extra) {
-    const char* v = std::getenv(var);
-    return std::string(var) + "='" + (v ? v : "") + (v && *v ? " " : "") + extra + "' ";
-  };
-  const std::string env =
-      with("ASAN_OPTIONS", "new_delete_type_mismatch=0") + with("TSAN_OPTIONS", "report_bugs=0");
-  run(env + peer, "/robot7", test_domain(0));
+  run(test::fastdds_peer_env() + peer, "/robot7", test_domain(0));
   check_all();
 }
 #endif
 
 TEST_F(Ros2Loopback, CyclonePeerDecodesOdomAndTfAndSendsSetPose) {
   // The peer takes its network set-up from CYCLONEDDS_URI: loopback, unicast discovery.
-  setenv("CYCLONEDDS_URI",
-         "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/>"
-         "</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery>"
-         "<ParticipantIndex>auto</ParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers>"
-         "</Discovery></Domain></CycloneDDS>",
-         1);
+  setenv("CYCLONEDDS_URI", test::kCycloneLoopbackXml, 1);
   const std::string emulator = ODO_PEER_EMULATOR;
   run(emulator.empty() ? ODO_CYCLONE_PEER : emulator + " " + ODO_CYCLONE_PEER, "", test_domain(1));
   check_all();
@@ -232,6 +193,7 @@ TEST(Ros2Bridge, PublishesEachSampleOnceAndStopsWithoutWaitingForItsPeriod) {
   // A source that always returns the same sample, stamped 1 ns (not a CLOCK_MONOTONIC phase
   // the bridge could lock to): one write of odom and tf, then the free-running fallback waits a
   // whole period (rate 0.5 Hz: 2 s) before it reads again, and stop() must not wait for it.
+  // stop() reads once more and does not write the same sample twice.
   Config c;
   c.domain_id = static_cast<std::uint32_t>(test_domain(2));
   c.rate_hz = 0.5;
@@ -260,9 +222,11 @@ TEST(Ros2Bridge, PublishesEachSampleOnceAndStopsWithoutWaitingForItsPeriod) {
   const BridgeStats st = (*b)->stats();
   EXPECT_EQ(st.odom_published, 1u);
   EXPECT_EQ(st.tf_published, 1u);
-  // Read once at t = 0; the next read would have been at t = 2 s.
-  EXPECT_EQ(calls, 1);
-  EXPECT_EQ(st.unchanged_skipped, 0u);
+  // Read at t = 0 and once more when stopped (the final sample goes out before the thread
+  // ends); the read in between would have been at t = 2 s. The last read found the sample
+  // already published.
+  EXPECT_EQ(calls, 2);
+  EXPECT_EQ(st.unchanged_skipped, 1u);
   (*b)->stop();  // idempotent
 }
 

@@ -59,6 +59,22 @@ Cov3 sample_covariance(const std::vector<PoseError>& e, PoseError* mean = nullpt
 // [m] forward, then d back, no turn) for wheelbase b [m].
 Cov3 outback_covariance(double d, double b, const ErrorModelParams& k);
 
+struct TwistMcResult {
+  int runs = 0;
+  std::array<double, 4> predicted{};  // 2x2 over (v, omega), row-major [(m/s)^2, m rad/s^2, ...]
+  std::array<double, 4> sample{};     // sample covariance of true - measured (divisor runs - 1)
+  std::array<double, 2> mean{};       // mean error [m/s, rad/s]
+  std::array<double, 2> rel_error{};  // |predicted_ii - sample_ii| / sample_ii, v then omega
+  double max_rel_error_diag = 0.0;
+};
+
+// run_twist_monte_carlo: the twist covariance that the ROS 2 output publishes
+// (ros2::twist_covariance_from_wheels) against a Monte Carlo: the simulated robot (true =
+// believed) drives a circle of 2 m radius at o.speed with wheel noise k^2 |d| on its true travel,
+// and the loop's (v, omega) over the tick after 1 s is compared with the true twist over the
+// same interval, o.runs times. o.path is not used.
+Result<TwistMcResult> run_twist_monte_carlo(const McOptions& o);
+
 struct FitResult {
   int runs = 0;
   ErrorModelParams k;  // the fitted k_L, k_R [m^(1/2)]

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -13,6 +14,10 @@
 #include "odo/hal/result.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
+
+namespace odo::ros2 {
+struct Config;  // [ros2]: odo/ros2/config.hpp (its fields and checks are the ros2 library's)
+}
 
 namespace odo::fw {
 
@@ -244,6 +249,9 @@ struct Config {
   CanEncoderSection can_encoder;
   ErrorModelParams error_model;  // [error_model]: Chong-Kleeman k_L, k_R [m^(1/2)]
   CanSection can;
+  // [ros2]: the ROS 2 output over DDS (README "ROS 2"), off unless enabled = true; null when
+  // the config was not read from text (default_config: off).
+  std::shared_ptr<const ros2::Config> ros2;
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.

@@ -7,6 +7,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <toml++/toml.h>
 
@@ -26,6 +27,8 @@ class TableReader {
   std::int64_t integer(std::string_view key, std::int64_t def, std::int64_t lo, std::int64_t hi);
   bool boolean(std::string_view key, bool def);
   std::string string(std::string_view key, std::string def);
+  // strings: an array of strings (may be empty).
+  std::vector<std::string> strings(std::string_view key, std::vector<std::string> def);
   // choice: a string that must spell one of E's choices (config.hpp).
   template <class E>
   E choice(std::string_view key, E def) {

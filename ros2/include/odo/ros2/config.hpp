@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -16,6 +17,9 @@ namespace odo::ros2 {
 inline constexpr std::uint32_t kDomainIdMax = 232;
 inline constexpr std::size_t kNameLengthMax = 255;  // frame ids and the namespace [characters]
 inline constexpr double kRateMinHz = 0.1;
+// kBuiltWithDds: this build has the DDS bridge (-DODO_ROS2=ON); without it the configuration is
+// still read and checked, and enabled = true is an error.
+inline constexpr bool kBuiltWithDds = ODO_ROS2_DDS != 0;
 
 struct Config {
   bool enabled = false;
@@ -40,6 +44,16 @@ Status validate_frame_id(std::string_view id, std::string_view field);
 // validate_namespace: "" or a ROS 2 absolute namespace "/a/b" whose tokens follow the frame id
 // rules.
 Status validate_namespace(std::string_view ns, std::string_view field);
+
+// ConfigProblem: the first invalid key of a Config ("domain_id", "rate_hz", ...) and what is
+// wrong with it ("= 300 is outside [0, 232] ..."), for a reader that prefixes file, line, table.
+struct ConfigProblem {
+  std::string key;
+  std::string what;
+};
+
+// check: the first problem of c, in field order (loop_rate_hz bounds rate_hz); nullopt if none.
+std::optional<ConfigProblem> check(const Config& c, double loop_rate_hz);
 
 // validate: every field of c; loop_rate_hz bounds rate_hz. Field names are "<prefix>.<key>".
 Status validate(const Config& c, double loop_rate_hz, std::string_view prefix = "ros2");

@@ -1,0 +1,96 @@
+#include "ros2_output.hpp"
+
+#include <sstream>
+
+#include "odo/ros2/config.hpp"
+
+namespace odo::fw {
+
+Ros2Output::Ros2Output(double b, const ErrorModelParams& k, loop::OdometryLoop& loop)
+    : b_(b), k_(k), loop_(loop) {}
+
+Ros2Output::~Ros2Output() {
+  stop();
+}
+
+Result<std::unique_ptr<Ros2Output>> Ros2Output::create(const ros2::Config* c, double loop_hz,
+                                                       double b, const ErrorModelParams& k,
+                                                       loop::OdometryLoop& loop) {
+  if (c == nullptr || !c->enabled) return std::unique_ptr<Ros2Output>();
+  std::unique_ptr<Ros2Output> out(new Ros2Output(b, k, loop));
+  Ros2Output* self = out.get();
+  auto bridge = ros2::Bridge::create(
+      *c, loop_hz, [self](ros2::OdomSample& s) { return self->read(s); },
+      [self](const ros2::SetPose& p) { self->post(p); });
+  if (!bridge) return std::move(bridge).error();
+  out->bridge_ = std::move(bridge).value();
+  if (!loop.add_observer(self)) {
+    return make_error(Errc::kBusy, "ros2: the loop has no free observer slot");
+  }
+  std::ostringstream d;
+  d << "DDS domain " << c->domain_id << ", " << ros2::odom_topic(*c)
+    << (c->publish_tf ? " + " + ros2::tf_topic() : std::string()) << " at " << c->rate_hz << " Hz, "
+    << ros2::set_pose_topic(*c) << " taken; frames " << c->odom_frame << " -> " << c->base_frame;
+  out->describe_ = d.str();
+  return out;
+}
+
+void Ros2Output::on_tick(const loop::LoopSnapshot& snap) noexcept {
+  ros2::OdomSample& s = samples_.back();
+  s.sample_time = snap.stamp;
+  s.x = snap.pose.x;
+  s.y = snap.pose.y;
+  s.theta = snap.pose.theta;
+  s.pose_cov = snap.has_cov ? snap.cov : Cov3{};
+  s.v = snap.v;
+  s.omega = snap.w;
+  // The wheel travels of this tick, back from (v, omega) over its sample interval: the twist
+  // is their difference quotient, so its covariance is theirs (mapping.hpp).
+  const TimeNs dt_ns =
+      prev_stamp_ > 0 && snap.stamp > prev_stamp_ ? snap.stamp - prev_stamp_ : loop_.period();
+  prev_stamp_ = snap.stamp;
+  const double dt = to_seconds(dt_ns);
+  const double d_left = (snap.v - 0.5 * b_ * snap.w) * dt;
+  const double d_right = (snap.v + 0.5 * b_ * snap.w) * dt;
+  s.twist_cov = ros2::twist_covariance_from_wheels(d_left, d_right, dt, b_, k_);
+  samples_.publish();
+}
+
+bool Ros2Output::read(ros2::OdomSample& s) {
+  return samples_.latest(s);
+}
+
+void Ros2Output::post(const ros2::SetPose& p) {
+  // The loop takes a set pose as exact (its covariance becomes 0); p.cov is not used.
+  if (loop_.post(loop::SetPose{Pose2{p.x, p.y, p.theta}})) {
+    set_pose_posted_.fetch_add(1, std::memory_order_relaxed);
+  } else {
+    set_pose_dropped_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+Status Ros2Output::start() {
+  return bridge_->start();
+}
+
+void Ros2Output::stop() {
+  if (bridge_) bridge_->stop();
+}
+
+std::string Ros2Output::describe() const {
+  return describe_;
+}
+
+nlohmann::json Ros2Output::json() const {
+  const ros2::BridgeStats st = bridge_->stats();
+  return {{"odom_published", st.odom_published},
+          {"tf_published", st.tf_published},
+          {"write_errors", st.write_errors},
+          {"set_pose_received", st.set_pose_received},
+          {"set_pose_rejected", st.set_pose_rejected},
+          {"set_pose_posted", set_pose_posted_.load(std::memory_order_relaxed)},
+          {"set_pose_dropped", set_pose_dropped_.load(std::memory_order_relaxed)},
+          {"write_age_max", to_seconds(st.write_age_max_ns)}};
+}
+
+}  // namespace odo::fw
