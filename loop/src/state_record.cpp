@@ -7,6 +7,7 @@
 
 #include "odo/calibration/le_bytes.hpp"
 #include "odo/calibration/record.hpp"
+#include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
 
 namespace odo::loop {
@@ -165,6 +166,21 @@ ResumeDecision decide_resume(const StateRecord& rec, const ResumeContext& ctx,
     return fresh(ResumeReason::kCounterJump);
   d.reason = ResumeReason::kResumed;
   return d;
+}
+
+void fill_state_record(const OdometryLoop& loop, StateRecord& r) noexcept {
+  const Odometry& o = loop.odometry();
+  r.stamp = loop.last_stamp();
+  r.left = loop.last_left();
+  r.right = loop.last_right();
+  r.counter_bits = static_cast<std::uint8_t>(loop.counter_bits());
+  r.calibration_state = static_cast<std::uint8_t>(loop.calibration());
+  r.metres_per_count_left = o.kinematics().metres_per_count_left();
+  r.metres_per_count_right = o.kinematics().metres_per_count_right();
+  r.wheelbase = o.kinematics().wheelbase();
+  r.pose = o.pose();
+  r.cov = o.covariance();
+  r.distance = o.distance();
 }
 
 }  // namespace odo::loop

@@ -99,6 +99,7 @@ class OdometryLoop {
   std::int64_t last_left() const noexcept { return prev_left_; }
   std::int64_t last_right() const noexcept { return prev_right_; }
   TimeNs last_stamp() const noexcept { return prev_stamp_; }
+  int counter_bits() const noexcept { return bits_; }
   calib::StoreStatus calibration() const noexcept { return calibration_; }
   // tick: runs one period of the loop (sleeps until the deadline first).
   void tick() noexcept;
@@ -174,5 +175,11 @@ class OdometryLoop {
   ResumeDecision resume_;
   std::atomic<bool> resume_decided_{false};
 };
+
+// fill_state_record: the loop's state after its last tick into `r` (pose, covariance, distance,
+// reference counts and their sample time, counter width, kinematics, calibration status); the
+// identity fields (sequence, boot id, clock epoch, backend, calibration sequence) are the
+// caller's. Loop thread (an observer) or after run() returned; no allocation.
+void fill_state_record(const OdometryLoop& loop, StateRecord& r) noexcept;
 
 }  // namespace odo::loop
