@@ -231,6 +231,14 @@ struct CanSection {
   double reopen_period = 1.0;      // [s] 0.01..60: retry period when the interface vanished
 };
 
+// [resume]: the pose that survives restarts (issue 17; README "Restarts").
+struct ResumeSection {
+  bool enabled = true;                            // read the record at start and keep writing it
+  std::string path = "/run/odometryd/state.bin";  // two-slot state record (tmpfs)
+  double rate_hz = 50.0;                          // [Hz] records written per second, 1..loop rate
+  double max_age = 5.0;                           // [s] 0.01..3600: oldest record resumed from
+};
+
 struct Config {
   std::string source = "<built-in>";  // file the config came from
   LoopSection loop;
@@ -244,6 +252,7 @@ struct Config {
   CanEncoderSection can_encoder;
   ErrorModelParams error_model;  // [error_model]: Chong-Kleeman k_L, k_R [m^(1/2)]
   CanSection can;
+  ResumeSection resume;
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.

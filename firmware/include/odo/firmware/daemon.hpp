@@ -32,6 +32,7 @@ struct AppliedCalibration;
 class Rig;
 class CanLink;
 class CalibrationReloader;
+struct ResumeWiring;
 
 // Daemon: odometryd in three steps: configure (config, calibration store, rig, loop, CAN link,
 // reloader; start-up report), run (status thread, systemd watchdog, real-time set-up, the loop
@@ -59,6 +60,7 @@ class Daemon {
   std::unique_ptr<loop::OdometryLoop> loop_;
   std::unique_ptr<CanLink> can_;
   std::unique_ptr<CalibrationReloader> reloader_;
+  std::unique_ptr<ResumeWiring> resume_;  // issue 17: persisted state (null in virtual time)
 };
 
 // run_daemon: runs the firmware until stop, duration or signal; returns the process exit code.
