@@ -1,6 +1,7 @@
 // odomctl: the command-line tool (replay, calibration, error model, protocol decoding).
 #include <iostream>
 
+#include "cmd_state.hpp"
 #include "commands.hpp"
 #include "odo/firmware/cli_parse.hpp"
 #include "odo/firmware/version.hpp"
@@ -15,6 +16,7 @@ int main(int argc, char** argv) {
   odo::ctl::add_errormodel(app, exit_code);
   odo::ctl::add_umbmark(app, exit_code);
   odo::ctl::add_decode(app, exit_code);
+  odo::ctl::add_state(app, exit_code);
   // Parse errors give kExitBadInput (2), as odometryd.
   if (auto rc = odo::fw::parse_command_line(app, argc, argv, "odomctl")) return *rc;
   return exit_code;

@@ -1,5 +1,7 @@
 #include "odo/calibration/record.hpp"
 
+#include "odo/calibration/le_bytes.hpp"
+
 #include <ctime>
 
 #include <bit>
@@ -30,28 +32,14 @@ constexpr std::uint32_t kFlagEmaxBefore = 1U << 4;
 constexpr std::uint32_t kFlagEmaxAfter = 1U << 5;
 constexpr std::uint32_t kFlagFit = 1U << 6;  // version 2: the fit fields at 104 .. 143
 
-// Little-endian field access, independent of the host's byte order.
 template <class T>
 void put(std::vector<std::uint8_t>& b, std::size_t off, T v) {
-  std::uint64_t u = 0;
-  if constexpr (std::is_same_v<T, double>) {
-    u = std::bit_cast<std::uint64_t>(v);
-  } else {
-    u = static_cast<std::uint64_t>(v);
-  }
-  for (std::size_t i = 0; i < sizeof(T); ++i) b[off + i] = static_cast<std::uint8_t>(u >> (8 * i));
+  put_le(std::span<std::uint8_t>(b), off, v);
 }
 
 template <class T>
 T get(std::span<const std::uint8_t> b, std::size_t off) {
-  std::uint64_t u = 0;
-  for (std::size_t i = 0; i < sizeof(T); ++i)
-    u |= static_cast<std::uint64_t>(b[off + i]) << (8 * i);
-  if constexpr (std::is_same_v<T, double>) {
-    return std::bit_cast<double>(u);
-  } else {
-    return static_cast<T>(u);
-  }
+  return get_le<T>(b, off);
 }
 
 Error corrupt(const std::string& why) {

@@ -213,6 +213,16 @@ void read_ros2(TableReader t, ros2::Config& c, double loop_hz) {
   t.finish();
 }
 
+// ---- [resume] (pose that survives restarts) ----
+void read_resume(TableReader t, ResumeSection& s, double loop_hz) {
+  s.enabled = t.boolean("enabled", s.enabled);
+  s.path = t.string("path", s.path);
+  if (s.path.empty()) t.reject("path", "= \"\" must name the state file");
+  s.rate_hz = t.number("rate_hz", s.rate_hz, 1.0, loop_hz, "Hz");
+  s.max_age = t.number("max_age", s.max_age, 0.01, 3600.0, "s");
+  t.finish();
+}
+
 // first_non_ascii: the first byte >= 0x80 as "line N, column C (byte 0xXX)", or "" if none.
 // The config is plain ASCII: toml++ 3.3 (Debian 12) reaches __builtin_unreachable() on some
 // non-ASCII characters (upstream issues #190 and #295; found here by fuzz_config), so such a
@@ -270,6 +280,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   ros2::Config ros2_cfg;
   read_ros2(root.sub("ros2"), ros2_cfg, c.loop.rate_hz);
   c.ros2 = std::make_shared<const ros2::Config>(std::move(ros2_cfg));
+  read_resume(root.sub("resume"), c.resume, c.loop.rate_hz);
   root.finish();
   if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
   return c;

@@ -20,6 +20,7 @@
 #include "odo/firmware/config.hpp"
 #include "odo/firmware/realtime_setup.hpp"
 #include "odo/firmware/rig.hpp"
+#include "odo/firmware/state_persist.hpp"
 #include "odo/firmware/timing_report.hpp"
 #include "odo/firmware/watchdog.hpp"
 #include "odo/loop/loop.hpp"
@@ -245,6 +246,9 @@ int Daemon::configure() {
   reloader_ = std::make_unique<CalibrationReloader>(
       loop_->commands(), cfg_->robot, cfg_->calibration.store, cfg_->calibration.backend, log_);
   if (o_.reload != nullptr) reloader_->start(*o_.reload);
+  // Pose that survives restarts: not in virtual time (its clock restarts with the process).
+  if (!o_.virtual_time)
+    resume_ = std::make_unique<ResumeWiring>(prepare_resume(*cfg_, *loop_, cal_->sequence, log_));
   report_start(calibrated->params());
   return 0;
 }
@@ -292,7 +296,12 @@ int Daemon::run(std::atomic<bool>& stop) {
     clock_gettime(CLOCK_REALTIME, &wall);
     can_->start(static_cast<std::int64_t>(wall.tv_sec) * kNsPerSecond + wall.tv_nsec);
   }
+  if (resume_ && resume_->persister) {
+    resume_->persister->start(
+        log_, resume_->offered ? std::nullopt : std::optional(resume_->reason), resume_->note);
+  }
   loop_->run(from_seconds(duration), stop);
+  if (resume_ && resume_->persister) resume_->persister->stop();
   // Clean stop (signal or end of --duration): the final pose and a status frame that says so.
   if (can_) can_->finish(loop_->snapshot());
   if (ros2_) ros2_->stop();
@@ -322,6 +331,14 @@ void Daemon::report() {
   if (o_.json) {
     nlohmann::json j = report_json(s, st, truth, can_.get());
     if (ros2_) j["ros2"] = ros2_->json();
+    if (resume_) {
+      const loop::ResumeReason why = resume_reason(*resume_, *loop_);
+      j["resume"] = {
+          {"resumed", why == loop::ResumeReason::kResumed},
+          {"reason", std::string(loop::resume_reason_name(why))},
+          {"gap",
+           why == loop::ResumeReason::kResumed ? to_seconds(loop_->resume_decision().gap) : 0.0}};
+    }
     out_ << j.dump() << std::endl;
   }
 }

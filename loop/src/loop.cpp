@@ -40,6 +40,7 @@ bool OdometryLoop::add_observer(TickObserver* o) noexcept {
 
 void OdometryLoop::start() noexcept {
   const EncoderSample s = enc_->read(clock_->now());
+  if (resume_offered_) apply_resume(s);
   prev_left_ = s.left;
   prev_right_ = s.right;
   prev_stamp_ = s.stamp;
@@ -52,7 +53,27 @@ void OdometryLoop::start() noexcept {
   b.encoder_flags = s.flags;
   b.encoder_counters = s.counters;
   b.calibration_state = calibration_;
+  b.pose = odom_.pose();
+  b.distance = odom_.distance();
+  b.cov = odom_.covariance();
   published_.publish();
+  resume_decided_.store(true, std::memory_order_release);
+}
+
+void OdometryLoop::resume_from(const StateRecord& rec, const ResumeContext& ctx) noexcept {
+  resume_rec_ = rec;
+  resume_ctx_ = ctx;
+  resume_offered_ = true;
+}
+
+void OdometryLoop::apply_resume(const EncoderSample& s) noexcept {
+  resume_ctx_.now = clock_->now();
+  resume_ = decide_resume(resume_rec_, resume_ctx_, s);
+  if (!resume_.resumed()) return;
+  odom_.restore(resume_rec_.pose, resume_rec_.cov, resume_rec_.distance);
+  // The downtime is one long step, as after an overrun: its counts are integrated exactly
+  // once (the arc of a constant-curvature gap is exact) and the covariance grows for it.
+  odom_.advance(resume_.dl, resume_.dr, to_seconds(resume_.gap));
 }
 
 LoopSnapshot& OdometryLoop::copy_newest() noexcept {

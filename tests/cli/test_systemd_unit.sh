@@ -18,7 +18,8 @@ out=$(systemd-analyze verify --man=no "$tmp/odometryd.service" 2>&1); rc=$?
 [ -z "$out" ] || echo "$out"
 [ $rc = 0 ] && [ -z "$out" ] || { echo "FAIL: systemd-analyze verify"; exit 1; }
 for key in Type=notify WatchdogSec= 'AmbientCapabilities=CAP_SYS_NICE CAP_IPC_LOCK' \
-  'CapabilityBoundingSet=CAP_SYS_NICE CAP_IPC_LOCK' NoNewPrivileges=yes; do
+  'CapabilityBoundingSet=CAP_SYS_NICE CAP_IPC_LOCK' NoNewPrivileges=yes \
+  RuntimeDirectory=odometryd RuntimeDirectoryPreserve=restart; do
   grep -q "^$key" "$unit" || { echo "FAIL: $key missing"; exit 1; }
 done
 echo "systemd unit: verify clean"

@@ -3,6 +3,9 @@
 // firmware's loop on the simulated robot for 200,000 ticks.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
+
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
@@ -13,6 +16,7 @@
 #include "odo/firmware/can_broadcast.hpp"
 #include "odo/firmware/config.hpp"
 #include "odo/firmware/rig.hpp"
+#include "odo/firmware/state_persist.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/protocol/can_protocol.hpp"
 #include "odo/sim/sim_can_bus.hpp"
@@ -313,6 +317,19 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   ASSERT_TRUE(can.ok()) << can.error().message;
   ASSERT_NE((*can)->sim_port(), nullptr);
   (*can)->start(0);
+  // Persistence on (issue 17): the observer hands the state to the writer thread at 50 Hz and
+  // at once on set-pose; the thread writes the state file while the window is open.
+  const std::string state_path = ::testing::TempDir() + "zero_alloc_state.bin";
+  std::remove(state_path.c_str());
+  std::ofstream state_log("/dev/null");
+  // The writer thread logs the resume decision once, maybe inside the window: the stream's
+  // buffer is allocated here, by a first write, so that line allocates nothing.
+  state_log << "resume log\n" << std::flush;
+  auto persister =
+      fw::StatePersister::create(state_path, 50.0, cfg.loop.rate_hz, *loop, loop::StateRecord{});
+  ASSERT_TRUE(persister.ok()) << persister.error().message;
+  loop->add_observer(persister->get());
+  (*persister)->start(state_log, loop::ResumeReason::kNoRecord, "");
   loop->start();
 
   constexpr std::uint64_t kTicks = 200'000;  // 200 s at 1 kHz: both squares, then standstill
@@ -346,6 +363,7 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
       }
     }
     (*can)->send_final(loop->snapshot());  // the clean-stop frames: no allocation either
+    (*persister)->stop();                  // joins the writer after its last write
     w.disarm();
     (*can)->close_log();  // joins the writer thread and closes the file: frees, off the loop path
     EXPECT_EQ(g_allocs.load(), 0u) << "heap allocations during " << kTicks << " ticks";
@@ -358,6 +376,17 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   EXPECT_EQ((*can)->counters().dropped(), 0u);
   EXPECT_EQ((*can)->counters().set_pose_applied, 1u);
   EXPECT_EQ(loop->commands_applied(), 2u);  // the calibration and the set-pose command
+  // Records: every 20th tick of 200,000 (1 kHz / 50 Hz) is 10,000; each command's tick adds
+  // one and restarts the count of 20 (which loses at most the partial period before it), and
+  // stop() adds the final state: 10,001 .. 10,003. The file holds the last, the final pose.
+  EXPECT_EQ((*persister)->write_errors(), 0u);
+  EXPECT_GT((*persister)->written(), 0u);
+  auto saved = fw::read_state_file(state_path);
+  ASSERT_TRUE(saved.ok()) << saved.error().message;
+  EXPECT_GE(saved->sequence, 10'001u);
+  EXPECT_LE(saved->sequence, 10'003u);
+  EXPECT_EQ(saved->pose.x, loop->snapshot().pose.x);
+  EXPECT_EQ(saved->pose.theta, loop->snapshot().pose.theta);
   EXPECT_EQ(loop->snapshot().calibration_state, calib::StoreStatus::kOk);
   // The writer runs on wall time and the loop here is faster than real time: what the ring
   // could not hold is counted, never waited for.

@@ -236,6 +236,14 @@ struct CanSection {
   double reopen_period = 1.0;      // [s] 0.01..60: retry period when the interface vanished
 };
 
+// [resume]: the pose that survives restarts (issue 17; README "Restarts").
+struct ResumeSection {
+  bool enabled = true;                            // read the record at start and keep writing it
+  std::string path = "/run/odometryd/state.bin";  // two-slot state record (tmpfs)
+  double rate_hz = 50.0;                          // [Hz] records written per second, 1..loop rate
+  double max_age = 5.0;                           // [s] 0.01..3600: oldest record resumed from
+};
+
 struct Config {
   std::string source = "<built-in>";  // file the config came from
   LoopSection loop;
@@ -252,6 +260,7 @@ struct Config {
   // [ros2]: the ROS 2 output over DDS (README "ROS 2"), off unless enabled = true; null when
   // the config was not read from text (default_config: off).
   std::shared_ptr<const ros2::Config> ros2;
+  ResumeSection resume;
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.

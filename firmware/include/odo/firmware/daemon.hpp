@@ -33,6 +33,7 @@ class Rig;
 class CanLink;
 class CalibrationReloader;
 class Ros2Output;
+struct ResumeWiring;
 
 // Daemon: odometryd in three steps: configure (config, calibration store, rig, loop, CAN link,
 // reloader; start-up report), run (status thread, systemd watchdog, real-time set-up, the loop
@@ -61,6 +62,7 @@ class Daemon {
   std::unique_ptr<CanLink> can_;
   std::unique_ptr<CalibrationReloader> reloader_;
   std::unique_ptr<Ros2Output> ros2_;  // [ros2] enabled; null otherwise
+  std::unique_ptr<ResumeWiring> resume_;  // issue 17: persisted state (null in virtual time)
 };
 
 // run_daemon: runs the firmware until stop, duration or signal; returns the process exit code.

@@ -15,6 +15,7 @@
 #include "odo/hal/result.hpp"
 #include "odo/loop/command.hpp"
 #include "odo/loop/latency_histogram.hpp"
+#include "odo/loop/state_record.hpp"
 #include "odo/loop/triple_buffer.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
@@ -86,6 +87,20 @@ class OdometryLoop {
   bool add_observer(TickObserver* o) noexcept;
   // start: latches the reference counts and sets the first deadline one period from now.
   void start() noexcept;
+  // resume_from: configure time; the next start() continues from `rec` when decide_resume()
+  // allows (the gap's counts integrated as one step) and starts fresh otherwise.
+  void resume_from(const StateRecord& rec, const ResumeContext& ctx) noexcept;
+  // resume_decision: what start() decided (kNoRecord when resume_from was not called); valid
+  // on other threads once resume_decided() is true.
+  const ResumeDecision& resume_decision() const noexcept { return resume_; }
+  bool resume_decided() const noexcept { return resume_decided_.load(std::memory_order_acquire); }
+  // Reference reading of the last integrated sample: raw counts and their sample time [ns]
+  // (loop thread, e.g. an observer persisting the state).
+  std::int64_t last_left() const noexcept { return prev_left_; }
+  std::int64_t last_right() const noexcept { return prev_right_; }
+  TimeNs last_stamp() const noexcept { return prev_stamp_; }
+  int counter_bits() const noexcept { return bits_; }
+  calib::StoreStatus calibration() const noexcept { return calibration_; }
   // tick: runs one period of the loop (sleeps until the deadline first).
   void tick() noexcept;
   // run: ticks until `stop` is set or `duration` [ns] of loop time passed (duration <= 0: no
@@ -149,6 +164,22 @@ class OdometryLoop {
 
   CommandQueue commands_;
   std::atomic<std::uint64_t> commands_applied_{0};
+
+  // resume (issue 17): the record offered at configure time and start()'s decision.
+  // apply_resume: decides on the reference reading `s`; on resume restores the record's state
+  // and integrates the gap as one step.
+  void apply_resume(const EncoderSample& s) noexcept;
+  StateRecord resume_rec_;
+  ResumeContext resume_ctx_;
+  bool resume_offered_ = false;
+  ResumeDecision resume_;
+  std::atomic<bool> resume_decided_{false};
 };
+
+// fill_state_record: the loop's state after its last tick into `r` (pose, covariance, distance,
+// reference counts and their sample time, counter width, kinematics, calibration status); the
+// identity fields (sequence, boot id, clock epoch, backend, calibration sequence) are the
+// caller's. Loop thread (an observer) or after run() returned; no allocation.
+void fill_state_record(const OdometryLoop& loop, StateRecord& r) noexcept;
 
 }  // namespace odo::loop

@@ -74,6 +74,8 @@ class PoseCovariance {
   explicit PoseCovariance(const ErrorModelParams& k = {}) : k_(k) {}
   // reset: zero covariance (a pose that was just set is taken as exact).
   void reset() noexcept { cov_ = {}; }
+  // restore: continue from a covariance saved earlier (a resumed state record).
+  void restore(const Cov3& cov) noexcept { cov_ = cov; }
   // step: add one tick's arc; theta0 is the heading at the start of the tick [rad], d_left and
   // d_right the wheel travels of the tick [m], b the wheelbase [m].
   void step(double theta0, double d_left, double d_right, double b) noexcept {

@@ -98,6 +98,12 @@ class Odometry {
     integ_.reset(p);
     cov_.reset();
   }
+  // restore: continue from a saved pose, covariance and path length [m] (a resumed state).
+  void restore(const Pose2& p, const Cov3& cov, double distance) noexcept {
+    integ_.reset(p);
+    cov_.restore(cov);
+    distance_ = distance;
+  }
   // update_fused: the same with the heading changing by dtheta [rad] instead of
   // (d_R - d_L) / b (the gyrodometry fusion's FusedTick::dtheta); bit-identical to update()
   // when dtheta is odometry's own increment.

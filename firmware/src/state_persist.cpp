@@ -1,0 +1,283 @@
+#include "odo/firmware/state_persist.hpp"
+
+#include <fcntl.h>
+#include <linux/magic.h>
+#include <sys/stat.h>
+#include <sys/statfs.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+
+namespace odo::fw {
+namespace {
+
+// hex_value: 0..15 of a hex digit, -1 for anything else.
+int hex_value(char c) {
+  int v = -1;
+  std::from_chars(&c, &c + 1, v, 16);
+  return v;
+}
+
+Error io_error(const std::string& what, const std::string& path) {
+  return make_error(Errc::kIo, path + ": " + what + " (" + std::strerror(errno) + ")");
+}
+
+// Backend ids as stored in a record: the EncoderKind plus the bus, so that the simulated and
+// the real variant of a backend never continue each other's counts.
+std::uint8_t backend_id(const Config& cfg) {
+  std::uint8_t id = static_cast<std::uint8_t>(cfg.encoder.backend) << 4;
+  if (cfg.encoder.backend == EncoderKind::kHctl1100)
+    id |= static_cast<std::uint8_t>(cfg.hctl1100.bus);
+  if (cfg.encoder.backend == EncoderKind::kCan)
+    id |= static_cast<std::uint8_t>(cfg.can_encoder.bus);
+  return id;
+}
+
+// on_tmpfs: whether the directory of `path` is a tmpfs (emptied by every reboot).
+bool on_tmpfs(const std::string& path) {
+  const std::size_t slash = path.rfind('/');
+  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash + 1);
+  struct statfs f {};
+  return ::statfs(dir.c_str(), &f) == 0 && f.f_type == TMPFS_MAGIC;
+}
+
+// boot_identity: the boot id; where /proc/sys is hidden (the unit's ProcSubset=pid) and the
+// state file is on a tmpfs such as /run, a record there is from this boot by construction and
+// the all-zero id stands for "this boot" in both the record and the check.
+Result<loop::BootId> boot_identity(const std::string& state_path) {
+  auto id = read_boot_id();
+  if (!id && on_tmpfs(state_path)) return loop::BootId{};
+  return id;
+}
+
+}  // namespace
+
+Result<loop::BootId> parse_boot_id(std::string_view text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.remove_suffix(1);
+  loop::BootId id{};
+  std::size_t n = 0;
+  int high = -1;
+  for (const char c : text) {
+    if (c == '-') continue;
+    const int v = hex_value(c);
+    if (v < 0 || n >= id.size()) return make_error(Errc::kParse, "boot id: not a UUID");
+    if (high < 0) {
+      high = v;
+    } else {
+      id[n++] = static_cast<std::uint8_t>(high << 4 | v);
+      high = -1;
+    }
+  }
+  if (n != id.size() || high >= 0) return make_error(Errc::kParse, "boot id: not a UUID");
+  return id;
+}
+
+Result<loop::BootId> read_boot_id(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) return io_error("cannot open", path);
+  char buf[64] = {};
+  const std::size_t n = std::fread(buf, 1, sizeof buf - 1, f);
+  std::fclose(f);
+  auto id = parse_boot_id(std::string_view(buf, n));
+  if (!id) return make_error(Errc::kParse, path + ": " + id.error().message);
+  return id;
+}
+
+Result<loop::StateRecord> read_state_file(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    if (errno == ENOENT) return make_error(Errc::kNotFound, path + ": no state record");
+    return io_error("cannot open", path);
+  }
+  std::array<std::uint8_t, loop::kStateFileBytes> b{};
+  const ssize_t n = ::pread(fd, b.data(), b.size(), 0);
+  ::close(fd);
+  if (n < 0) return io_error("cannot read", path);
+  auto r = loop::decode_state_file(std::span<const std::uint8_t>(b.data(), std::size_t(n)));
+  if (!r) return make_error(r.error().code, path + ": " + r.error().message);
+  return r;
+}
+
+bool counters_survive_restart(const Config& cfg) {
+  return cfg.encoder.backend == EncoderKind::kHctl1100 && cfg.hctl1100.bus == HctlBus::kGpio;
+}
+
+// ---- StatePersister ----
+
+Result<std::unique_ptr<StatePersister>> StatePersister::create(const std::string& path,
+                                                               double rate_hz, double loop_hz,
+                                                               const loop::OdometryLoop& loop,
+                                                               const loop::StateRecord& identity) {
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) return io_error("cannot open the state file", path);
+  // Both slots exist from the start; the older record in them stays readable until replaced.
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || (st.st_size < static_cast<off_t>(loop::kStateFileBytes) &&
+                                ::ftruncate(fd, loop::kStateFileBytes) != 0)) {
+    auto e = io_error("cannot size the state file", path);
+    ::close(fd);
+    return e;
+  }
+  const auto every = static_cast<std::uint64_t>(std::max(1.0, std::round(loop_hz / rate_hz)));
+  return std::unique_ptr<StatePersister>(new StatePersister(fd, every, loop, identity));
+}
+
+StatePersister::StatePersister(int fd, std::uint64_t every, const loop::OdometryLoop& loop,
+                               const loop::StateRecord& identity)
+    : fd_(fd), every_(every), loop_(loop), identity_(identity), sequence_(identity.sequence) {
+  sem_init(&wake_, 0, 0);
+}
+
+StatePersister::~StatePersister() {
+  stop();
+  sem_destroy(&wake_);
+  ::close(fd_);
+}
+
+void StatePersister::on_tick(const loop::LoopSnapshot&) noexcept {
+  // Every n-th tick, and at once on a tick whose commands (a set pose) changed the state.
+  const std::uint64_t applied = loop_.commands_applied();
+  if (--countdown_ != 0 && applied == seen_commands_) return;
+  countdown_ = every_;
+  seen_commands_ = applied;
+  loop::StateRecord& r = records_.back();
+  loop::fill_state_record(loop_, r);
+  r.sequence = ++sequence_;
+  records_.publish();
+  sem_post(&wake_);  // never blocks; a futex wake only when the writer waits
+}
+
+void StatePersister::start(std::ostream& log, std::optional<loop::ResumeReason> fixed,
+                           std::string note) {
+  thread_ = std::thread([this, &log, fixed, n = std::move(note)] { run(log, fixed, n); });
+}
+
+void StatePersister::stop() {
+  if (!thread_.joinable()) return;
+  done_.store(true, std::memory_order_release);
+  sem_post(&wake_);
+  thread_.join();
+  // The loop has stopped (stop() is called after run() returned): the state of its very last
+  // tick, which need not have been a due tick, is written too.
+  loop::StateRecord& r = records_.back();
+  loop::fill_state_record(loop_, r);
+  r.sequence = ++sequence_;
+  records_.publish();
+  write_newest();
+}
+
+void StatePersister::write_newest() noexcept {
+  if (!records_.latest(newest_) || newest_.sequence == last_written_) return;
+  loop::StateRecord r = newest_;
+  r.boot_id = identity_.boot_id;
+  r.clock_epoch = identity_.clock_epoch;
+  r.backend = identity_.backend;
+  r.calibration_sequence = identity_.calibration_sequence;
+  loop::StateBytes b{};
+  loop::encode_state(r, b);
+  const auto off = static_cast<off_t>((r.sequence % 2) * loop::kStateSlotBytes);
+  if (::pwrite(fd_, b.data(), b.size(), off) == static_cast<ssize_t>(b.size())) {
+    last_written_ = r.sequence;
+    written_.fetch_add(1, std::memory_order_relaxed);
+  } else {
+    write_errors_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+void StatePersister::run(std::ostream& log, std::optional<loop::ResumeReason> fixed,
+                         const std::string& note) {
+  bool told = false;
+  while (!done_.load(std::memory_order_acquire)) {
+    timespec until{};
+    clock_gettime(CLOCK_REALTIME, &until);
+    until.tv_nsec += 100'000'000;  // wake at least every 0.1 s to notice stop and the decision
+    if (until.tv_nsec >= 1'000'000'000) {
+      until.tv_sec += 1;
+      until.tv_nsec -= 1'000'000'000;
+    }
+    sem_timedwait(&wake_, &until);
+    if (!told && loop_.resume_decided()) {
+      // The decision is made in the loop's start(); it is told here, off the loop thread.
+      const loop::ResumeDecision& d = loop_.resume_decision();
+      const loop::ResumeReason why = fixed ? *fixed : d.reason;
+      // A stack buffer and one write: the thread allocates nothing while the loop runs.
+      char line[400];
+      int n = 0;
+      if (why == loop::ResumeReason::kResumed) {
+        n = std::snprintf(line, sizeof line, "odometryd: resume: resumed after a gap of %.3f s\n",
+                          to_seconds(d.gap));
+      } else {
+        const std::string_view name = loop::resume_reason_name(why);
+        n = std::snprintf(line, sizeof line, "odometryd: resume: fresh start (%.*s)%s\n",
+                          static_cast<int>(name.size()), name.data(), note.c_str());
+      }
+      log.write(line, std::min<int>(n, sizeof line - 1)).flush();
+      told = true;
+    }
+    write_newest();
+  }
+}
+
+// ---- wiring ----
+
+ResumeWiring prepare_resume(const Config& cfg, loop::OdometryLoop& loop,
+                            std::uint64_t calibration_sequence, std::ostream& log) {
+  ResumeWiring w;
+  w.active = true;
+  if (!cfg.resume.enabled) {
+    log << "odometryd: resume: off ([resume] enabled = false)\n";
+    return w;
+  }
+  loop::StateRecord identity;
+  auto boot = boot_identity(cfg.resume.path);
+  if (boot) identity.boot_id = *boot;
+  identity.backend = backend_id(cfg);
+  identity.calibration_sequence = calibration_sequence;
+  auto rec = read_state_file(cfg.resume.path);
+  if (rec && boot) {
+    identity.sequence = rec->sequence;  // ours follow it: the newest slot is always ours
+    const Kinematics& k = loop.odometry().kinematics();
+    loop::ResumeContext c;
+    c.boot_id = identity.boot_id;
+    c.max_age = from_seconds(cfg.resume.max_age);
+    c.backend = identity.backend;
+    c.backend_continuous = counters_survive_restart(cfg);
+    c.counter_bits = loop.counter_bits();
+    c.calibration_sequence = calibration_sequence;
+    c.metres_per_count_left = k.metres_per_count_left();
+    c.metres_per_count_right = k.metres_per_count_right();
+    c.wheelbase = k.wheelbase();
+    c.max_wheel_speed = cfg.encoder.backend == EncoderKind::kCan ? cfg.can_encoder.max_speed
+                                                                 : cfg.hctl1100.max_speed;
+    loop.resume_from(*rec, c);
+    w.offered = true;
+  } else if (!rec) {
+    w.reason = rec.error().code == Errc::kNotFound ? loop::ResumeReason::kNoRecord
+                                                   : loop::ResumeReason::kCorrupt;
+    w.note = ": " + rec.error().message;
+  } else {
+    // Without the boot id a reboot cannot be told from a restart: never resume.
+    w.reason = loop::ResumeReason::kOtherBoot;
+    w.note = ": " + boot.error().message;
+  }
+  auto p =
+      StatePersister::create(cfg.resume.path, cfg.resume.rate_hz, cfg.loop.rate_hz, loop, identity);
+  if (!p) {
+    log << "odometryd: resume: " << p.error().message << ": the pose will not survive a restart\n";
+  } else {
+    w.persister = std::move(p).value();
+    loop.add_observer(w.persister.get());
+  }
+  return w;
+}
+
+loop::ResumeReason resume_reason(const ResumeWiring& w, const loop::OdometryLoop& loop) {
+  return w.offered ? loop.resume_decision().reason : w.reason;
+}
+
+}  // namespace odo::fw

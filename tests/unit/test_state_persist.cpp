@@ -1,0 +1,86 @@
+// The daemon's side of the pose that survives restarts (issue 17): boot id, state file, the
+// [resume] config section and which backends may resume.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include "odo/firmware/config.hpp"
+#include "odo/firmware/state_persist.hpp"
+
+namespace odo::fw {
+namespace {
+
+TEST(StatePersist, BootIdParsesTheKernelsText) {
+  auto id = parse_boot_id("0123abcd-4567-89ab-cdef-0011223344ff\n");
+  ASSERT_TRUE(id) << id.error().message;
+  EXPECT_EQ((*id)[0], 0x01);
+  EXPECT_EQ((*id)[3], 0xcd);
+  EXPECT_EQ((*id)[15], 0xff);
+  EXPECT_FALSE(parse_boot_id("0123abcd-4567"));
+  EXPECT_FALSE(parse_boot_id("0123abcd-4567-89ab-cdef-0011223344fg"));
+  EXPECT_FALSE(parse_boot_id("0123abcd-4567-89ab-cdef-0011223344ff00"));
+}
+
+TEST(StatePersist, OnlyCountersThatKeepCountingResume) {
+  Config c = default_config();
+  c.encoder.backend = EncoderKind::kGpio;  // decoded by this process: lost while it is down
+  EXPECT_FALSE(counters_survive_restart(c));
+  c.encoder.backend = EncoderKind::kSim;
+  EXPECT_FALSE(counters_survive_restart(c));
+  c.encoder.backend = EncoderKind::kHctl1100;
+  c.hctl1100.bus = HctlBus::kSim;  // the register model restarts with the process
+  EXPECT_FALSE(counters_survive_restart(c));
+  c.hctl1100.bus = HctlBus::kGpio;  // the chips count on their own
+  EXPECT_TRUE(counters_survive_restart(c));
+}
+
+TEST(StatePersist, ResumeSectionIsReadAndChecked) {
+  auto c = parse_config(
+      "[resume]\nenabled = false\npath = \"/tmp/x.bin\"\nrate_hz = 20\n"
+      "max_age = 2.5\n",
+      "t.toml");
+  ASSERT_TRUE(c) << c.error().message;
+  EXPECT_FALSE(c->resume.enabled);
+  EXPECT_EQ(c->resume.path, "/tmp/x.bin");
+  EXPECT_EQ(c->resume.rate_hz, 20.0);
+  EXPECT_EQ(c->resume.max_age, 2.5);
+  // rate_hz above the loop rate (100 Hz by default) names the field and the range.
+  auto bad = parse_config("[resume]\nrate_hz = 500\n", "t.toml");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("rate_hz"), std::string::npos) << bad.error().message;
+  EXPECT_NE(bad.error().message.find("t.toml"), std::string::npos);
+}
+
+TEST(StatePersist, StateFileReasons) {
+  const std::string path = ::testing::TempDir() + "state_persist_test.bin";
+  std::remove(path.c_str());
+  EXPECT_EQ(read_state_file(path).error().code, Errc::kNotFound);
+  {
+    std::ofstream f(path, std::ios::binary);
+    f << std::string(loop::kStateFileBytes, '\x5a');
+  }
+  auto r = read_state_file(path);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, Errc::kCorrupt);
+  EXPECT_NE(r.error().message.find(path), std::string::npos);
+  // A valid record in slot 1 (sequence 3 is odd).
+  loop::StateRecord rec;
+  rec.sequence = 3;
+  rec.counter_bits = 24;
+  rec.pose = {1.0, 2.0, 3.0};
+  loop::StateBytes b{};
+  loop::encode_state(rec, b);
+  {
+    std::fstream f(path, std::ios::binary | std::ios::in | std::ios::out);
+    f.seekp(loop::kStateSlotBytes);
+    f.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  }
+  auto ok = read_state_file(path);
+  ASSERT_TRUE(ok) << ok.error().message;
+  EXPECT_EQ(ok->sequence, 3u);
+  EXPECT_EQ(ok->pose.y, 2.0);
+}
+
+}  // namespace
+}  // namespace odo::fw
