@@ -1,5 +1,6 @@
-// Little-endian (Intel) byte fields, independent of the host's byte order: CAN payloads, the
-// calibration record, simulated controller frames.
+// Byte fields independent of the host's byte order, written once for every user: CAN payloads
+// (protocol/, drivers' CAN encoder), the calibration record (calibration/), the simulated
+// controller frames (sim_hal/). Little endian (Intel) unless the name says otherwise.
 #pragma once
 
 #include <cstddef>
@@ -16,6 +17,13 @@ constexpr void put_le(std::uint8_t* p, std::size_t n, std::uint64_t v) noexcept 
 constexpr std::uint64_t get_le(const std::uint8_t* p, std::size_t n) noexcept {
   std::uint64_t v = 0;
   for (std::size_t i = 0; i < n; ++i) v |= static_cast<std::uint64_t>(p[i]) << (8 * i);
+  return v;
+}
+
+// get_be: p[0..n) (1..8 bytes), most significant first (Motorola order), zero-extended.
+constexpr std::uint64_t get_be(const std::uint8_t* p, std::size_t n) noexcept {
+  std::uint64_t v = 0;
+  for (std::size_t i = 0; i < n; ++i) v = (v << 8) | p[i];
   return v;
 }
 
