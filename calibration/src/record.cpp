@@ -7,6 +7,8 @@
 #include <cstring>
 #include <sstream>
 
+#include "odo/hal/bytes.hpp"
+
 namespace odo::calib {
 namespace {
 
@@ -30,7 +32,7 @@ constexpr std::uint32_t kFlagEmaxBefore = 1U << 4;
 constexpr std::uint32_t kFlagEmaxAfter = 1U << 5;
 constexpr std::uint32_t kFlagFit = 1U << 6;  // version 2: the fit fields at 104 .. 143
 
-// Little-endian field access, independent of the host's byte order.
+// Little-endian field access (hal/bytes.hpp), independent of the host's byte order.
 template <class T>
 void put(std::vector<std::uint8_t>& b, std::size_t off, T v) {
   std::uint64_t u = 0;
@@ -39,14 +41,12 @@ void put(std::vector<std::uint8_t>& b, std::size_t off, T v) {
   } else {
     u = static_cast<std::uint64_t>(v);
   }
-  for (std::size_t i = 0; i < sizeof(T); ++i) b[off + i] = static_cast<std::uint8_t>(u >> (8 * i));
+  put_le(b.data() + off, sizeof(T), u);
 }
 
 template <class T>
 T get(std::span<const std::uint8_t> b, std::size_t off) {
-  std::uint64_t u = 0;
-  for (std::size_t i = 0; i < sizeof(T); ++i)
-    u |= static_cast<std::uint64_t>(b[off + i]) << (8 * i);
+  const std::uint64_t u = get_le(b.data() + off, sizeof(T));
   if constexpr (std::is_same_v<T, double>) {
     return std::bit_cast<double>(u);
   } else {
@@ -60,10 +60,12 @@ Error corrupt(const std::string& why) {
 
 Status check_range(const char* field, double v, double lo, double hi, const char* unit) {
   if (std::isfinite(v) && v >= lo && v <= hi) return Ok{};
-  std::ostringstream m;
-  m << field << " = " << v << " is outside the allowed range [" << lo << ", " << hi << "]"
-    << (*unit ? " " : "") << unit;
-  return make_error(Errc::kInvalidArgument, m.str());
+  return range_error({field, v, lo, hi, unit, false});
+}
+
+Status check_count(const char* field, std::uint32_t v) {
+  if (v <= RecordLimits::kRunsMax) return Ok{};
+  return range_error(integer_range(field, v, 0, RecordLimits::kRunsMax));
 }
 
 Status validate_fit(const FixFitProvenance& f) {
@@ -74,13 +76,8 @@ Status validate_fit(const FixFitProvenance& f) {
     if (auto s = check_range(field, v, 0.0, 1e9, ""); !s) return s;
   if (auto s = check_range("sigma_wheelbase", f.sigma_wheelbase, 0.0, L::kWheelbaseMax, "m"); !s)
     return s;
-  for (auto [field, v] :
-       {std::pair{"fixes_used", f.fixes_used}, {"fixes_rejected", f.fixes_rejected}})
-    if (v > L::kRunsMax)
-      return make_error(Errc::kInvalidArgument, std::string(field) + " = " + std::to_string(v) +
-                                                    " is outside the allowed range [0, " +
-                                                    std::to_string(L::kRunsMax) + "]");
-  return Ok{};
+  if (auto s = check_count("fixes_used", f.fixes_used); !s) return s;
+  return check_count("fixes_rejected", f.fixes_rejected);
 }
 
 }  // namespace
@@ -148,9 +145,12 @@ Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
   const auto version = get<std::uint16_t>(bytes, 4);
   const auto length = get<std::uint16_t>(bytes, 6);
   if (version < 1) return corrupt("format version 0 is not valid");
-  if (length < kRecordV1Bytes || length > bytes.size())
-    return corrupt("length " + std::to_string(length) + " outside [" +
-                   std::to_string(kRecordV1Bytes) + ", " + std::to_string(bytes.size()) + "]");
+  if (length < kRecordV1Bytes || length > bytes.size()) {
+    Error e = range_error(
+        integer_range("length", length, kRecordV1Bytes, static_cast<std::int64_t>(bytes.size())));
+    e.code = Errc::kCorrupt;  // a stored length: the record is damaged, not the caller's input
+    return e;
+  }
   const auto stored = get<std::uint32_t>(bytes, length - 4U);
   const auto computed = crc32(bytes.first(length - 4U));
   if (stored != computed) {
@@ -218,10 +218,7 @@ Status validate_record(const CalibrationRecord& r) {
   if (r.e_max_after)
     if (auto s = check_range("e_max_syst_after", *r.e_max_after, L::kEmaxMin, L::kEmaxMax, "m"); !s)
       return s;
-  if (r.runs > L::kRunsMax)
-    return make_error(Errc::kInvalidArgument, "runs = " + std::to_string(r.runs) +
-                                                  " is outside the allowed range [0, " +
-                                                  std::to_string(L::kRunsMax) + "]");
+  if (auto s = check_count("runs", r.runs); !s) return s;
   if (r.time < 0)
     return make_error(Errc::kInvalidArgument,
                       "time = " + std::to_string(r.time) + " is before 1970 (allowed: >= 0 s)");
