@@ -18,6 +18,62 @@ struct DecodeOpts {
   int base_id = static_cast<int>(protocol::kDefaultBaseId);
 };
 
+// DecodeTally: what a log held, for the summary line.
+struct DecodeTally {
+  std::size_t frames = 0, ours = 0, groups = 0, lost = 0;
+  std::map<int, int> last_seq;  // per node
+};
+
+// count_pose_group: a PoseX frame opens a pose group; a gap in its 8-bit sequence counts lost
+// groups.
+void count_pose_group(const protocol::DecodedFrame& d, DecodeTally& tally) {
+  const int seq = static_cast<int>(d.fields[1].value);
+  auto it = tally.last_seq.find(d.node);
+  if (it != tally.last_seq.end())
+    tally.lost += static_cast<std::size_t>((seq - it->second - 1 + 256) % 256);
+  tally.last_seq[d.node] = seq;
+  ++tally.groups;
+}
+
+// format_frame: one parsed line as table row(s) or CSV rows, appended to `out`.
+void format_frame(const DecodeOpts& o, const protocol::CandumpLine& p, DecodeTally& tally,
+                  std::string& out) {
+  char buf[160];
+  char t[32];
+  std::snprintf(t, sizeof t, "%lld.%06d", static_cast<long long>(p.sec), p.usec);
+  char id[16];
+  std::snprintf(id, sizeof id, p.frame.extended ? "%08X" : "%03X", p.frame.id);
+  protocol::DecodedFrame d;
+  if (!protocol::decode_protocol_frame(static_cast<std::uint32_t>(o.base_id), p.frame, d)) {
+    if (!o.csv) {
+      std::snprintf(buf, sizeof buf,
+                    "%s %-6s %s  %-2s %-12s len=%u (not a frame of this "
+                    "protocol)\n",
+                    t, p.iface.c_str(), id, "-", "-", p.frame.len);
+      out += buf;
+    }
+    return;
+  }
+  ++tally.ours;
+  if (d.msg == protocol::Msg::kPoseX) count_pose_group(d, tally);
+  if (o.csv) {
+    for (std::size_t i = 0; i < d.n_fields; ++i) {
+      std::snprintf(buf, sizeof buf, "%s,%s,%s,%d,%s,%s,%.9g\n", t, p.iface.c_str(), id, d.node,
+                    d.message, d.fields[i].name, d.fields[i].value);
+      out += buf;
+    }
+    return;
+  }
+  std::snprintf(buf, sizeof buf, "%s %-6s %s  %-2d %-12s", t, p.iface.c_str(), id, d.node,
+                d.message);
+  out += buf;
+  for (std::size_t i = 0; i < d.n_fields; ++i) {
+    std::snprintf(buf, sizeof buf, " %s=%.9g", d.fields[i].name, d.fields[i].value);
+    out += buf;
+  }
+  out += '\n';
+}
+
 // run_decode: `odomctl ... decode` once its options are parsed; sets exit_code.
 void run_decode(const DecodeOpts& o, int& exit_code) {
   std::ifstream in(o.file, std::ios::binary);
@@ -26,13 +82,11 @@ void run_decode(const DecodeOpts& o, int& exit_code) {
     exit_code = kExitBadInput;
     return;
   }
-  const auto base = static_cast<std::uint32_t>(o.base_id);
   std::string line;
-  std::size_t n = 0, frames = 0, ours = 0, groups = 0, lost = 0;
-  std::map<int, int> last_seq;  // per node
+  std::size_t n = 0;
+  DecodeTally tally;
   std::string out;
   if (o.csv) out += "time,iface,id,node,message,signal,value\n";
-  char buf[160];
   while (std::getline(in, line)) {
     ++n;
     if (line.empty() || line == "\r") continue;
@@ -42,53 +96,14 @@ void run_decode(const DecodeOpts& o, int& exit_code) {
       exit_code = kExitBadInput;
       return;
     }
-    ++frames;
-    char t[32];
-    std::snprintf(t, sizeof t, "%lld.%06d", static_cast<long long>(p->sec), p->usec);
-    char id[16];
-    std::snprintf(id, sizeof id, p->frame.extended ? "%08X" : "%03X", p->frame.id);
-    protocol::DecodedFrame d;
-    const bool ok = protocol::decode_protocol_frame(base, p->frame, d);
-    if (!ok) {
-      if (!o.csv) {
-        std::snprintf(buf, sizeof buf,
-                      "%s %-6s %s  %-2s %-12s len=%u (not a frame of this "
-                      "protocol)\n",
-                      t, p->iface.c_str(), id, "-", "-", p->frame.len);
-        out += buf;
-      }
-      continue;
-    }
-    ++ours;
-    if (d.msg == protocol::Msg::kPoseX) {
-      const int seq = static_cast<int>(d.fields[1].value);
-      auto it = last_seq.find(d.node);
-      if (it != last_seq.end())
-        lost += static_cast<std::size_t>((seq - it->second - 1 + 256) % 256);
-      last_seq[d.node] = seq;
-      ++groups;
-    }
-    if (o.csv) {
-      for (std::size_t i = 0; i < d.n_fields; ++i) {
-        std::snprintf(buf, sizeof buf, "%s,%s,%s,%d,%s,%s,%.9g\n", t, p->iface.c_str(), id, d.node,
-                      d.message, d.fields[i].name, d.fields[i].value);
-        out += buf;
-      }
-    } else {
-      std::snprintf(buf, sizeof buf, "%s %-6s %s  %-2d %-12s", t, p->iface.c_str(), id, d.node,
-                    d.message);
-      out += buf;
-      for (std::size_t i = 0; i < d.n_fields; ++i) {
-        std::snprintf(buf, sizeof buf, " %s=%.9g", d.fields[i].name, d.fields[i].value);
-        out += buf;
-      }
-      out += '\n';
-    }
+    ++tally.frames;
+    format_frame(o, *p, tally, out);
   }
   std::cout << out;
   if (!o.csv) {
-    std::cout << "# " << frames << " frames, " << ours << " of this protocol, " << groups
-              << " pose groups, " << lost << " pose groups lost (sequence gaps)\n";
+    std::cout << "# " << tally.frames << " frames, " << tally.ours << " of this protocol, "
+              << tally.groups << " pose groups, " << tally.lost
+              << " pose groups lost (sequence gaps)\n";
   }
 }
 

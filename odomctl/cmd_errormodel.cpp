@@ -36,6 +36,7 @@ namespace {
 
 struct ValidateOpts {
   analysis::McOptions mc;
+  std::string path = "outback";  // --path as typed; parsed into mc.path before run_validate
   std::string plot, csv;
   bool json = false;
   bool twist = false;  // --twist: the ROS 2 twist covariance instead of the pose's
@@ -126,7 +127,7 @@ void run_validate(const ValidateOpts& o, int& exit_code) {
   }
   if (o.json) {
     nlohmann::json j{{"runs", r->runs},
-                     {"path", o.mc.path},
+                     {"path", std::string(analysis::name_of(o.mc.path))},
                      {"wheelbase", o.mc.wheelbase},
                      {"k_left", o.mc.k.k_left},
                      {"k_right", o.mc.k.k_right},
@@ -154,7 +155,7 @@ void add_validate(CLI::App& parent, int& exit_code) {
   CLI::App* c = parent.add_subcommand(
       "validate", "Monte Carlo on the simulated robot: predicted against sample covariance");
   c->add_option("--runs", o->mc.runs, "number of runs (default 2000)");
-  c->add_option("--path", o->mc.path,
+  c->add_option("--path", o->path,
                 "outback (10 m forward, 10 m back) or arc (270 deg, 2 m radius)");
   c->add_option("--k-left", o->mc.k.k_left, "k_L [m^(1/2)] (default 0.00040)");
   c->add_option("--k-right", o->mc.k.k_right, "k_R [m^(1/2)] (default 0.00058)");
@@ -165,7 +166,11 @@ void add_validate(CLI::App& parent, int& exit_code) {
   c->add_flag("--json", o->json, "print one JSON object on stdout");
   c->add_flag("--twist", o->twist,
               "the twist covariance of the ROS 2 output (one tick on a 2 m circle) instead");
-  c->callback([o, &exit_code] { run_validate(*o, exit_code); });
+  c->callback([o, &exit_code] {
+    const auto path = analysis::parse_mc_path(o->path);
+    if (take_choice(path, o->mc.path, "errormodel validate", exit_code))
+      run_validate(*o, exit_code);
+  });
 }
 
 namespace {

@@ -241,6 +241,7 @@ namespace {
 
 struct SimulateOpts {
   analysis::UmbmarkSimOptions sim;
+  std::string robot = "labmate", noise = "none";  // as typed; parsed into sim before run_simulate
   std::string store, plot, eb_form = "umbmark";
   bool json = false;
 };
@@ -334,11 +335,11 @@ void add_simulate(CLI::App& parent, int& exit_code) {
   auto o = std::make_shared<SimulateOpts>();
   CLI::App* c = parent.add_subcommand(
       "simulate", "automated UMBmark self-calibration of the simulated robot (virtual time)");
-  c->add_option("--robot", o->sim.robot, "simulated robot (labmate: DESIGN.md reference)");
+  c->add_option("--robot", o->robot, "simulated robot (labmate: DESIGN.md reference)");
   c->add_option("--runs", o->sim.runs, "squares a direction per set (default 5)");
   c->add_option("--passes", o->sim.passes, "calibration passes (default 1)");
   c->add_option("--side", o->sim.side, "side of the square [m] (default 4)");
-  c->add_option("--noise", o->sim.noise, "none | paper (floor roughness, reference error)");
+  c->add_option("--noise", o->noise, "none | paper (floor roughness, reference error)");
   c->add_flag("--bumps", o->sim.bumps, "add extended-UMBmark runs (ten 10 mm bumps)");
   c->add_option("--seed", o->sim.seed, "random seed (default 1)");
   c->add_option("--store", o->store, "write the final factors to this calibration store");
@@ -346,7 +347,12 @@ void add_simulate(CLI::App& parent, int& exit_code) {
   c->add_option("--eb-form", o->eb_form,
                 "wheelbase formula: umbmark (Eq. 6.29, default) or chong (C&K Eq. 9)");
   c->add_flag("--json", o->json, "print one JSON object on stdout");
-  c->callback([o, &exit_code] { run_simulate(*o, exit_code); });
+  c->callback([o, &exit_code] {
+    const char* cmd = "umbmark simulate";
+    if (take_choice(analysis::parse_umbmark_robot(o->robot), o->sim.robot, cmd, exit_code) &&
+        take_choice(analysis::parse_umbmark_noise(o->noise), o->sim.noise, cmd, exit_code))
+      run_simulate(*o, exit_code);
+  });
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <iostream>
 #include <string>
 
+#include "odo/hal/result.hpp"
+
 namespace odo::ctl {
 
 // Exit status of odomctl: 0 ok, 1 the operation failed, 2 bad input or bad options.
@@ -24,6 +26,20 @@ inline bool write_output_file(const std::string& path, const std::string& text, 
     return false;
   }
   return true;
+}
+
+// take_choice: stores a command-line choice parsed from its text (the only place the text is
+// read) in `out`; on failure says "odomctl <cmd>: <error>" on stderr, sets kExitBadInput and
+// returns false.
+template <class E>
+bool take_choice(Result<E> parsed, E& out, const char* cmd, int& exit_code) {
+  if (parsed) {
+    out = *parsed;
+    return true;
+  }
+  std::cerr << "odomctl " << cmd << ": " << parsed.error().message << "\n";
+  exit_code = kExitBadInput;
+  return false;
 }
 
 // add_replay: `odomctl replay` (integrate a log of raw counts).

@@ -31,6 +31,12 @@ Error CsvReader::error(const std::string& what) const {
   return make_error(Errc::kParse, source_ + ":" + std::to_string(line_) + ": " + what);
 }
 
+Error CsvReader::range_error(FieldRange r) const {
+  Error e = error(range_message(r));
+  e.range = std::move(r);
+  return e;
+}
+
 Result<std::vector<int>> CsvReader::header(const std::vector<std::string_view>& required,
                                            const std::vector<std::string_view>& optional) {
   std::vector<std::string> names;

@@ -23,7 +23,7 @@ constexpr double kArcAngle = 1.5 * std::numbers::pi;  // 270 deg counter-clockwi
 sim::Scenario make_path(const McOptions& o) {
   const double rw = o.wheel_diameter / 2.0;
   const double w = o.speed / rw;  // wheel angular velocity for the centre speed [rad/s]
-  if (o.path == "outback") {
+  if (o.path == McPath::kOutback) {
     const double t = kOutbackDistance / o.speed;
     return {{t, w, w}, {t, -w, -w}};
   }
@@ -35,31 +35,35 @@ sim::Scenario make_path(const McOptions& o) {
 
 }  // namespace
 
-std::string path_description(const std::string& path) {
-  if (path == "outback")
+Result<McPath> parse_mc_path(std::string_view text) {
+  if (auto p = choice_value<McPath>(kMcPaths, text)) return *p;
+  return make_error(Errc::kInvalidArgument, "--path = '" + std::string(text) + "' must be " +
+                                                choice_join(kMcPaths, " or "));
+}
+
+std::string path_description(McPath path) {
+  if (path == McPath::kOutback)
     return "10 m forward then 10 m backward, no turn (Chong & Kleeman Sec. 5.2)";
   return "counter-clockwise arc of 270 deg on a 2 m radius (9.42 m)";
 }
 
 Status check_mc_options(const McOptions& o) {
-  std::ostringstream m;
-  if (o.runs < 2 || o.runs > 1000000) {
-    m << range_message({"--runs", static_cast<double>(o.runs), 2, 1000000, "", false, true});
-  } else if (o.path != "outback" && o.path != "arc") {
-    m << "--path = '" << o.path << "' must be outback or arc";
-  } else if (!(o.wheelbase >= 0.05 && o.wheelbase <= 5.0)) {
-    m << range_message({"--wheelbase", o.wheelbase, 0.05, 5.0, "m"});
-  } else if (!(o.wheel_diameter >= 0.01 && o.wheel_diameter <= 2.0)) {
-    m << "wheel diameter = " << o.wheel_diameter << " m is outside [0.01, 2] m";
-  } else if (!(o.speed > 0.0 && o.speed <= 5.0)) {
-    m << "speed = " << o.speed << " m/s is outside (0, 5] m/s";
-  } else if (auto r = error_model_range(o.k)) {
-    r->field = r->field == "k_left" ? "--k-left" : "--k-right";  // the options' names
-    m << range_message(*r);
-  } else {
-    return Ok{};
+  if (o.runs < 2 || o.runs > 1000000)
+    return range_error(integer_range("--runs", o.runs, 2, 1000000));
+  if (!(o.wheelbase >= 0.05 && o.wheelbase <= 5.0))
+    return range_error({"--wheelbase", o.wheelbase, 0.05, 5.0, "m"});
+  if (!(o.wheel_diameter >= 0.01 && o.wheel_diameter <= 2.0))
+    return range_error({"wheel diameter", o.wheel_diameter, 0.01, 2.0, "m"});
+  if (!(o.speed > 0.0 && o.speed <= 5.0)) {
+    FieldRange r{"speed", o.speed, 0.0, 5.0, "m/s"};
+    r.lo_open = true;
+    return range_error(std::move(r));
   }
-  return make_error(Errc::kInvalidArgument, m.str());
+  if (auto r = error_model_range(o.k)) {
+    r->field = r->field == "k_left" ? "--k-left" : "--k-right";  // the options' names
+    return range_error(std::move(*r));
+  }
+  return Ok{};
 }
 
 Cov3 sample_covariance(const std::vector<PoseError>& e, PoseError* mean) {

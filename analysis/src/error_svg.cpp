@@ -40,6 +40,72 @@ std::vector<std::array<double, 2>> ellipse_points(const Cov3& c, int i, int j, d
   return pts;
 }
 
+// Panel: where the (i, j) panel number p sits, its half-ranges around the mean, and the
+// mapping of error values to SVG coordinates.
+struct Panel {
+  int p = 0, i = 0, j = 0;
+  double ox = 0, oy = 0, hx = 0, hy = 0, mi = 0, mj = 0;
+  double sx(double v) const { return ox + kPanel * (0.5 + 0.5 * (v - mi) / hx); }
+  double sy(double v) const { return oy + kPanel * (0.5 - 0.5 * (v - mj) / hy); }
+};
+
+// half_range: the larger ellipse plus a margin, so outlying dots may fall off the panel.
+void half_range(Panel& q, const std::vector<std::array<double, 2>>& pred,
+                const std::vector<std::array<double, 2>>& samp) {
+  double hx = 0.0, hy = 0.0;
+  for (const auto* e : {&pred, &samp}) {
+    for (const auto& pt : *e) {
+      hx = std::max(hx, std::fabs(pt[0] - q.mi));
+      hy = std::max(hy, std::fabs(pt[1] - q.mj));
+    }
+  }
+  q.hx = std::max(hx * 1.4, 1e-12);
+  q.hy = std::max(hy * 1.4, 1e-12);
+}
+
+// write_plot: the panel's frame, the run dots and both ellipses (clipped to the panel).
+void write_plot(std::ostream& s, const Panel& q, const std::vector<PoseError>& errors,
+                const std::vector<std::array<double, 2>>& pred,
+                const std::vector<std::array<double, 2>>& samp) {
+  s << "<g>\n<rect x=\"" << q.ox << "\" y=\"" << q.oy << "\" width=\"" << kPanel << "\" height=\""
+    << kPanel << "\" fill=\"none\" stroke=\"black\"/>\n";
+  s << "<clipPath id=\"c" << q.p << "\"><rect x=\"" << q.ox << "\" y=\"" << q.oy << "\" width=\""
+    << kPanel << "\" height=\"" << kPanel << "\"/></clipPath>\n<g clip-path=\"url(#c" << q.p
+    << ")\">\n";
+  const std::size_t n = std::min(errors.size(), kMaxDots);
+  for (std::size_t k = 0; k < n; ++k) {
+    s << "<circle cx=\"" << q.sx(errors[k][q.i]) << "\" cy=\"" << q.sy(errors[k][q.j])
+      << "\" r=\"1.2\" fill=\"#7a9cc6\"/>\n";
+  }
+  auto poly = [&](const std::vector<std::array<double, 2>>& pts, const char* style) {
+    s << "<polyline fill=\"none\" " << style << " points=\"";
+    for (const auto& pt : pts) s << q.sx(pt[0]) << "," << q.sy(pt[1]) << " ";
+    s << "\"/>\n";
+  };
+  poly(samp, "stroke=\"black\" stroke-width=\"1.5\"");
+  poly(pred, "stroke=\"#c0392b\" stroke-width=\"1.5\" stroke-dasharray=\"6,4\"");
+  s << "</g>\n";
+}
+
+// write_axes: axis labels and the extreme values of each axis, in mm / mrad.
+void write_axes(std::ostream& s, const Panel& q) {
+  const double ox = q.ox, oy = q.oy;
+  s << std::setprecision(3);
+  s << "<text x=\"" << ox + kPanel / 2 << "\" y=\"" << oy + kPanel + 30
+    << "\" text-anchor=\"middle\">" << kLabel[q.i] << "</text>\n"
+    << "<text x=\"" << ox << "\" y=\"" << oy + kPanel + 14 << "\">" << (q.mi - q.hx) * kScale[q.i]
+    << "</text>\n"
+    << "<text x=\"" << ox + kPanel << "\" y=\"" << oy + kPanel + 14 << "\" text-anchor=\"end\">"
+    << (q.mi + q.hx) * kScale[q.i] << "</text>\n"
+    << "<text transform=\"translate(" << ox - 8 << "," << oy + kPanel / 2
+    << ") rotate(-90)\" text-anchor=\"middle\">" << kLabel[q.j] << "</text>\n"
+    << "<text x=\"" << ox + 3 << "\" y=\"" << oy + 12 << "\">" << (q.mj + q.hy) * kScale[q.j]
+    << "</text>\n"
+    << "<text x=\"" << ox + 3 << "\" y=\"" << oy + kPanel - 4 << "\">"
+    << (q.mj - q.hy) * kScale[q.j] << "</text>\n";
+  s << std::setprecision(6);
+}
+
 }  // namespace
 
 std::string error_ellipse_svg(const std::vector<PoseError>& errors, const Cov3& predicted,
@@ -55,55 +121,19 @@ std::string error_ellipse_svg(const std::vector<PoseError>& errors, const Cov3& 
     << "<text x=\"" << kMargin << "\" y=\"34\">dots: runs; solid: 95% ellipse of the sample; "
     << "dashed: 95% ellipse predicted by the closed form (both around the sample mean)</text>\n";
   for (int p = 0; p < 3; ++p) {
-    const int i = pairs[p][0], j = pairs[p][1];
-    const auto pred = ellipse_points(predicted, i, j, mean[i], mean[j]);
-    const auto samp = ellipse_points(sample, i, j, mean[i], mean[j]);
-    // Half-range: the larger ellipse plus a margin, so outlying dots may fall off the panel.
-    double hx = 0.0, hy = 0.0;
-    for (const auto* e : {&pred, &samp}) {
-      for (const auto& q : *e) {
-        hx = std::max(hx, std::fabs(q[0] - mean[i]));
-        hy = std::max(hy, std::fabs(q[1] - mean[j]));
-      }
-    }
-    hx = std::max(hx * 1.4, 1e-12);
-    hy = std::max(hy * 1.4, 1e-12);
-    const double ox = kMargin + p * (kPanel + kMargin), oy = 1.5 * kMargin;
-    auto sx = [&](double v) { return ox + kPanel * (0.5 + 0.5 * (v - mean[i]) / hx); };
-    auto sy = [&](double v) { return oy + kPanel * (0.5 - 0.5 * (v - mean[j]) / hy); };
-    s << "<g>\n<rect x=\"" << ox << "\" y=\"" << oy << "\" width=\"" << kPanel << "\" height=\""
-      << kPanel << "\" fill=\"none\" stroke=\"black\"/>\n";
-    s << "<clipPath id=\"c" << p << "\"><rect x=\"" << ox << "\" y=\"" << oy << "\" width=\""
-      << kPanel << "\" height=\"" << kPanel << "\"/></clipPath>\n<g clip-path=\"url(#c" << p
-      << ")\">\n";
-    const std::size_t n = std::min(errors.size(), kMaxDots);
-    for (std::size_t k = 0; k < n; ++k) {
-      s << "<circle cx=\"" << sx(errors[k][i]) << "\" cy=\"" << sy(errors[k][j])
-        << "\" r=\"1.2\" fill=\"#7a9cc6\"/>\n";
-    }
-    auto poly = [&](const std::vector<std::array<double, 2>>& pts, const char* style) {
-      s << "<polyline fill=\"none\" " << style << " points=\"";
-      for (const auto& q : pts) s << sx(q[0]) << "," << sy(q[1]) << " ";
-      s << "\"/>\n";
-    };
-    poly(samp, "stroke=\"black\" stroke-width=\"1.5\"");
-    poly(pred, "stroke=\"#c0392b\" stroke-width=\"1.5\" stroke-dasharray=\"6,4\"");
-    s << "</g>\n";
-    // Axis labels and the extreme values of each axis, in mm / mrad.
-    s << std::setprecision(3);
-    s << "<text x=\"" << ox + kPanel / 2 << "\" y=\"" << oy + kPanel + 30
-      << "\" text-anchor=\"middle\">" << kLabel[i] << "</text>\n"
-      << "<text x=\"" << ox << "\" y=\"" << oy + kPanel + 14 << "\">" << (mean[i] - hx) * kScale[i]
-      << "</text>\n"
-      << "<text x=\"" << ox + kPanel << "\" y=\"" << oy + kPanel + 14 << "\" text-anchor=\"end\">"
-      << (mean[i] + hx) * kScale[i] << "</text>\n"
-      << "<text transform=\"translate(" << ox - 8 << "," << oy + kPanel / 2
-      << ") rotate(-90)\" text-anchor=\"middle\">" << kLabel[j] << "</text>\n"
-      << "<text x=\"" << ox + 3 << "\" y=\"" << oy + 12 << "\">" << (mean[j] + hy) * kScale[j]
-      << "</text>\n"
-      << "<text x=\"" << ox + 3 << "\" y=\"" << oy + kPanel - 4 << "\">"
-      << (mean[j] - hy) * kScale[j] << "</text>\n";
-    s << std::setprecision(6);
+    Panel q;
+    q.p = p;
+    q.i = pairs[p][0];
+    q.j = pairs[p][1];
+    q.mi = mean[q.i];
+    q.mj = mean[q.j];
+    q.ox = kMargin + p * (kPanel + kMargin);
+    q.oy = 1.5 * kMargin;
+    const auto pred = ellipse_points(predicted, q.i, q.j, q.mi, q.mj);
+    const auto samp = ellipse_points(sample, q.i, q.j, q.mi, q.mj);
+    half_range(q, pred, samp);
+    write_plot(s, q, errors, pred, samp);
+    write_axes(s, q);
     s << "</g>\n";
   }
   s << "</svg>\n";

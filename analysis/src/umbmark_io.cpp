@@ -32,16 +32,11 @@ Result<std::vector<calib::UmbmarkRun>> read_umbmark_runs(std::istream& in,
     } else {
       return csv.error("field 'direction' = '" + dir + "' must be cw or ccw");
     }
-    // A return error beyond 1000 m or 1000 rad is a unit mistake, not odometry.
     auto number = [&](int col, const char* field, const char* unit) -> Result<double> {
       auto v = csv.parse_double(f[static_cast<std::size_t>(col)], field);
       if (!v) return std::move(v).error();
-      if (std::fabs(*v) > 1000.0) {
-        std::ostringstream m;
-        m << "field '" << field << "' = " << *v << " is outside the allowed range [-1000, 1000] "
-          << unit;
-        return csv.error(m.str());
-      }
+      if (std::fabs(*v) > kMaxReturnError)
+        return csv.range_error(return_error_range(field, *v, unit));
       return *v;
     };
     auto ex = number(c[1], "ex", "m");

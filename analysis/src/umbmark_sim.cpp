@@ -40,7 +40,7 @@ struct Driver {
     sim::SquareOptions so;
     so.side = o.side;
     so.direction = d == Direction::kCw ? sim::Turn::kClockwise : sim::Turn::kCounterClockwise;
-    const bool paper = o.noise == "paper";
+    const bool paper = o.noise == UmbmarkNoise::kPaper;
     const std::uint64_t seed = seed_of(o.seed, run_index++);
     sim::UmbmarkFloor::Options fo;
     fo.wheel_radius = kNominalDiameter / 2.0;
@@ -95,22 +95,32 @@ struct Driver {
 
 }  // namespace
 
+std::ostream& operator<<(std::ostream& out, UmbmarkRobot r) {
+  return out << choice_name(kUmbmarkRobots, r);
+}
+
+std::ostream& operator<<(std::ostream& out, UmbmarkNoise n) {
+  return out << choice_name(kUmbmarkNoises, n);
+}
+
+Result<UmbmarkRobot> parse_umbmark_robot(std::string_view text) {
+  if (auto r = choice_value<UmbmarkRobot>(kUmbmarkRobots, text)) return *r;
+  return make_error(Errc::kInvalidArgument,
+                    "--robot = '" + std::string(text) +
+                        "' is not known (allowed: " + choice_join(kUmbmarkRobots, ", ") + ")");
+}
+
+Result<UmbmarkNoise> parse_umbmark_noise(std::string_view text) {
+  if (auto n = choice_value<UmbmarkNoise>(kUmbmarkNoises, text)) return *n;
+  return make_error(Errc::kInvalidArgument, "--noise = '" + std::string(text) + "' must be " +
+                                                choice_join(kUmbmarkNoises, " or "));
+}
+
 Status check_umbmark_sim_options(const UmbmarkSimOptions& o) {
-  std::ostringstream m;
-  if (o.robot != "labmate") {
-    m << "--robot = '" << o.robot << "' is not known (allowed: labmate)";
-  } else if (o.runs < 1 || o.runs > 1000) {
-    m << range_message({"--runs", static_cast<double>(o.runs), 1, 1000, "", false, true});
-  } else if (o.passes < 1 || o.passes > 10) {
-    m << range_message({"--passes", static_cast<double>(o.passes), 1, 10, "", false, true});
-  } else if (!(o.side >= 0.5 && o.side <= 20.0)) {
-    m << range_message({"--side", o.side, 0.5, 20.0, "m"});
-  } else if (o.noise != "none" && o.noise != "paper") {
-    m << "--noise = '" << o.noise << "' must be none or paper";
-  } else {
-    return Ok{};
-  }
-  return make_error(Errc::kInvalidArgument, m.str());
+  if (o.runs < 1 || o.runs > 1000) return range_error(integer_range("--runs", o.runs, 1, 1000));
+  if (o.passes < 1 || o.passes > 10) return range_error(integer_range("--passes", o.passes, 1, 10));
+  if (!(o.side >= 0.5 && o.side <= 20.0)) return range_error({"--side", o.side, 0.5, 20.0, "m"});
+  return Ok{};
 }
 
 Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,

@@ -1,6 +1,5 @@
 #include "odo/calibration/record.hpp"
 
-#include "odo/calibration/le_bytes.hpp"
 
 #include <ctime>
 
@@ -8,6 +7,8 @@
 #include <cmath>
 #include <cstring>
 #include <sstream>
+
+#include "odo/hal/bytes.hpp"
 
 namespace odo::calib {
 namespace {
@@ -48,10 +49,12 @@ Error corrupt(const std::string& why) {
 
 Status check_range(const char* field, double v, double lo, double hi, const char* unit) {
   if (std::isfinite(v) && v >= lo && v <= hi) return Ok{};
-  std::ostringstream m;
-  m << field << " = " << v << " is outside the allowed range [" << lo << ", " << hi << "]"
-    << (*unit ? " " : "") << unit;
-  return make_error(Errc::kInvalidArgument, m.str());
+  return range_error({field, v, lo, hi, unit, false});
+}
+
+Status check_count(const char* field, std::uint32_t v) {
+  if (v <= RecordLimits::kRunsMax) return Ok{};
+  return range_error(integer_range(field, v, 0, RecordLimits::kRunsMax));
 }
 
 Status validate_fit(const FixFitProvenance& f) {
@@ -62,13 +65,8 @@ Status validate_fit(const FixFitProvenance& f) {
     if (auto s = check_range(field, v, 0.0, 1e9, ""); !s) return s;
   if (auto s = check_range("sigma_wheelbase", f.sigma_wheelbase, 0.0, L::kWheelbaseMax, "m"); !s)
     return s;
-  for (auto [field, v] :
-       {std::pair{"fixes_used", f.fixes_used}, {"fixes_rejected", f.fixes_rejected}})
-    if (v > L::kRunsMax)
-      return make_error(Errc::kInvalidArgument, std::string(field) + " = " + std::to_string(v) +
-                                                    " is outside the allowed range [0, " +
-                                                    std::to_string(L::kRunsMax) + "]");
-  return Ok{};
+  if (auto s = check_count("fixes_used", f.fixes_used); !s) return s;
+  return check_count("fixes_rejected", f.fixes_rejected);
 }
 
 }  // namespace
@@ -136,9 +134,12 @@ Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
   const auto version = get<std::uint16_t>(bytes, 4);
   const auto length = get<std::uint16_t>(bytes, 6);
   if (version < 1) return corrupt("format version 0 is not valid");
-  if (length < kRecordV1Bytes || length > bytes.size())
-    return corrupt("length " + std::to_string(length) + " outside [" +
-                   std::to_string(kRecordV1Bytes) + ", " + std::to_string(bytes.size()) + "]");
+  if (length < kRecordV1Bytes || length > bytes.size()) {
+    Error e = range_error(
+        integer_range("length", length, kRecordV1Bytes, static_cast<std::int64_t>(bytes.size())));
+    e.code = Errc::kCorrupt;  // a stored length: the record is damaged, not the caller's input
+    return e;
+  }
   const auto stored = get<std::uint32_t>(bytes, length - 4U);
   const auto computed = crc32(bytes.first(length - 4U));
   if (stored != computed) {
@@ -206,10 +207,7 @@ Status validate_record(const CalibrationRecord& r) {
   if (r.e_max_after)
     if (auto s = check_range("e_max_syst_after", *r.e_max_after, L::kEmaxMin, L::kEmaxMax, "m"); !s)
       return s;
-  if (r.runs > L::kRunsMax)
-    return make_error(Errc::kInvalidArgument, "runs = " + std::to_string(r.runs) +
-                                                  " is outside the allowed range [0, " +
-                                                  std::to_string(L::kRunsMax) + "]");
+  if (auto s = check_count("runs", r.runs); !s) return s;
   if (r.time < 0)
     return make_error(Errc::kInvalidArgument,
                       "time = " + std::to_string(r.time) + " is before 1970 (allowed: >= 0 s)");

@@ -1,25 +1,26 @@
 #include "odo/calibration/scaling.hpp"
 
 #include <cmath>
-#include <sstream>
+
+#include "odo/calibration/record.hpp"
 
 namespace odo::calib {
 
 Result<ScalingResult> scaling_error(double l_calc, double l_actual, double wheel_diameter) {
-  auto bad = [](const char* field, double v, const char* range) {
-    std::ostringstream m;
-    m << field << " = " << v << " is outside the allowed range " << range;
-    return make_error(Errc::kInvalidArgument, m.str());
-  };
-  if (!(std::isfinite(l_calc) && l_calc > 0)) return bad("calculated length", l_calc, "(0, inf) m");
-  if (!(std::isfinite(l_actual) && l_actual > 0))
-    return bad("measured length", l_actual, "(0, inf) m");
-  if (!(std::isfinite(wheel_diameter) && wheel_diameter > 0))
-    return bad("wheel diameter", wheel_diameter, "(0, inf) m");
+  auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!positive(l_calc)) return range_error(positive_range("calculated length", l_calc, "m"));
+  if (!positive(l_actual)) return range_error(positive_range("measured length", l_actual, "m"));
+  if (!positive(wheel_diameter))
+    return range_error(positive_range("wheel diameter", wheel_diameter, "m"));
   ScalingResult r;
   r.e_s = l_calc / l_actual;
   // More than 25 % off is a wrong measurement or wrong units, not a worn tyre.
-  if (r.e_s < 0.8 || r.e_s > 1.25) return bad("E_s", r.e_s, "[0.8, 1.25] (check the units)");
+  using L = RecordLimits;  // the E_s a calibration record may hold
+  if (r.e_s < L::kScalingMin || r.e_s > L::kScalingMax) {
+    FieldRange e{"E_s", r.e_s, L::kScalingMin, L::kScalingMax};
+    e.note = "(check the units)";
+    return range_error(std::move(e));
+  }
   // L = N * pi * D / (n * Ce) for the same N: L_calc / L_actual = Dn / Da, so Da = Dn / E_s.
   r.wheel_diameter_new = wheel_diameter / r.e_s;
   return r;

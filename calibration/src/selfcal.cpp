@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "odo/odometry/kinematics.hpp"
 #include "selfcal_model.hpp"
 
 namespace odo::calib {
@@ -17,10 +18,9 @@ using detail::Vec3;
 using Vec2 = Eigen::Vector2d;
 using Mat2 = Eigen::Matrix2d;
 
-Error bad(const std::string& field, double v, const std::string& range) {
-  std::ostringstream m;
-  m << field << " = " << v << " is outside the allowed range " << range;
-  return make_error(Errc::kInvalidArgument, m.str());
+// positive: a value that must be positive and finite, worded by range_message.
+Error positive(std::string field, double v, const char* unit = "") {
+  return range_error(positive_range(std::move(field), v, unit));
 }
 
 Status check_fixes(std::span<const PoseFix> fixes) {
@@ -30,9 +30,9 @@ Status check_fixes(std::span<const PoseFix> fixes) {
     if (!(std::isfinite(f.x) && std::isfinite(f.y) && (!f.theta || std::isfinite(*f.theta))))
       return make_error(Errc::kInvalidArgument, n + "x, y, theta must be finite");
     if (!(std::isfinite(f.sigma_xy) && f.sigma_xy > 0.0))
-      return bad(n + "sigma_xy", f.sigma_xy, "(0, inf) m");
+      return positive(n + "sigma_xy", f.sigma_xy, "m");
     if (f.theta && !(std::isfinite(f.sigma_theta) && f.sigma_theta > 0.0))
-      return bad(n + "sigma_theta", f.sigma_theta, "(0, inf) rad");
+      return positive(n + "sigma_theta", f.sigma_theta, "rad");
     if (i > 0 && f.t <= fixes[i - 1].t)
       return make_error(Errc::kInvalidArgument, n + "time is not after the previous fix's");
   }
@@ -234,22 +234,26 @@ const char* verdict_name(Verdict v) noexcept {
 
 Status check_selfcal_config(const SelfCalConfig& c) {
   if (!(std::isfinite(c.metres_per_count) && c.metres_per_count > 0.0))
-    return bad("metres_per_count", c.metres_per_count, "(0, inf) m");
-  if (!(c.in_use.c_l >= 0.5 && c.in_use.c_l <= 1.5)) return bad("c_l", c.in_use.c_l, "[0.5, 1.5]");
-  if (!(c.in_use.c_r >= 0.5 && c.in_use.c_r <= 1.5)) return bad("c_r", c.in_use.c_r, "[0.5, 1.5]");
+    return positive("metres_per_count", c.metres_per_count, "m");
+  const Limit factor = KinematicLimits::kFactor;  // what the loop's kinematics accept
+  for (auto [f, v] : {std::pair{"c_l", c.in_use.c_l}, {"c_r", c.in_use.c_r}})
+    if (!factor.contains(v)) return range_error({f, v, factor.lo, factor.hi});
   if (!(std::isfinite(c.in_use.wheelbase) && c.in_use.wheelbase > 0.0))
-    return bad("wheelbase", c.in_use.wheelbase, "(0, inf) m");
+    return positive("wheelbase", c.in_use.wheelbase, "m");
   for (auto [f, v] : {std::pair{"prior_sigma_factor", c.prior_sigma_factor},
                       {"prior_sigma_wheelbase", c.prior_sigma_wheelbase},
                       {"max_sigma_factor", c.max_sigma_factor},
                       {"max_sigma_wheelbase", c.max_sigma_wheelbase}}) {
-    if (!(std::isfinite(v) && v > 0.0)) return bad(f, v, "(0, inf)");
+    if (!(std::isfinite(v) && v > 0.0)) return positive(f, v);
   }
   if (auto s = check_error_model(c.odometry_noise); !s) return s;
   if (c.max_iterations < 1 || c.max_iterations > 100)
-    return bad("max_iterations", c.max_iterations, "[1, 100]");
-  if (c.hold_out_every < 0 || c.hold_out_every == 1 || c.hold_out_every > 1000)
-    return bad("hold_out_every", c.hold_out_every, "0 or [2, 1000]");
+    return range_error(integer_range("max_iterations", c.max_iterations, 1, 100));
+  if (c.hold_out_every < 0 || c.hold_out_every == 1 || c.hold_out_every > 1000) {
+    FieldRange r = integer_range("hold_out_every", c.hold_out_every, 2, 1000);
+    r.note = "(or 0: no hold-out)";
+    return range_error(std::move(r));
+  }
   return Ok{};
 }
 

@@ -14,10 +14,16 @@ const char* name(Direction d) {
   return d == Direction::kCw ? "cw" : "ccw";
 }
 
-Error out_of_range(const std::string& field, double v, const std::string& range) {
-  std::ostringstream m;
-  m << field << " = " << v << " is outside the allowed range " << range;
-  return make_error(Errc::kInvalidArgument, m.str());
+// factor_range: a correction factor outside the record's [kFactorMin, kFactorMax].
+Error factor_range(std::string field, double v) {
+  return range_error({std::move(field), v, RecordLimits::kFactorMin, RecordLimits::kFactorMax});
+}
+
+// angle_range: |alpha| or |beta| beyond kMaxAngle, almost always millimetres typed as metres.
+Error angle_range(const char* field, double v) {
+  FieldRange r{field, v, -kMaxAngle, kMaxAngle, "rad", false};
+  r.note = "(check the units: metres)";
+  return range_error(std::move(r));
 }
 
 }  // namespace
@@ -136,11 +142,11 @@ Result<std::optional<double>> eps_theta_nonsys(std::span<const UmbmarkRun> runs)
 Result<UmbmarkResult> umbmark_compute(const UmbmarkInput& in) {
   using L = RecordLimits;
   if (!(std::isfinite(in.side) && in.side > 0.0))
-    return out_of_range("side", in.side, "(0, inf) m");
+    return range_error(positive_range("side", in.side, "m"));
   if (!(std::isfinite(in.current.wheelbase) && in.current.wheelbase > 0.0))
-    return out_of_range("wheelbase", in.current.wheelbase, "(0, inf) m");
+    return range_error(positive_range("wheelbase", in.current.wheelbase, "m"));
   for (auto [f, v] : {std::pair{"current c_l", in.current.c_l}, {"current c_r", in.current.c_r}}) {
-    if (!(v >= L::kFactorMin && v <= L::kFactorMax)) return out_of_range(f, v, "[0.9, 1.1]");
+    if (!(v >= L::kFactorMin && v <= L::kFactorMax)) return factor_range(f, v);
   }
   for (std::size_t i = 0; i < in.runs.size(); ++i) {
     const UmbmarkRun& r = in.runs[i];
@@ -165,10 +171,8 @@ Result<UmbmarkResult> umbmark_compute(const UmbmarkInput& in) {
   }
   out.e_max_syst = e_max_syst(out.cw, out.ccw);
   out.ab = type_ab(out.cw, out.ccw, in.side);
-  if (!(std::fabs(out.ab.alpha) <= kMaxAngle))
-    return out_of_range("alpha", out.ab.alpha, "[-0.1, 0.1] rad (check the units: metres)");
-  if (!(std::fabs(out.ab.beta) <= kMaxAngle))
-    return out_of_range("beta", out.ab.beta, "[-0.1, 0.1] rad (check the units: metres)");
+  if (!(std::fabs(out.ab.alpha) <= kMaxAngle)) return angle_range("alpha", out.ab.alpha);
+  if (!(std::fabs(out.ab.beta) <= kMaxAngle)) return angle_range("beta", out.ab.beta);
   out.radius = curvature_radius(out.ab.beta, in.side);
   // Eq. 6.24 with the wheelbase the robot used, as the report does (the true one differs by
   // E_b, a second-order change of E_d - 1 that the next pass would absorb).
@@ -179,7 +183,7 @@ Result<UmbmarkResult> umbmark_compute(const UmbmarkInput& in) {
   out.composed = compose(in.current, out.pass);
   for (auto [f, v] : {std::pair{"c_l", out.composed.c_l}, {"c_r", out.composed.c_r}}) {
     if (!(v >= L::kFactorMin && v <= L::kFactorMax))
-      return out_of_range(std::string("resulting ") + f, v, "[0.9, 1.1]");
+      return factor_range(std::string("resulting ") + f, v);
   }
   out.sigma = return_spread(in.runs, out.cw, out.ccw);
   // The c.g. with fewer runs is the less certain one: SEM with the smaller n.

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "odo/drivers/count_plausibility.hpp"
+#include "odo/hal/bytes.hpp"
 
 namespace odo::drivers {
 namespace {
@@ -36,13 +37,9 @@ CanDecode decode_count(const CanFrame& f, const CanCountLayout& layout,
   if (layout.byte_offset < 0 || bytes < 1 || bytes > 8 || layout.byte_offset + bytes > 8 ||
       f.len > 8 || layout.byte_offset + bytes > f.len)
     return CanDecode::kShortFrame;
-  std::uint64_t v = 0;
-  for (int i = 0; i < bytes; ++i) {
-    // Little endian: byte i carries bits 8i..8i+7; big endian: the first byte is the highest.
-    const int src =
-        layout.big_endian ? layout.byte_offset + i : layout.byte_offset + (bytes - 1 - i);
-    v = (v << 8) | f.data[static_cast<std::size_t>(src)];
-  }
+  const std::uint8_t* p = f.data.data() + layout.byte_offset;
+  const auto n = static_cast<std::size_t>(bytes);
+  const std::uint64_t v = layout.big_endian ? get_be(p, n) : get_le(p, n);
   const int bits = bytes * 8;
   if (layout.is_signed) {
     out = wrap_bits(static_cast<std::int64_t>(v), bits);

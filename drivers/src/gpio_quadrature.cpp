@@ -98,6 +98,13 @@ struct GpioQuadratureEncoder::Impl {
     }
     return true;
   }
+  // read_line: appends line l's waiting events to `pending`, counting what does not fit;
+  // false when the kernel refuses the read.
+  bool read_line(gpiod_line* l) noexcept;
+  // sort_pending: `pending` in timestamp order (stable, in place).
+  void sort_pending() noexcept;
+  // ready_count: how many of the oldest pending events may be applied at read time t_read.
+  std::size_t ready_count(TimeNs t_read) const noexcept;
   void process(std::size_t n) noexcept;
   void idle_check() noexcept;
   void run() noexcept;
@@ -164,6 +171,61 @@ void GpioQuadratureEncoder::Impl::idle_check() noexcept {
   suspect_events = events_read;
 }
 
+bool GpioQuadratureEncoder::Impl::read_line(gpiod_line* l) noexcept {
+  unsigned idx = 0;
+  while (idx < n_lines && gpiod_line_bulk_get_line(&bulk, idx) != l) ++idx;
+  const int got = gpiod_line_event_read_multiple(l, buf.data(), static_cast<unsigned>(buf.size()));
+  if (got < 0) return false;
+  const BatchSplit split =
+      split_batch(static_cast<std::size_t>(got), pending.capacity() - pending.size());
+  if (split.dropped > 0)
+    pub[roles[idx].wheel].dropped.fetch_add(split.dropped, std::memory_order_relaxed);
+  for (std::size_t e = 0; e < split.taken; ++e) {
+    const gpiod_line_event& ev = buf[e];
+    const TimeNs ts = static_cast<TimeNs>(ev.ts.tv_sec) * kNsPerSecond + ev.ts.tv_nsec;
+    ++events_read;
+    if (roles[idx].role != Role::kIndex) {
+      pub[roles[idx].wheel].received.fetch_add(1, std::memory_order_relaxed);
+      seen_ts[roles[idx].wheel][roles[idx].role == Role::kA ? 0 : 1] = ts;
+    }
+    pending.push_back(Event{ts, static_cast<std::uint8_t>(idx),
+                            ev.event_type == GPIOD_LINE_EVENT_RISING_EDGE, false});
+  }
+  return true;
+}
+
+void GpioQuadratureEncoder::Impl::sort_pending() noexcept {
+  // Each line's events arrive in order, so the buffer is nearly sorted: an insertion sort
+  // merges the lines by timestamp in place (stable: equal stamps keep their read order) and,
+  // unlike std::stable_sort, allocates nothing.
+  for (std::size_t k = 1; k < pending.size(); ++k) {
+    const Event e = pending[k];
+    std::size_t m = k;
+    for (; m > 0 && pending[m - 1].ts > e.ts; --m) pending[m] = pending[m - 1];
+    pending[m] = e;
+  }
+}
+
+std::size_t GpioQuadratureEncoder::Impl::ready_count(TimeNs t_read) const noexcept {
+  // An A/B edge is ready when the wheel's other line has delivered a younger edge (each
+  // line's queue is in order, so nothing older of that line can still come) or when it is
+  // older than the reorder window (the other line may simply not have moved). While the
+  // wheel turns, A and B alternate, so the order is exact whatever the kernel's latency.
+  // Everything is ready when the buffer is nearly full.
+  const TimeNs cutoff = t_read - cfg.reorder_window;
+  const bool flush = pending.size() * 4 >= pending.capacity() * 3;
+  std::size_t n = 0;
+  while (n < pending.size()) {
+    const Event& e = pending[n];
+    const LineRole role = roles[e.line];
+    const bool other_newer =
+        role.role != Role::kIndex && seen_ts[role.wheel][role.role == Role::kA ? 1 : 0] > e.ts;
+    if (!(flush || other_newer || e.ts <= cutoff)) break;
+    ++n;
+  }
+  return n;
+}
+
 void GpioQuadratureEncoder::Impl::run() noexcept {
   TimeNs last_activity = monotonic_now();
   while (!stop.load(std::memory_order_relaxed)) {
@@ -178,40 +240,15 @@ void GpioQuadratureEncoder::Impl::run() noexcept {
     timespec to{static_cast<time_t>(wait / kNsPerSecond), static_cast<long>(wait % kNsPerSecond)};
     gpiod_line_bulk evb;
     const int r = gpiod_line_event_wait_bulk(&bulk, &to, &evb);
-    if (r < 0) {
+    const TimeNs t_read = monotonic_now();  // before the reads: the reorder cutoff's origin
+    bool ok = r >= 0;
+    for (unsigned k = 0; r > 0 && ok && k < gpiod_line_bulk_num_lines(&evb); ++k)
+      ok = read_line(gpiod_line_bulk_get_line(&evb, k));
+    if (!ok) {
       failed.store(true, std::memory_order_release);
       return;
     }
-    const TimeNs t_read = monotonic_now();
-    if (r > 0) {
-      for (unsigned k = 0; k < gpiod_line_bulk_num_lines(&evb); ++k) {
-        gpiod_line* l = gpiod_line_bulk_get_line(&evb, k);
-        unsigned idx = 0;
-        while (idx < n_lines && gpiod_line_bulk_get_line(&bulk, idx) != l) ++idx;
-        const int got =
-            gpiod_line_event_read_multiple(l, buf.data(), static_cast<unsigned>(buf.size()));
-        if (got < 0) {
-          failed.store(true, std::memory_order_release);
-          return;
-        }
-        const BatchSplit split =
-            split_batch(static_cast<std::size_t>(got), pending.capacity() - pending.size());
-        if (split.dropped > 0)
-          pub[roles[idx].wheel].dropped.fetch_add(split.dropped, std::memory_order_relaxed);
-        for (std::size_t e = 0; e < split.taken; ++e) {
-          const gpiod_line_event& ev = buf[e];
-          const TimeNs ts = static_cast<TimeNs>(ev.ts.tv_sec) * kNsPerSecond + ev.ts.tv_nsec;
-          ++events_read;
-          if (roles[idx].role != Role::kIndex) {
-            pub[roles[idx].wheel].received.fetch_add(1, std::memory_order_relaxed);
-            seen_ts[roles[idx].wheel][roles[idx].role == Role::kA ? 0 : 1] = ts;
-          }
-          pending.push_back(Event{ts, static_cast<std::uint8_t>(idx),
-                                  ev.event_type == GPIOD_LINE_EVENT_RISING_EDGE, false});
-        }
-      }
-      last_activity = t_read;
-    }
+    if (r > 0) last_activity = t_read;
     if (pending.empty()) {
       if (r == 0 && t_read - last_activity >= cfg.idle_check) {
         idle_check();
@@ -220,31 +257,8 @@ void GpioQuadratureEncoder::Impl::run() noexcept {
       }
       continue;
     }
-    // Each line's events arrive in order, so the buffer is nearly sorted: an insertion sort
-    // merges the lines by timestamp in place (stable: equal stamps keep their read order) and,
-    // unlike std::stable_sort, allocates nothing.
-    for (std::size_t k = 1; k < pending.size(); ++k) {
-      const Event e = pending[k];
-      std::size_t m = k;
-      for (; m > 0 && pending[m - 1].ts > e.ts; --m) pending[m] = pending[m - 1];
-      pending[m] = e;
-    }
-    // An A/B edge is ready when the wheel's other line has delivered a younger edge (each
-    // line's queue is in order, so nothing older of that line can still come) or when it is
-    // older than the reorder window (the other line may simply not have moved). While the
-    // wheel turns, A and B alternate, so the order is exact whatever the kernel's latency.
-    // Everything is ready when the buffer is nearly full.
-    const TimeNs cutoff = t_read - cfg.reorder_window;
-    const bool flush = pending.size() * 4 >= pending.capacity() * 3;
-    std::size_t n = 0;
-    while (n < pending.size()) {
-      const Event& e = pending[n];
-      const LineRole role = roles[e.line];
-      const bool other_newer =
-          role.role != Role::kIndex && seen_ts[role.wheel][role.role == Role::kA ? 1 : 0] > e.ts;
-      if (!(flush || other_newer || e.ts <= cutoff)) break;
-      ++n;
-    }
+    sort_pending();
+    const std::size_t n = ready_count(t_read);
     if (n == 0) continue;
     process(n);
     pending.erase(pending.begin(), pending.begin() + static_cast<std::ptrdiff_t>(n));

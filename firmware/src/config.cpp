@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "odo/firmware/toml_reader.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/odometry/count_delta.hpp"
 #include "odo/protocol/can_protocol.hpp"
 #include "odo/ros2/config.hpp"
 
@@ -24,20 +26,25 @@ Config default_config() {
 namespace {
 
 void read_loop(TableReader t, LoopSection& s) {
-  s.rate_hz = t.number("rate_hz", s.rate_hz, 50.0, 2000.0, "Hz");
+  s.rate_hz =
+      t.number("rate_hz", s.rate_hz, loop::kLoopRateLimit.lo, loop::kLoopRateLimit.hi, "Hz");
   s.status_period = t.number("status_period", s.status_period, 0.0, 3600.0, "s");
   t.finish();
 }
 
 void read_robot(TableReader t, KinematicParams& p) {
-  p.wheel_diameter = t.number("wheel_diameter", p.wheel_diameter, 0.005, 5.0, "m");
-  p.counts_per_rev = t.number("counts_per_rev", p.counts_per_rev, 1.0, 1e9, "counts");
-  p.gear_ratio = t.number("gear_ratio", p.gear_ratio, 1e-3, 1e4, "");
-  p.wheelbase_nominal = t.number("wheelbase", p.wheelbase_nominal, 0.01, 20.0, "m");
+  using L = KinematicLimits;  // the limits Kinematics::create checks
+  auto num = [&](std::string_view key, double v, Limit l, std::string_view unit) {
+    return t.number(key, v, l.lo, l.hi, unit);
+  };
+  p.wheel_diameter = num("wheel_diameter", p.wheel_diameter, L::kWheelDiameter, "m");
+  p.counts_per_rev = num("counts_per_rev", p.counts_per_rev, L::kCountsPerRev, "counts");
+  p.gear_ratio = num("gear_ratio", p.gear_ratio, L::kGearRatio, "");
+  p.wheelbase_nominal = num("wheelbase", p.wheelbase_nominal, L::kWheelbase, "m");
   // Until a calibration is loaded the effective wheelbase is the nominal one.
   p.wheelbase = p.wheelbase_nominal;
-  p.c_l = t.number("c_l", p.c_l, 0.5, 1.5, "");
-  p.c_r = t.number("c_r", p.c_r, 0.5, 1.5, "");
+  p.c_l = num("c_l", p.c_l, L::kFactor, "");
+  p.c_r = num("c_r", p.c_r, L::kFactor, "");
   t.finish();
 }
 
@@ -53,7 +60,8 @@ void read_sim(TableReader t, SimSection& s) {
   s.speed = t.number("speed", s.speed, 0.01, 5.0, "m/s");
   s.turn_rate = t.number("turn_rate", s.turn_rate, 0.05, 10.0, "rad/s");
   s.pause = t.number("pause", s.pause, 0.0, 60.0, "s");
-  s.counter_bits = static_cast<int>(t.integer("counter_bits", s.counter_bits, 16, 64));
+  s.counter_bits =
+      static_cast<int>(t.integer("counter_bits", s.counter_bits, kCounterBitsMin, kCounterBitsMax));
   t.finish();
 }
 

@@ -10,9 +10,7 @@
 #include "odo/drivers/gpiod_parallel_bus.hpp"
 #include "odo/drivers/hctl1100_encoder.hpp"
 #include "odo/drivers/socketcan_bus.hpp"
-#include "odo/sim/hctl1100_model.hpp"
-#include "odo/sim/robot.hpp"
-#include "odo/sim/sim_odrive.hpp"
+#include "odo/sim/robot_buses.hpp"
 
 namespace odo::fw {
 namespace {
@@ -60,51 +58,23 @@ class HctlGpioBackend final : public EncoderBackend {
   std::string desc_;
 };
 
-// HctlSimBackend: the chip models follow the simulated wheels before every bus cycle.
-class HctlSimBackend final : public EncoderBackend, public sim::BusCycleHook {
+// HctlSimBackend: the real driver reading sim_hal's register models, which follow the robot.
+class HctlSimBackend final : public EncoderBackend {
  public:
   HctlSimBackend(const Hctl1100Section& s, sim::SimRobot& robot, Clock& clock, TimeNs epoch)
-      : left_(s.latch == HctlLatch::kLsb ? sim::Hctl1100Model::Latch::kLsbLatch
-                                         : sim::Hctl1100Model::Latch::kNone),
-        right_(left_),
-        bus_(&left_, &right_),
-        robot_(robot),
-        clock_(clock),
-        epoch_(epoch),
-        cycle_(from_seconds(s.bus_cycle)) {
-    bus_.set_hook(this);
-  }
+      : chips_(s.latch == HctlLatch::kLsb ? sim::Hctl1100Model::Latch::kLsbLatch
+                                          : sim::Hctl1100Model::Latch::kNone,
+               from_seconds(s.bus_cycle), robot, clock, epoch) {}
   void set_encoder(drivers::Hctl1100Encoder enc, std::string d) {
     enc_.emplace(std::move(enc));
     desc_ = std::move(d);
   }
-  sim::SimHctlBus& bus() noexcept { return bus_; }
-  void on_bus_cycle() noexcept override {
-    // Bus cycles take time: the wheels move on while the driver reads byte by byte (counted
-    // from the tick's clock reading, so the model never runs ahead of the simulation).
-    const TimeNs now = clock_.now();
-    if (now != last_now_) {
-      last_now_ = now;
-      extra_ = 0;
-    }
-    extra_ += cycle_;
-    const TimeNs t = now - epoch_ + extra_;
-    if (t > robot_.time()) robot_.advance_to(t);
-    left_.follow(robot_.counts_left());
-    right_.follow(robot_.counts_right());
-  }
+  sim::SimHctlBus& bus() noexcept { return chips_.bus(); }
   EncoderSource& encoder() noexcept override { return *enc_; }
   const std::string& describe() const noexcept override { return desc_; }
 
  private:
-  sim::Hctl1100Model left_, right_;
-  sim::SimHctlBus bus_;
-  sim::SimRobot& robot_;
-  Clock& clock_;
-  TimeNs epoch_;
-  TimeNs cycle_;
-  TimeNs extra_ = 0;
-  TimeNs last_now_ = -1;
+  sim::RobotHctlBus chips_;
   std::optional<drivers::Hctl1100Encoder> enc_;
   std::string desc_;
 };
@@ -124,33 +94,29 @@ class CanSocketBackend final : public EncoderBackend {
   std::string desc_;
 };
 
-// CanSimBackend: before each read, the simulated ODrive axes publish every cyclic message due
-// since the last read (the robot moved to each message's time), then the driver reads the port.
+sim::RobotOdriveOptions odrive_options(const CanEncoderSection& s) {
+  sim::RobotOdriveOptions o;
+  o.node_left = static_cast<std::uint32_t>(s.node_left);
+  o.node_right = static_cast<std::uint32_t>(s.node_right);
+  o.period = from_seconds(s.sim_period);
+  o.stop_left_after = s.sim_stop_left_after < 0 ? -1 : from_seconds(s.sim_stop_left_after);
+  o.stop_right_after = s.sim_stop_right_after < 0 ? -1 : from_seconds(s.sim_stop_right_after);
+  return o;
+}
+
+// CanSimBackend: before each read, sim_hal's ODrive axes publish every cyclic message due
+// since the last read, then the real driver reads the port.
 class CanSimBackend final : public EncoderBackend, public EncoderSource {
  public:
   CanSimBackend(const CanEncoderSection& s, sim::SimRobot& robot, TimeNs epoch)
-      : port_(64, 1024),
-        odrive_(port_, sim::SimOdriveOptions{static_cast<std::uint32_t>(s.node_left),
-                                             static_cast<std::uint32_t>(s.node_right), 8192}),
-        robot_(robot),
-        epoch_(epoch),
-        period_(from_seconds(s.sim_period)),
-        stop_left_(s.sim_stop_left_after < 0 ? -1 : from_seconds(s.sim_stop_left_after)),
-        stop_right_(s.sim_stop_right_after < 0 ? -1 : from_seconds(s.sim_stop_right_after)) {}
+      : axes_(odrive_options(s), robot, epoch) {}
   void set_encoder(drivers::CanEncoderSource enc, std::string d) {
     enc_.emplace(std::move(enc));
     desc_ = std::move(d);
   }
-  sim::SimCanPort& port() noexcept { return port_; }
+  sim::SimCanPort& port() noexcept { return axes_.port(); }
   EncoderSample read(TimeNs now) noexcept override {
-    const TimeNs t = now - epoch_;
-    for (; next_ <= t; next_ += period_) {
-      if (next_ > robot_.time()) robot_.advance_to(next_);
-      odrive_.set_sending(0, stop_left_ < 0 || next_ < stop_left_);
-      odrive_.set_sending(1, stop_right_ < 0 || next_ < stop_right_);
-      odrive_.publish(next_ + epoch_, robot_.counts_left(), robot_.counts_right());
-    }
-    if (t > robot_.time()) robot_.advance_to(t);  // the truth at the loop's time
+    axes_.publish_until(now);
     return enc_->read(now);
   }
   int counter_bits() const noexcept override { return enc_->counter_bits(); }
@@ -158,14 +124,7 @@ class CanSimBackend final : public EncoderBackend, public EncoderSource {
   const std::string& describe() const noexcept override { return desc_; }
 
  private:
-  sim::SimCanPort port_;
-  sim::SimOdrive odrive_;
-  sim::SimRobot& robot_;
-  TimeNs epoch_;
-  TimeNs period_;
-  TimeNs stop_left_;
-  TimeNs stop_right_;
-  TimeNs next_ = 0;
+  sim::RobotOdriveBus axes_;
   std::optional<drivers::CanEncoderSource> enc_;
   std::string desc_;
 };

@@ -66,32 +66,29 @@ double Rig::scenario_duration() const noexcept {
   return impl_->scenario_duration;
 }
 
-Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_time) {
-  auto impl = std::make_unique<Impl>();
+namespace {
+
+// hardware_backend: the real encoder backend named in the config (not simulated; a virtual
+// clock is refused).
+Result<std::unique_ptr<EncoderBackend>> hardware_backend(const Config& cfg, const Kinematics& k,
+                                                         bool virtual_time) {
   const EncoderKind be = cfg.encoder.backend;
-  const bool hctl_sim = be == EncoderKind::kHctl1100 && cfg.hctl1100.bus == HctlBus::kSim;
-  const bool can_sim = be == EncoderKind::kCan && cfg.can_encoder.bus == CanEncoderBus::kSim;
-  if (be != EncoderKind::kSim && !hctl_sim && !can_sim) {
-    if (virtual_time)
-      return make_error(Errc::kInvalidArgument,
-                        "--virtual-time needs a simulated encoder "
-                        "backend (encoder.backend = \"" +
-                            std::string(name_of(be)) + "\")");
-    auto b = be == EncoderKind::kGpio       ? make_gpio_backend(cfg)
-             : be == EncoderKind::kHctl1100 ? make_hctl_gpio_backend(cfg, k)
-                                            : make_can_socketcan_backend(cfg, k);
-    if (!b) return std::move(b).error();
-    impl->backend = std::move(b).value();
-    impl->clock = std::make_unique<drivers::MonotonicClock>();
-    impl->encoder = &impl->backend->encoder();
-    impl->description = impl->backend->describe() + ", real time (CLOCK_MONOTONIC)";
-    return Rig(std::move(impl));
-  }
-  const KinematicParams& p = k.params();
+  if (virtual_time)
+    return make_error(Errc::kInvalidArgument,
+                      "--virtual-time needs a simulated encoder "
+                      "backend (encoder.backend = \"" +
+                          std::string(name_of(be)) + "\")");
+  return be == EncoderKind::kGpio       ? make_gpio_backend(cfg)
+         : be == EncoderKind::kHctl1100 ? make_hctl_gpio_backend(cfg, k)
+                                        : make_can_socketcan_backend(cfg, k);
+}
+
+// sim_geometry: the simulated robot's true geometry: the LabMate's errors, or the belief.
+sim::RobotGeometry sim_geometry(const SimSection& s, const KinematicParams& p) {
   sim::RobotGeometry g;
   g.counts_per_rev = p.counts_per_rev;
   g.gear_ratio = p.gear_ratio;
-  if (cfg.sim.robot == SimRobotKind::kLabmate) {
+  if (s.robot == SimRobotKind::kLabmate) {
     const sim::RobotGeometry lm = sim::labmate_geometry(p.wheel_diameter);
     g.wheel_diameter_left = lm.wheel_diameter_left;
     g.wheel_diameter_right = lm.wheel_diameter_right;
@@ -100,6 +97,26 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     g.wheel_diameter_left = g.wheel_diameter_right = p.wheel_diameter;
     g.wheelbase = p.wheelbase_nominal;
   }
+  return g;
+}
+
+}  // namespace
+
+Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_time) {
+  const EncoderKind be = cfg.encoder.backend;
+  const bool hctl_sim = be == EncoderKind::kHctl1100 && cfg.hctl1100.bus == HctlBus::kSim;
+  const bool can_sim = be == EncoderKind::kCan && cfg.can_encoder.bus == CanEncoderBus::kSim;
+  auto impl = std::make_unique<Impl>();
+  if (be != EncoderKind::kSim && !hctl_sim && !can_sim) {
+    auto b = hardware_backend(cfg, k, virtual_time);
+    if (!b) return std::move(b).error();
+    impl->backend = std::move(b).value();
+    impl->clock = std::make_unique<drivers::MonotonicClock>();
+    impl->encoder = &impl->backend->encoder();
+    impl->description = impl->backend->describe() + ", real time (CLOCK_MONOTONIC)";
+    return Rig(std::move(impl));
+  }
+  const sim::RobotGeometry g = sim_geometry(cfg.sim, k.params());
   sim::Scenario scenario = make_scenario(cfg.sim, k);
   impl->scenario_duration = sim::scenario_duration(scenario);
   auto robot = sim::SimRobot::create(g, std::move(scenario));
@@ -114,16 +131,10 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     impl->encoder_wrapper = std::make_unique<sim::EpochEncoder>(*impl->sim_encoder);
     impl->encoder = impl->encoder_wrapper.get();
   }
-  if (hctl_sim) {
+  if (hctl_sim || can_sim) {
     const TimeNs epoch = virtual_time ? 0 : impl->clock->now();
-    auto b = make_hctl_sim_backend(cfg, k, *impl->robot, *impl->clock, epoch);
-    if (!b) return std::move(b).error();
-    impl->backend = std::move(b).value();
-    impl->encoder = &impl->backend->encoder();
-  }
-  if (can_sim) {
-    const TimeNs epoch = virtual_time ? 0 : impl->clock->now();
-    auto b = make_can_sim_backend(cfg, k, *impl->robot, epoch);
+    auto b = hctl_sim ? make_hctl_sim_backend(cfg, k, *impl->robot, *impl->clock, epoch)
+                      : make_can_sim_backend(cfg, k, *impl->robot, epoch);
     if (!b) return std::move(b).error();
     impl->backend = std::move(b).value();
     impl->encoder = &impl->backend->encoder();

@@ -66,9 +66,7 @@ std::int64_t TableReader::integer(std::string_view key, std::int64_t def, std::i
     return def;
   }
   if (*i < lo || *i > hi) {
-    fail(n, key,
-         "= " + std::to_string(*i) + " is outside the allowed range [" + std::to_string(lo) + ", " +
-             std::to_string(hi) + "]");
+    fail(n, key, range_text(integer_range(std::string(key), *i, lo, hi)));
     return def;
   }
   return *i;

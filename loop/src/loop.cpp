@@ -11,9 +11,9 @@ namespace odo::loop {
 Result<std::unique_ptr<OdometryLoop>> OdometryLoop::create(const LoopConfig& cfg,
                                                            const Kinematics& k,
                                                            EncoderSource& encoder, Clock& clock) {
-  if (!(cfg.rate_hz >= 50.0 && cfg.rate_hz <= 2000.0)) {
-    return make_error(Errc::kInvalidArgument,
-                      range_message({"loop.rate_hz", cfg.rate_hz, 50.0, 2000.0, "Hz", false}));
+  if (!kLoopRateLimit.contains(cfg.rate_hz)) {
+    const Limit l = kLoopRateLimit;
+    return range_error({"loop.rate_hz", cfg.rate_hz, l.lo, l.hi, "Hz", false});
   }
   if (auto s = check_counter_bits(encoder.counter_bits()); !s) return std::move(s).error();
   if (auto s = check_error_model(cfg.error_model); !s) {

@@ -5,7 +5,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "odo/calibration/le_bytes.hpp"
+#include "odo/hal/bytes.hpp"
 #include "odo/calibration/record.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
@@ -17,12 +17,12 @@ constexpr std::size_t kCrcOffset = kStateRecordBytes - 4;
 
 template <class T>
 void put(StateBytes& b, std::size_t off, T v) noexcept {
-  calib::put_le(std::span<std::uint8_t>(b), off, v);
+  put_le(std::span<std::uint8_t>(b), off, v);
 }
 
 template <class T>
 T get(std::span<const std::uint8_t> b, std::size_t off) noexcept {
-  return calib::get_le<T>(b, off);
+  return get_le<T>(b, off);
 }
 
 Error corrupt(const std::string& why) {

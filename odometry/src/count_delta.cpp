@@ -5,9 +5,8 @@
 namespace odo {
 
 Status check_counter_bits(int bits) {
-  if (bits >= 16 && bits <= 64) return Ok{};
-  return make_error(Errc::kInvalidArgument,
-                    "counter_bits = " + std::to_string(bits) + " is outside [16, 64]");
+  if (bits >= kCounterBitsMin && bits <= kCounterBitsMax) return Ok{};
+  return range_error(integer_range("counter_bits", bits, kCounterBitsMin, kCounterBitsMax));
 }
 
 Result<std::int64_t> normalise_reading(std::int64_t raw, int bits) {

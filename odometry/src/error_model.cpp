@@ -163,7 +163,7 @@ std::optional<FieldRange> error_model_range(const ErrorModelParams& k) {
 }
 
 Status check_error_model(const ErrorModelParams& k) {
-  if (auto r = error_model_range(k)) return make_error(Errc::kInvalidArgument, range_message(*r));
+  if (auto r = error_model_range(k)) return range_error(std::move(*r));
   return Ok{};
 }
 

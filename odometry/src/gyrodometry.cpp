@@ -282,30 +282,38 @@ FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
     return out;
   }
   out.flags |= why | kFusionGyroUsed;
-  const double n2 = p_.noise.rate_noise_density * p_.noise.rate_noise_density;
-  const double b_res = b_res_;
   if (!in_interval_) {
-    in_interval_ = true;
-    interval_ticks_ = 0;
-    out.flags |= kFusionEventStart;
-    counters_.disagreements += (why & kFusionDisagree) != 0 ? 1 : 0;
-    counters_.speed_events += (why & kFusionSpeedLimit) != 0 ? 1 : 0;
-    counters_.accel_events += (why & kFusionAccelLimit) != 0 ? 1 : 0;
-    out.dtheta = odo + begin_interval();
-    // m ticks of gyro at once: white noise N^2 m dt, the bias error's (b_res m dt)^2.
-    const double t = static_cast<double>(interval_ticks_) * dt;
-    out.var_heading = n2 * t + b_res * b_res * t * t;
-    counters_.flagged_ticks += interval_ticks_;
-    return out;
+    open_interval(why, odo, dt, out);
+  } else {
+    continue_interval(e.gyro, dt, out);
   }
+  return out;
+}
+
+void Gyrodometry::open_interval(std::uint32_t why, double odo, double dt, FusedTick& out) noexcept {
+  in_interval_ = true;
+  interval_ticks_ = 0;
+  out.flags |= kFusionEventStart;
+  counters_.disagreements += (why & kFusionDisagree) != 0 ? 1 : 0;
+  counters_.speed_events += (why & kFusionSpeedLimit) != 0 ? 1 : 0;
+  counters_.accel_events += (why & kFusionAccelLimit) != 0 ? 1 : 0;
+  out.dtheta = odo + begin_interval();
+  // m ticks of gyro at once: white noise N^2 m dt, the bias error's (b_res m dt)^2.
+  const double n2 = p_.noise.rate_noise_density * p_.noise.rate_noise_density;
+  const double t = static_cast<double>(interval_ticks_) * dt;
+  out.var_heading = n2 * t + b_res_ * b_res_ * t * t;
+  counters_.flagged_ticks += interval_ticks_;
+}
+
+void Gyrodometry::continue_interval(double gyro, double dt, FusedTick& out) noexcept {
   ring_[head_].replaced = true;
-  out.dtheta = e.gyro;
+  out.dtheta = gyro;
   // Tick k of an interval: the bias part (b_res k dt)^2 grows by b_res^2 dt^2 (2k + 1).
+  const double n2 = p_.noise.rate_noise_density * p_.noise.rate_noise_density;
   const double k = static_cast<double>(interval_ticks_);
-  out.var_heading = n2 * dt + b_res * b_res * dt * dt * (2.0 * k + 1.0);
+  out.var_heading = n2 * dt + b_res_ * b_res_ * dt * dt * (2.0 * k + 1.0);
   ++interval_ticks_;
   ++counters_.flagged_ticks;
-  return out;
 }
 
 void propagate_gyro_arc(Cov3& cov, double sin_theta0, double cos_theta0, double ds, double dtheta,

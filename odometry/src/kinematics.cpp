@@ -4,33 +4,32 @@
 
 #include <cmath>
 #include <numbers>
-#include <sstream>
+#include <optional>
 
 namespace odo {
 namespace {
 
-// check_range: one field against [lo, hi]; writes a message naming field, value and range.
-bool check_range(std::ostringstream& msg, const char* field, const char* unit, double v, double lo,
-                 double hi) {
-  if (std::isfinite(v) && v >= lo && v <= hi) return true;
-  msg << range_message({field, v, lo, hi, unit});
+// check_range: one field against its limit; on failure `bad` says which, as data.
+bool check_range(std::optional<FieldRange>& bad, const char* field, const char* unit, double v,
+                 Limit l) {
+  if (l.contains(v)) return true;
+  bad = FieldRange{field, v, l.lo, l.hi, unit};
   return false;
 }
 
 }  // namespace
 
 Result<Kinematics> Kinematics::create(const KinematicParams& p) {
-  std::ostringstream msg;
-  // Ranges are wide enough for any wheeled base from a 30 mm toy to a 3 m vehicle but catch
-  // unit mistakes (mm instead of m, degrees instead of a factor).
-  const bool ok = check_range(msg, "wheel_diameter", "m", p.wheel_diameter, 0.005, 5.0) &&
-                  check_range(msg, "counts_per_rev", "", p.counts_per_rev, 1.0, 1e9) &&
-                  check_range(msg, "gear_ratio", "", p.gear_ratio, 1e-3, 1e4) &&
-                  check_range(msg, "wheelbase_nominal", "m", p.wheelbase_nominal, 0.01, 20.0) &&
-                  check_range(msg, "wheelbase", "m", p.wheelbase, 0.01, 20.0) &&
-                  check_range(msg, "c_l", "", p.c_l, 0.5, 1.5) &&
-                  check_range(msg, "c_r", "", p.c_r, 0.5, 1.5);
-  if (!ok) return make_error(Errc::kInvalidArgument, msg.str());
+  using L = KinematicLimits;
+  std::optional<FieldRange> bad;
+  const bool ok = check_range(bad, "wheel_diameter", "m", p.wheel_diameter, L::kWheelDiameter) &&
+                  check_range(bad, "counts_per_rev", "", p.counts_per_rev, L::kCountsPerRev) &&
+                  check_range(bad, "gear_ratio", "", p.gear_ratio, L::kGearRatio) &&
+                  check_range(bad, "wheelbase_nominal", "m", p.wheelbase_nominal, L::kWheelbase) &&
+                  check_range(bad, "wheelbase", "m", p.wheelbase, L::kWheelbase) &&
+                  check_range(bad, "c_l", "", p.c_l, L::kFactor) &&
+                  check_range(bad, "c_r", "", p.c_r, L::kFactor);
+  if (!ok) return range_error(std::move(*bad));
   return Kinematics(p);
 }
 

@@ -4,13 +4,6 @@
 #include <numbers>
 
 namespace odo {
-namespace {
-
-// Re-derive sin/cos from theta every this many steps so that the rotated pair can never drift
-// from the cumulative heading by more than a few ulp.
-constexpr std::uint32_t kResyncSteps = 1024;
-
-}  // namespace
 
 double wrap_angle(double a) noexcept {
   constexpr double kPi = std::numbers::pi;
@@ -38,30 +31,18 @@ Pose2 report_step(const Pose2& p, double d_left, double d_right, double b) noexc
 
 void PoseIntegrator::reset(const Pose2& p) noexcept {
   pose_ = p;
-  s_ = std::sin(p.theta);
-  c_ = std::cos(p.theta);
-  steps_since_sync_ = 0;
+  heading_.reset(p.theta);
 }
 
 void PoseIntegrator::step_arc(double ds, double dth) noexcept {
   const HalfAngle h = half_angle(0.5 * dth);
-  // cos/sin of the mean heading theta + h by the angle-sum identities.
-  const double cm = c_ * h.c - s_ * h.s;
-  const double sm = s_ * h.c + c_ * h.s;
+  double cm = 0.0, sm = 0.0;  // of the mean heading theta + h
+  heading_.mean(h.c, h.s, cm, sm);
   const double chord = ds * h.sinc;
   pose_.x += chord * cm;
   pose_.y += chord * sm;
   pose_.theta += dth;
-  if (++steps_since_sync_ >= kResyncSteps) {
-    s_ = std::sin(pose_.theta);
-    c_ = std::cos(pose_.theta);
-    steps_since_sync_ = 0;
-  } else {
-    // Rotate once more by h: theta + 2h is the new heading.
-    const double c_new = cm * h.c - sm * h.s;
-    s_ = sm * h.c + cm * h.s;
-    c_ = c_new;
-  }
+  heading_.finish(pose_.theta, cm, sm, h.c, h.s);
 }
 
 void Odometry::update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {

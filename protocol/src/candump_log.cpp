@@ -26,18 +26,18 @@ bool all_digits(std::string_view s) {
 
 }  // namespace
 
-Result<CandumpLine> parse_candump_line(std::string_view line) {
-  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-  CandumpLine out;
-  if (line.empty() || line.front() != '(')
-    return make_error(Errc::kParse, "expected '(seconds.microseconds)' at the start");
-  const std::size_t close = line.find(')');
-  if (close == std::string_view::npos) return make_error(Errc::kParse, "missing ')'");
-  const std::string_view stamp = line.substr(1, close - 1);
+namespace {
+
+Error bad(const char* why) {
+  return make_error(Errc::kParse, why);
+}
+
+// parse_stamp: "<seconds>.<6 digits>" (inside the parentheses) into out.sec, out.usec.
+Status parse_stamp(std::string_view stamp, CandumpLine& out) {
   const std::size_t dot = stamp.find('.');
   if (dot == std::string_view::npos || !all_digits(stamp.substr(0, dot)) ||
       stamp.substr(dot + 1).size() != 6 || !all_digits(stamp.substr(dot + 1)) || dot > 12)
-    return make_error(Errc::kParse, "time stamp must be seconds.microseconds (6 digits)");
+    return bad("time stamp must be seconds.microseconds (6 digits)");
   for (char c : stamp.substr(0, dot)) out.sec = out.sec * 10 + (c - '0');
   for (char c : stamp.substr(dot + 1)) out.usec = out.usec * 10 + (c - '0');
   // Callers turn the stamp into 64-bit nanoseconds (TimeNs): beyond 9223372035 s (the year
@@ -48,49 +48,74 @@ Result<CandumpLine> parse_candump_line(std::string_view line) {
                                         "(at most " +
                                         std::to_string(kCandumpMaxSeconds) + " s, year 2262)");
   }
-  std::string_view rest = line.substr(close + 1);
-  if (rest.empty() || rest.front() != ' ')
-    return make_error(Errc::kParse, "expected a space after the time stamp");
-  rest.remove_prefix(1);
-  const std::size_t sp = rest.find(' ');
-  if (sp == 0 || sp == std::string_view::npos || sp > 15)
-    return make_error(Errc::kParse, "expected an interface name (1..15 characters) and a frame");
-  // A Linux interface name is printable ASCII without blanks or '/'; anything else (a NUL byte,
-  // found by fuzz_candump) would not survive being printed back.
-  for (char c : rest.substr(0, sp)) {
+  return Ok{};
+}
+
+// parse_iface: a Linux interface name: printable ASCII without blanks or '/'; anything else
+// (a NUL byte, found by fuzz_candump) would not survive being printed back.
+Status parse_iface(std::string_view name, CandumpLine& out) {
+  for (char c : name) {
     if (c <= ' ' || c > '~' || c == '/')
-      return make_error(Errc::kParse,
-                        "interface name must be printable ASCII without blanks or '/'");
+      return bad("interface name must be printable ASCII without blanks or '/'");
   }
-  out.iface = std::string(rest.substr(0, sp));
-  const std::string_view fr = rest.substr(sp + 1);
-  const std::size_t hash = fr.find('#');
-  if (hash == std::string_view::npos) return make_error(Errc::kParse, "frame without '#'");
-  const std::string_view id = fr.substr(0, hash);
+  out.iface = std::string(name);
+  return Ok{};
+}
+
+// parse_id: 3 (standard) or 8 (extended) hex digits into f.id, f.extended.
+Status parse_id(std::string_view id, CanFrame& f) {
   if (id.size() != 3 && id.size() != 8)
-    return make_error(Errc::kParse, "CAN id must have 3 (standard) or 8 (extended) hex digits");
+    return bad("CAN id must have 3 (standard) or 8 (extended) hex digits");
   std::uint32_t v = 0;
   for (char c : id) {
     const int h = hex_value(c);
-    if (h < 0) return make_error(Errc::kParse, "CAN id is not hexadecimal");
+    if (h < 0) return bad("CAN id is not hexadecimal");
     v = (v << 4) | static_cast<std::uint32_t>(h);
   }
-  out.frame.extended = id.size() == 8;
-  if ((!out.frame.extended && v > 0x7FF) || v > 0x1FFFFFFF)
-    return make_error(Errc::kParse, "CAN id out of range");
-  out.frame.id = v;
-  const std::string_view data = fr.substr(hash + 1);
+  f.extended = id.size() == 8;
+  if ((!f.extended && v > 0x7FF) || v > 0x1FFFFFFF) return bad("CAN id out of range");
+  f.id = v;
+  return Ok{};
+}
+
+// parse_data: 0..8 bytes as pairs of hex digits into f.data, f.len.
+Status parse_data(std::string_view data, CanFrame& f) {
   if (!data.empty() && (data.front() == 'R' || data.front() == 'r' || data.front() == '#'))
-    return make_error(Errc::kParse, "remote and CAN FD frames are not part of this protocol");
+    return bad("remote and CAN FD frames are not part of this protocol");
   if (data.size() % 2 != 0 || data.size() > 16)
-    return make_error(Errc::kParse, "data must be 0..8 bytes as pairs of hex digits");
+    return bad("data must be 0..8 bytes as pairs of hex digits");
   for (std::size_t i = 0; i < data.size(); i += 2) {
     const int hi = hex_value(data[i]);
     const int lo = hex_value(data[i + 1]);
-    if (hi < 0 || lo < 0) return make_error(Errc::kParse, "data is not hexadecimal");
-    out.frame.data[i / 2] = static_cast<std::uint8_t>(hi * 16 + lo);
+    if (hi < 0 || lo < 0) return bad("data is not hexadecimal");
+    f.data[i / 2] = static_cast<std::uint8_t>(hi * 16 + lo);
   }
-  out.frame.len = static_cast<std::uint8_t>(data.size() / 2);
+  f.len = static_cast<std::uint8_t>(data.size() / 2);
+  return Ok{};
+}
+
+}  // namespace
+
+Result<CandumpLine> parse_candump_line(std::string_view line) {
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  CandumpLine out;
+  if (line.empty() || line.front() != '(')
+    return bad("expected '(seconds.microseconds)' at the start");
+  const std::size_t close = line.find(')');
+  if (close == std::string_view::npos) return bad("missing ')'");
+  if (auto st = parse_stamp(line.substr(1, close - 1), out); !st) return std::move(st).error();
+  std::string_view rest = line.substr(close + 1);
+  if (rest.empty() || rest.front() != ' ') return bad("expected a space after the time stamp");
+  rest.remove_prefix(1);
+  const std::size_t sp = rest.find(' ');
+  if (sp == 0 || sp == std::string_view::npos || sp > 15)
+    return bad("expected an interface name (1..15 characters) and a frame");
+  if (auto st = parse_iface(rest.substr(0, sp), out); !st) return std::move(st).error();
+  const std::string_view fr = rest.substr(sp + 1);
+  const std::size_t hash = fr.find('#');
+  if (hash == std::string_view::npos) return bad("frame without '#'");
+  if (auto st = parse_id(fr.substr(0, hash), out.frame); !st) return std::move(st).error();
+  if (auto st = parse_data(fr.substr(hash + 1), out.frame); !st) return std::move(st).error();
   return out;
 }
 

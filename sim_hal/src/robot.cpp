@@ -90,16 +90,10 @@ Result<SimRobot> SimRobot::create(const RobotGeometry& g, Scenario scenario, con
 }
 
 SimRobot::SimRobot(const RobotGeometry& g, Scenario s, const Pose2& start)
-    : g_(g), scenario_(std::move(s)), pose_(start) {
+    : g_(g), scenario_(std::move(s)), pose_(start), heading_(kResyncSteps) {
   counts_per_wheel_rad_ = g.counts_per_rev * g.gear_ratio / (2.0 * std::numbers::pi);
   if (!scenario_.empty()) seg_end_ = from_seconds(scenario_[0].duration);
-  resync_heading();
-}
-
-void SimRobot::resync_heading() noexcept {
-  sin_theta_ = std::sin(pose_.theta);
-  cos_theta_ = std::cos(pose_.theta);
-  steps_since_sync_ = 0;
+  heading_.reset(pose_.theta);
 }
 
 void SimRobot::move(double dt, const Segment& seg) noexcept {
@@ -125,7 +119,7 @@ void SimRobot::move(double dt, const Segment& seg) noexcept {
     if (!(std::fabs(h) < kHalfAngleSeriesLimit)) {
       // A large turn in one step (coarse test steps): real trigonometry, then a fresh sin/cos.
       pose_ = arc_step(pose_, d_l, d_r, g_.wheelbase);
-      resync_heading();
+      heading_.reset(pose_.theta);
       return;
     }
     const HalfAngle a = half_angle(h);  // the series branch
@@ -137,18 +131,12 @@ void SimRobot::move(double dt, const Segment& seg) noexcept {
     step_d_r_ = d_r;
   }
   // cos/sin of the mean heading by the angle-sum identities instead of a sin and cos per step.
-  const double cm = cos_theta_ * step_cos_h_ - sin_theta_ * step_sin_h_;
-  const double sm = sin_theta_ * step_cos_h_ + cos_theta_ * step_sin_h_;
+  double cm = 0.0, sm = 0.0;
+  heading_.mean(step_cos_h_, step_sin_h_, cm, sm);
   pose_.x += step_chord_ * cm;
   pose_.y += step_chord_ * sm;
   pose_.theta += step_dth_;
-  if (++steps_since_sync_ >= kResyncSteps) {
-    resync_heading();
-  } else {
-    // Rotate once more by h: theta + 2h is the new heading.
-    cos_theta_ = cm * step_cos_h_ - sm * step_sin_h_;
-    sin_theta_ = sm * step_cos_h_ + cm * step_sin_h_;
-  }
+  heading_.finish(pose_.theta, cm, sm, step_cos_h_, step_sin_h_);
 }
 
 void SimRobot::advance_across(TimeNs t) noexcept {
@@ -166,7 +154,7 @@ void SimRobot::advance_across(TimeNs t) noexcept {
       seg_end_ = seg_ < scenario_.size() ? seg_start_ + from_seconds(scenario_[seg_].duration)
                                          : kNoSegment;
       // Segment boundary: the rotated sin/cos restart from the exact heading.
-      resync_heading();
+      heading_.reset(pose_.theta);
     }
   }
 }

@@ -1,13 +1,8 @@
 #include "odo/sim/sim_odrive.hpp"
 
+#include "odo/hal/bytes.hpp"
+
 namespace odo::sim {
-namespace {
-
-void put_le32(CanFrame& f, std::size_t at, std::uint32_t v) noexcept {
-  for (std::size_t i = 0; i < 4; ++i) f.data[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
-}
-
-}  // namespace
 
 void SimOdrive::publish(TimeNs stamp, std::int64_t left, std::int64_t right) noexcept {
   const std::array<std::int64_t, 2> counts{left, right};
@@ -19,9 +14,9 @@ void SimOdrive::publish(TimeNs stamp, std::int64_t left, std::int64_t right) noe
     f.id = (nodes[i] << 5) | 0x00A;
     f.len = 8;
     f.stamp = stamp;
-    put_le32(f, 0, static_cast<std::uint32_t>(static_cast<std::uint64_t>(c)));  // low 32 bits
+    put_le(f.data.data(), 4, static_cast<std::uint64_t>(c));  // the low 32 bits
     const std::int64_t in_cpr = ((c % opts_.cpr) + opts_.cpr) % opts_.cpr;
-    put_le32(f, 4, static_cast<std::uint32_t>(in_cpr));
+    put_le(f.data.data() + 4, 4, static_cast<std::uint64_t>(in_cpr));
     port_.inject(f);
     ++frames_;
   }

@@ -32,7 +32,7 @@ void expect_within_10_percent(const analysis::McResult& r, const char* path) {
 TEST(ErrorMonteCarlo, OutbackVariancesWithin10PercentOfSample) {
   analysis::McOptions o;
   o.runs = kRuns;
-  o.path = "outback";
+  o.path = analysis::McPath::kOutback;
   auto r = analysis::run_error_monte_carlo(o);
   ASSERT_TRUE(r.ok()) << r.error().message;
   expect_within_10_percent(*r, "outback");
@@ -48,7 +48,7 @@ TEST(ErrorMonteCarlo, OutbackVariancesWithin10PercentOfSample) {
 TEST(ErrorMonteCarlo, ArcVariancesWithin10PercentOfSample) {
   analysis::McOptions o;
   o.runs = kRuns;
-  o.path = "arc";
+  o.path = analysis::McPath::kArc;
   auto r = analysis::run_error_monte_carlo(o);
   ASSERT_TRUE(r.ok()) << r.error().message;
   expect_within_10_percent(*r, "arc");
@@ -69,7 +69,6 @@ TEST(ErrorMonteCarlo, NoNoiseNoSpread) {
 TEST(ErrorMonteCarlo, RejectsBadOptions) {
   const std::pair<analysis::McOptions, const char*> cases[] = {
       {{.runs = 1}, "--runs = 1 is outside the allowed range [2, 1000000]"},
-      {{.path = "square"}, "--path = 'square' must be outback or arc"},
       {{.k = {-1e-4, 0.00058}}, "--k-left = -0.0001 m^(1/2) is outside the allowed range"},
       {{.k = {1e-4, 0.5}}, "--k-right = 0.5 m^(1/2) is outside"},
       {{.wheelbase = 0.0}, "--wheelbase = 0 m is outside the allowed range [0.05, 5] m"},
@@ -79,6 +78,11 @@ TEST(ErrorMonteCarlo, RejectsBadOptions) {
     ASSERT_FALSE(r.ok()) << expect;
     EXPECT_NE(r.error().message.find(expect), std::string::npos) << r.error().message;
   }
+  // The path is a choice, read from its text once (odomctl --path).
+  auto p = analysis::parse_mc_path("square");
+  ASSERT_FALSE(p.ok());
+  EXPECT_NE(p.error().message.find("--path = 'square' must be outback or arc"), std::string::npos)
+      << p.error().message;
 }
 
 // StraightLineSlopes: sample variances of the along-track (x) and lateral (y) error of a straight

@@ -240,7 +240,7 @@ TEST(SELFCAL_SUITE, NoiseFreeFixesWithinFiveHundredthsOfAPercent) {
 // squares on the same floor. Returns {self-calibrated, manual} [m].
 std::pair<double, double> noisy_seed(std::uint64_t seed, bool table) {
   analysis::UmbmarkSimOptions uo;
-  uo.noise = "paper";
+  uo.noise = analysis::UmbmarkNoise::kPaper;
   uo.seed = seed;
   auto manual = analysis::run_umbmark_simulation(uo);
   EXPECT_TRUE(manual) << manual.error().message;

@@ -21,7 +21,7 @@ TEST(UmbmarkStudy, PaperNoiseTwentySeeds) {
   std::vector<double> improve, sigma, gain_asked, gain_not_asked;
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
     analysis::UmbmarkSimOptions o;
-    o.noise = "paper";
+    o.noise = analysis::UmbmarkNoise::kPaper;
     o.passes = 2;
     o.seed = seed;
     auto r = analysis::run_umbmark_simulation(o);

@@ -12,6 +12,14 @@
 
 namespace odo::analysis {
 
+// kMaxReturnError: a return error beyond 1000 m or 1000 rad is a unit mistake, not odometry.
+inline constexpr double kMaxReturnError = 1000.0;
+
+// return_error_range: the range of a run's return error field `field` ("ex", ...) in `unit`.
+inline FieldRange return_error_range(const std::string& field, double v, const char* unit) {
+  return {"field '" + field + "'", v, -kMaxReturnError, kMaxReturnError, unit, false};
+}
+
 // CsvReader: reads rows of comma-separated fields; blank lines and lines starting with '#' are
 // skipped. Field text is trimmed of spaces and a trailing CR.
 class CsvReader {
@@ -27,6 +35,8 @@ class CsvReader {
   std::size_t columns() const { return n_columns_; }  // columns named in the header
   // error: an Error of kind kParse prefixed with "source:line: ".
   Error error(const std::string& what) const;
+  // range_error: error(range_message(r)) carrying r (kind kParse: the file is at fault).
+  Error range_error(FieldRange r) const;
 
   // parse_double / parse_int64: strict parsing of one field (whole field, finite).
   Result<double> parse_double(const std::string& text, std::string_view field) const;

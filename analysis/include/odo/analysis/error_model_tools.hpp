@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "odo/hal/choice.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/error_model.hpp"
 
@@ -18,9 +19,23 @@ namespace odo::analysis {
 // One run's end-of-path error: true pose minus odometry pose (x [m], y [m], theta [rad]).
 using PoseError = std::array<double, 3>;
 
+// McPath: the Monte Carlo path; kMcPaths spells it (odomctl --path).
+enum class McPath : std::uint8_t {
+  kOutback,  // 10 m forward, 10 m back
+  kArc,      // see path_description()
+};
+inline constexpr Choice<McPath> kMcPaths[] = {{McPath::kOutback, "outback"}, {McPath::kArc, "arc"}};
+
+// name_of: the spelling of p ("outback", "arc").
+constexpr std::string_view name_of(McPath p) {
+  return choice_name(kMcPaths, p);
+}
+// parse_mc_path: the path spelt `text`; the error names --path and the choices.
+Result<McPath> parse_mc_path(std::string_view text);
+
 struct McOptions {
-  int runs = 2000;               // 2 .. 1e6
-  std::string path = "outback";  // outback: 10 m forward, 10 m back; arc: see path_description()
+  int runs = 2000;  // 2 .. 1e6
+  McPath path = McPath::kOutback;
   ErrorModelParams k;            // noise injected into the simulated wheels [m^(1/2)]
   double wheelbase = 0.34;       // true = believed wheelbase [m], 0.05 .. 5
   std::uint64_t seed = 1;        // run i uses the noise sequence of (seed, i)
@@ -43,7 +58,7 @@ struct McResult {
 Status check_mc_options(const McOptions& o);
 
 // path_description: one line describing the path, for reports.
-std::string path_description(const std::string& path);
+std::string path_description(McPath path);
 
 // run_error_monte_carlo: drives the simulated robot (true geometry = believed) `runs` times along
 // the path with per-wheel white noise of variance k^2 |d| on its true wheel travel, integrates

@@ -8,10 +8,12 @@
 #include <istream>
 #include <numbers>
 #include <optional>
+#include <ostream>
 #include <string>
 #include <vector>
 
 #include "odo/calibration/umbmark.hpp"
+#include "odo/hal/choice.hpp"
 #include "odo/hal/result.hpp"
 
 namespace odo::analysis {
@@ -22,13 +24,32 @@ namespace odo::analysis {
 Result<std::vector<calib::UmbmarkRun>> read_umbmark_runs(std::istream& in,
                                                          const std::string& source);
 
+// UmbmarkRobot, UmbmarkNoise: choices of the UMBmark simulation, spelt once in their tables
+// (odomctl --robot, --noise); printed with their spelling.
+enum class UmbmarkRobot : std::uint8_t {
+  kLabmate,  // the reference robot of DESIGN.md (only one so far)
+};
+enum class UmbmarkNoise : std::uint8_t {
+  kNone,
+  kPaper,  // floor roughness + reference-sensor error
+};
+inline constexpr Choice<UmbmarkRobot> kUmbmarkRobots[] = {{UmbmarkRobot::kLabmate, "labmate"}};
+inline constexpr Choice<UmbmarkNoise> kUmbmarkNoises[] = {{UmbmarkNoise::kNone, "none"},
+                                                          {UmbmarkNoise::kPaper, "paper"}};
+std::ostream& operator<<(std::ostream& out, UmbmarkRobot r);
+std::ostream& operator<<(std::ostream& out, UmbmarkNoise n);
+// parse_umbmark_robot, parse_umbmark_noise: the choice spelt `text`; the error names the
+// option (--robot, --noise) and the choices.
+Result<UmbmarkRobot> parse_umbmark_robot(std::string_view text);
+Result<UmbmarkNoise> parse_umbmark_noise(std::string_view text);
+
 struct UmbmarkSimOptions {
-  std::string robot = "labmate";  // the reference robot of DESIGN.md (only one so far)
-  int runs = 5;                   // N squares a direction per set, 1 .. 1000
-  int passes = 1;                 // 1 .. 10
-  double side = 4.0;              // L [m], 0.5 .. 20
-  std::string noise = "none";     // none | paper (floor roughness + reference-sensor error)
-  bool bumps = false;             // add N + N extended-UMBmark runs to the first pass
+  UmbmarkRobot robot = UmbmarkRobot::kLabmate;
+  int runs = 5;       // N squares a direction per set, 1 .. 1000
+  int passes = 1;     // 1 .. 10
+  double side = 4.0;  // L [m], 0.5 .. 20
+  UmbmarkNoise noise = UmbmarkNoise::kNone;
+  bool bumps = false;  // add N + N extended-UMBmark runs to the first pass
   std::uint64_t seed = 1;
   calib::WheelbaseFormula formula = calib::WheelbaseFormula::kUmbmark629;
 };
@@ -68,8 +89,8 @@ Status check_umbmark_sim_options(const UmbmarkSimOptions& o);
 
 // run_umbmark_simulation: the automated self-calibration on the simulated robot in virtual time.
 // Every square is driven by the robot's own odometry with its current factors
-// (sim::square_scenario) and integrated by loop::OdometryLoop; the return error is the reference pose
-// (true pose, plus the reference's error with --noise paper) minus the loop's pose. Pass k's
+// (sim::square_scenario) and integrated by loop::OdometryLoop; the return error is the reference
+// pose (true pose, plus the reference's error with --noise paper) minus the loop's pose. Pass k's
 // input is pass k-1's verification set (the compensated robot as a "new" robot).
 // progress(done, total) after every run.
 Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,

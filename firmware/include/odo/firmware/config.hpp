@@ -11,6 +11,7 @@
 #include <tuple>
 #include <vector>
 
+#include "odo/hal/choice.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
@@ -24,10 +25,7 @@ namespace odo::fw {
 // Choices of the config file: each an enum, spelt once in its table below; code compares
 // enum values, so a misspelt choice does not compile.
 template <class E>
-struct Choice {
-  E value;
-  std::string_view name;  // as written in the file
-};
+using Choice = odo::Choice<E>;  // hal/choice.hpp; the name as written in the file
 
 enum class EncoderKind : std::uint8_t { kSim, kHctl1100, kGpio, kCan };
 enum class SimRobotKind : std::uint8_t { kLabmate, kNominal };
@@ -88,17 +86,13 @@ constexpr std::span<const Choice<E>> choices() {
 // name_of: how the config file spells choice v.
 template <class E>
 constexpr std::string_view name_of(E v) {
-  for (const Choice<E>& c : choices<E>())
-    if (c.value == v) return c.name;
-  return "?";
+  return choice_name(choices<E>(), v);
 }
 
 // parse_choice: the choice spelt `name`; nullopt when it is none of them.
 template <class E>
 constexpr std::optional<E> parse_choice(std::string_view name) {
-  for (const Choice<E>& c : choices<E>())
-    if (c.name == name) return c.value;
-  return std::nullopt;
+  return choice_value<E>(choices<E>(), name);
 }
 
 // choice_names: the spellings of E's choices, in table order.
@@ -112,9 +106,7 @@ std::vector<std::string> choice_names() {
 // choice_list: "a, b, c": the spellings of E's choices, for messages.
 template <class E>
 std::string choice_list() {
-  std::string s;
-  for (const Choice<E>& c : choices<E>()) s += (s.empty() ? "" : ", ") + std::string(c.name);
-  return s;
+  return choice_join(choices<E>(), ", ");
 }
 
 struct LoopSection {

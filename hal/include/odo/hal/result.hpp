@@ -3,9 +3,12 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <variant>
+
+#include "odo/hal/field_range.hpp"
 
 namespace odo {
 
@@ -20,10 +23,12 @@ enum class Errc : std::uint8_t {
   kTimeout,          // a deadline passed before the operation completed
 };
 
-// Error: a code plus a human-readable message naming the field and the allowed range.
+// Error: a code plus a human-readable message naming the field and the allowed range; a range
+// error also carries that range as data (range_error), so that no caller parses the text.
 struct Error {
   Errc code = Errc::kInvalidArgument;
   std::string message;
+  std::optional<FieldRange> range;  // set by range_error
 };
 
 // Result<T>: holds either a T or an Error; never throws on access through the checked API.
@@ -55,7 +60,13 @@ using Status = Result<Ok>;
 
 // make_error: shorthand for building an Error result.
 inline Error make_error(Errc code, std::string message) {
-  return Error{code, std::move(message)};
+  return Error{code, std::move(message), std::nullopt};
+}
+
+// range_error: kInvalidArgument worded by range_message(r), carrying r.
+inline Error range_error(FieldRange r) {
+  std::string m = range_message(r);
+  return Error{Errc::kInvalidArgument, std::move(m), std::move(r)};
 }
 
 }  // namespace odo

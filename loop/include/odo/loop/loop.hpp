@@ -66,8 +66,11 @@ class TickObserver {
   virtual void on_tick(const LoopSnapshot& snap) noexcept = 0;
 };
 
+// kLoopRateLimit: the allowed loop rate [Hz] (checked by create and by the config reader).
+inline constexpr Limit kLoopRateLimit{50.0, 2000.0};
+
 struct LoopConfig {
-  double rate_hz = 100.0;        // [Hz], 50..2000
+  double rate_hz = 100.0;        // [Hz], kLoopRateLimit
   ErrorModelParams error_model;  // Chong-Kleeman k_L, k_R for the pose covariance
   // The store's status of the kinematics the loop starts with (snapshot calibration_state).
   calib::StoreStatus calibration = calib::StoreStatus::kUncalibrated;

@@ -18,6 +18,11 @@ constexpr std::int64_t wrap_delta(std::int64_t prev, std::int64_t cur, int bits)
   return static_cast<std::int64_t>(diff << shift) >> shift;
 }
 
+// kCounterBitsMin, kCounterBitsMax: the counter widths the loop handles (the config reader
+// checks against the same numbers).
+inline constexpr int kCounterBitsMin = 16;
+inline constexpr int kCounterBitsMax = 64;
+
 // check_counter_bits: validates a counter width, naming the allowed range on failure.
 Status check_counter_bits(int bits);
 

@@ -160,6 +160,11 @@ class Gyrodometry {
   void resum() noexcept;
   std::uint32_t limit_flags() const noexcept;
   double begin_interval() noexcept;
+  // open_interval: the first flagged tick: the window's odometry increments are replaced by the
+  // gyro's (out.dtheta, out.var_heading [rad^2]); why: the kFusion* reasons.
+  void open_interval(std::uint32_t why, double odo, double dt, FusedTick& out) noexcept;
+  // continue_interval: a further flagged tick integrates this tick's gyro increment [rad].
+  void continue_interval(double gyro, double dt, FusedTick& out) noexcept;
   Entry& at(std::size_t age) noexcept;  // age 0: the newest entry
 
   GyrodometryParams p_;

@@ -16,6 +16,17 @@ struct KinematicParams {
   double c_r = 1.0;                // UMBmark correction factor of the right wheel (Eq. 6.34)
 };
 
+// KinematicLimits: the allowed range of each parameter, written once: Kinematics::create and
+// the config reader ([robot]) check against it. Wide enough for any wheeled base from a 30 mm
+// toy to a 3 m vehicle but catch unit mistakes (mm instead of m, degrees instead of a factor).
+struct KinematicLimits {
+  static constexpr Limit kWheelDiameter{0.005, 5.0};  // [m]
+  static constexpr Limit kCountsPerRev{1.0, 1e9};     // [counts]
+  static constexpr Limit kGearRatio{1e-3, 1e4};
+  static constexpr Limit kWheelbase{0.01, 20.0};  // nominal and effective [m]
+  static constexpr Limit kFactor{0.5, 1.5};       // c_l, c_r
+};
+
 // counts_per_metre: encoder counts per metre of nominal wheel travel, Ce * n / (pi * Dn)
 // [counts/m] (the inverse of Kinematics::metres_per_count, for unvalidated parameters).
 double counts_per_metre(const KinematicParams& p) noexcept;

@@ -51,6 +51,45 @@ Pose2 arc_step(const Pose2& p, double d_left, double d_right, double b) noexcept
 // the new heading); kept for comparison with the exact arc.
 Pose2 report_step(const Pose2& p, double d_left, double d_right, double b) noexcept;
 
+// HeadingRotor: sin and cos of a heading carried from step to step by the angle-sum identities
+// (no trigonometric call per step), re-derived from the heading itself every `resync_steps`
+// steps so that the rotated pair never drifts. Used by the loop's PoseIntegrator and by the
+// simulated robot's ground truth.
+class HeadingRotor {
+ public:
+  explicit HeadingRotor(std::uint32_t resync_steps) : resync_steps_(resync_steps) {}
+  // reset: sin and cos of theta [rad], exactly.
+  void reset(double theta) noexcept {
+    s_ = std::sin(theta);
+    c_ = std::cos(theta);
+    steps_ = 0;
+  }
+  double sin() const noexcept { return s_; }
+  double cos() const noexcept { return c_; }
+  // mean: cos and sin (cm, sm) of the heading plus h, from cos h and sin h: the mean heading of
+  // a step that turns by 2h.
+  void mean(double ch, double sh, double& cm, double& sm) const noexcept {
+    cm = c_ * ch - s_ * sh;
+    sm = s_ * ch + c_ * sh;
+  }
+  // finish: the step of mean (cm, sm) ended at heading theta (heading + 2h): rotate the mean once
+  // more by h, or every resync_steps re-derive from theta.
+  void finish(double theta, double cm, double sm, double ch, double sh) noexcept {
+    if (++steps_ >= resync_steps_) {
+      reset(theta);
+    } else {
+      c_ = cm * ch - sm * sh;
+      s_ = sm * ch + cm * sh;
+    }
+  }
+
+ private:
+  double s_ = 0.0;  // sin(heading)
+  double c_ = 1.0;  // cos(heading)
+  std::uint32_t steps_ = 0;
+  std::uint32_t resync_steps_;
+};
+
 // PoseIntegrator: exact-arc integration that carries sin and cos of the heading from tick to
 // tick, so a tick with a small turn costs no trigonometric call at all.
 class PoseIntegrator {
@@ -66,14 +105,15 @@ class PoseIntegrator {
   // heading from elsewhere, e.g. the gyrodometry fusion; step() is step_arc of the wheels').
   void step_arc(double ds, double dtheta) noexcept;
   const Pose2& pose() const noexcept { return pose_; }
-  double sin_theta() const noexcept { return s_; }
-  double cos_theta() const noexcept { return c_; }
+  double sin_theta() const noexcept { return heading_.sin(); }
+  double cos_theta() const noexcept { return heading_.cos(); }
 
  private:
+  // Re-derive sin/cos from theta every this many steps so that the rotated pair can never drift
+  // from the cumulative heading by more than a few ulp.
+  static constexpr std::uint32_t kResyncSteps = 1024;
   Pose2 pose_;
-  double s_ = 0.0;  // sin(pose_.theta)
-  double c_ = 1.0;  // cos(pose_.theta)
-  std::uint32_t steps_since_sync_ = 0;
+  HeadingRotor heading_{kResyncSteps};  // of pose_.theta
 };
 
 // Odometry: counts -> pose and velocity with the calibrated kinematics, and the pose's

@@ -120,9 +120,6 @@ class SimRobot {
   // advance_across: advance_to for steps that reach a segment end or lie past the scenario.
   void advance_across(TimeNs t) noexcept;
 
-  // resync_heading: sin/cos of the true heading from a real sin and cos (drops rounding drift).
-  void resync_heading() noexcept;
-
   RobotGeometry g_;
   Scenario scenario_;
   std::size_t seg_ = 0;
@@ -132,9 +129,7 @@ class SimRobot {
   TimeNs seg_end_ = kNoSegment;
   TimeNs t_ = 0;
   Pose2 pose_;
-  double sin_theta_ = 0.0;  // sin(pose_.theta), rotated step by step between re-syncs
-  double cos_theta_ = 1.0;  // cos(pose_.theta)
-  std::uint32_t steps_since_sync_ = 0;
+  HeadingRotor heading_;  // of pose_.theta, re-derived every kResyncSteps (robot.cpp)
   // Half-angle rotation of the last step, reused while the step's travels are bit-identical
   // (constant wheel speeds and step length); NaN keys never match, so the first step computes.
   double step_d_l_ = std::numeric_limits<double>::quiet_NaN();  // [m] key: left travel
