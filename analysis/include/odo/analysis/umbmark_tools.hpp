@@ -22,6 +22,11 @@ namespace odo::analysis {
 Result<std::vector<calib::UmbmarkRun>> read_umbmark_runs(std::istream& in,
                                                          const std::string& source);
 
+// format_umbmark_runs: the CSV read_umbmark_runs() reads, header direction,ex,ey,etheta,bumps;
+// ex, ey [m] with 4 decimals (0.1 mm, the CAN pose resolution), etheta [rad] with 5 (empty when
+// not measured). What `umbmark simulate --csv` and `umbmark record` write.
+std::string format_umbmark_runs(const std::vector<calib::UmbmarkRun>& runs);
+
 struct UmbmarkSimOptions {
   std::string robot = "labmate";  // the reference robot of DESIGN.md (only one so far)
   int runs = 5;                   // N squares a direction per set, 1 .. 1000
@@ -68,8 +73,8 @@ Status check_umbmark_sim_options(const UmbmarkSimOptions& o);
 
 // run_umbmark_simulation: the automated self-calibration on the simulated robot in virtual time.
 // Every square is driven by the robot's own odometry with its current factors
-// (sim::square_scenario) and integrated by loop::OdometryLoop; the return error is the reference pose
-// (true pose, plus the reference's error with --noise paper) minus the loop's pose. Pass k's
+// (sim::square_scenario) and integrated by loop::OdometryLoop; the return error is the reference
+// pose (true pose, plus the reference's error with --noise paper) minus the loop's pose. Pass k's
 // input is pass k-1's verification set (the compensated robot as a "new" robot).
 // progress(done, total) after every run.
 Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
