@@ -92,18 +92,26 @@ void run_validate(const ValidateOpts& o, int& exit_code) {
     exit_code = kExitBadInput;
     return;
   }
+  // A path that cannot be written is reported before the Monte Carlo, not after it.
+  if (!output_paths_ok({o.plot, o.csv}, "errormodel validate")) {
+    exit_code = kExitBadInput;
+    return;
+  }
   if (o.twist) return run_validate_twist(o, exit_code);
   std::cerr << "errormodel validate: " << o.mc.runs << " runs, "
             << analysis::path_description(o.mc.path) << ", k_L " << o.mc.k.k_left << ", k_R "
             << o.mc.k.k_right << " m^(1/2), b " << o.mc.wheelbase << " m, seed " << o.mc.seed
             << "\n";
+  ProgressLine progress("runs");
   auto r = analysis::run_error_monte_carlo(
-      o.mc, [](int done, int total) { std::cerr << "  " << done << "/" << total << " runs\n"; });
+      o.mc, [&progress](int done, int total) { progress.update(done, total); });
+  progress.finish();
   if (!r) {
     std::cerr << "odomctl errormodel validate: " << r.error().message << "\n";
     exit_code = kExitFailed;
     return;
   }
+  std::cerr << "errormodel validate: " << r->runs << " runs driven\n";
   if (!o.plot.empty()) {
     std::ostringstream title;
     title << "Chong-Kleeman error model, " << r->runs

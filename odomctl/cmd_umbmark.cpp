@@ -15,6 +15,7 @@
 #include "odo/analysis/umbmark_tools.hpp"
 #include "odo/calibration/scaling.hpp"
 #include "odo/firmware/calibration_store.hpp"
+#include "umbmark_shared.hpp"
 
 namespace odo::ctl {
 namespace {
@@ -27,9 +28,9 @@ json opt(const std::optional<double>& v) {
   return v ? json(*v) : json(nullptr);
 }
 
-// compute_json: the documented keys of `umbmark compute --json` (SI units, radians); also what
-// `odomctl calib import` reads (c_l, c_r, b_new, e_max_syst, n_cw, n_ccw).
-json compute_json(const calib::UmbmarkResult& r) {
+}  // namespace
+
+nlohmann::json compute_json(const calib::UmbmarkResult& r) {
   json j{{"method", "umbmark"},
          {"n_cw", r.cw.n},
          {"n_ccw", r.ccw.n},
@@ -100,6 +101,8 @@ void print_compute(std::ostream& out, const calib::UmbmarkResult& r, double whee
         << " deg (extended UMBmark)\n";
   }
 }
+
+namespace {
 
 namespace {
 
@@ -210,121 +213,160 @@ void add_scale(CLI::App& parent, int& exit_code) {
   c->callback([o, &exit_code] { run_scale(*o, exit_code); });
 }
 
-// store_result: saves the final factors as a record (method umbmark-sim) in the store at `path`.
-bool store_result(const std::string& path, const analysis::UmbmarkSimResult& r) {
+}  // namespace
+
+bool save_factors(const std::string& path, calib::CalibrationRecord rec, const char* cmd) {
   auto s = fw::open_calibration_store(path, fw::StoreBackend::kAuto);
   if (!s) {
-    std::cerr << "odomctl umbmark simulate: " << s.error().message << "\n";
+    std::cerr << "odomctl " << cmd << ": " << s.error().message << "\n";
     return false;
   }
+  rec.time = static_cast<std::int64_t>(std::time(nullptr));
+  auto seq = s->store->save(rec);
+  if (!seq) {
+    // The store's messages already start with the path.
+    std::cerr << "odomctl " << cmd << ": " << seq.error().message << "\n";
+    return false;
+  }
+  std::cerr << cmd << ": stored sequence " << *seq << " in " << path << " (" << s->backend << ")\n";
+  return true;
+}
+
+namespace {
+
+namespace {
+
+// sim_record: the final factors of a simulation as a record (method umbmark-sim).
+calib::CalibrationRecord sim_record(const analysis::UmbmarkSimResult& r) {
   const analysis::UmbmarkSimPass& last = r.passes.back();
   calib::CalibrationRecord rec;
   rec.c_l = last.result.composed.c_l;
   rec.c_r = last.result.composed.c_r;
   rec.wheelbase = last.result.composed.wheelbase;
   rec.method = "umbmark-sim";
-  rec.time = static_cast<std::int64_t>(std::time(nullptr));
   rec.e_max_before = r.passes.front().before.e_max_syst;
   rec.e_max_after = last.after.e_max_syst;
   rec.runs = static_cast<std::uint32_t>(last.before.runs.size());
-  auto seq = s->store->save(rec);
-  if (!seq) {
-    std::cerr << "odomctl umbmark simulate: " << path << ": " << seq.error().message << "\n";
-    return false;
-  }
-  std::cerr << "umbmark simulate: stored sequence " << *seq << " in " << path << " (" << s->backend
-            << ")\n";
-  return true;
+  return rec;
 }
-
-namespace {
 
 struct SimulateOpts {
   analysis::UmbmarkSimOptions sim;
   std::string robot = "labmate", noise = "none";  // as typed; parsed into sim before run_simulate
-  std::string store, plot, eb_form = "umbmark";
+  std::string store, plot, csv, eb_form = "umbmark";
   bool json = false;
 };
 
-// run_simulate: `odomctl ... simulate` once its options are parsed; sets exit_code.
-void run_simulate(SimulateOpts o, int& exit_code) {  // a copy: sets o.sim.formula
+// simulate_options_ok: the options, the formula and every output path, before any square.
+bool simulate_options_ok(SimulateOpts& o) {
   if (o.eb_form != "umbmark" && o.eb_form != "chong") {
     std::cerr << "odomctl umbmark simulate: --eb-form = '" << o.eb_form
               << "' must be umbmark or chong\n";
-    exit_code = kExitBadInput;
-    return;
+    return false;
   }
   o.sim.formula = o.eb_form == "chong" ? calib::WheelbaseFormula::kChongKleeman9
                                        : calib::WheelbaseFormula::kUmbmark629;
   if (auto s = analysis::check_umbmark_sim_options(o.sim); !s) {
     std::cerr << "odomctl umbmark simulate: " << s.error().message << "\n";
+    return false;
+  }
+  return output_paths_ok({o.store, o.plot, o.csv}, "umbmark simulate");
+}
+
+// simulate_outputs: --store, --plot and --csv once the simulation is done.
+bool simulate_outputs(const SimulateOpts& o, const analysis::UmbmarkSimResult& r) {
+  if (!o.store.empty() && !save_factors(o.store, sim_record(r), "umbmark simulate")) return false;
+  if (!o.plot.empty()) {
+    std::ostringstream title;
+    title << "UMBmark on the simulated " << o.sim.robot << ": " << o.sim.runs
+          << " cw + ccw squares of " << o.sim.side << " m, noise " << o.sim.noise << ", seed "
+          << o.sim.seed;
+    if (!write_output_file(o.plot, analysis::umbmark_svg(r, title.str()), "umbmark simulate"))
+      return false;
+  }
+  if (!o.csv.empty()) {
+    // The runs the first pass computed from, as `umbmark record` writes them.
+    std::vector<calib::UmbmarkRun> runs = r.passes.front().before.runs;
+    runs.insert(runs.end(), r.bump_runs.begin(), r.bump_runs.end());
+    if (!write_output_file(o.csv, analysis::format_umbmark_runs(runs), "umbmark simulate"))
+      return false;
+  }
+  return true;
+}
+
+void print_simulate_json(const analysis::UmbmarkSimResult& r) {
+  json passes = json::array();
+  for (const analysis::UmbmarkSimPass& p : r.passes) {
+    json jp{{"e_max_syst_before", p.before.e_max_syst},
+            {"e_max_syst_after", p.after.e_max_syst},
+            {"c_l", p.result.composed.c_l},
+            {"c_r", p.result.composed.c_r},
+            {"b", p.result.composed.wheelbase},
+            {"alpha", p.result.ab.alpha},
+            {"beta", p.result.ab.beta},
+            {"sigma", opt(p.result.sigma)},
+            {"sem", p.result.sem},
+            {"second_pass_recommended", p.result.second_pass}};
+    if (p.result.eps_theta_nonsys) jp["eps_theta_nonsys"] = *p.result.eps_theta_nonsys;
+    passes.push_back(jp);
+  }
+  std::cout << json{{"passes", passes}, {"improvement", r.improvement}}.dump() << "\n";
+}
+
+void print_simulate_text(const analysis::UmbmarkSimResult& r) {
+  std::cout << "pass  E_max,syst before  after [mm]   c_l        c_r        b [mm]    "
+               "sigma [mm]  3xSEM [mm]  2nd pass?\n";
+  int i = 1;
+  for (const analysis::UmbmarkSimPass& p : r.passes) {
+    const calib::UmbmarkResult& u = p.result;
+    std::cout << std::fixed << std::setw(4) << i++ << std::setprecision(2) << std::setw(19)
+              << p.before.e_max_syst * 1e3 << std::setw(11) << p.after.e_max_syst * 1e3
+              << std::setprecision(6) << std::setw(11) << u.composed.c_l << std::setw(11)
+              << u.composed.c_r << std::setprecision(3) << std::setw(10)
+              << u.composed.wheelbase * 1e3 << std::setprecision(2) << std::setw(12)
+              << (u.sigma ? *u.sigma * 1e3 : 0.0) << std::setw(12) << 3 * u.sem * 1e3 << "  "
+              << (u.second_pass ? "yes" : "no") << "\n";
+  }
+  std::cout << std::setprecision(1) << "improvement (first before / last after): " << r.improvement
+            << "-fold\n";
+  if (const auto& e = r.passes.front().result.eps_theta_nonsys) {
+    std::cout << std::setprecision(3) << "eps_theta,nonsys (extended UMBmark): " << *e * kDeg
+              << " deg\n";
+  }
+}
+
+// run_simulate: `odomctl ... simulate` once its options are parsed; sets exit_code.
+void run_simulate(SimulateOpts o, int& exit_code) {  // a copy: sets o.sim.formula
+  if (!simulate_options_ok(o)) {
     exit_code = kExitBadInput;
     return;
   }
   std::cerr << "umbmark simulate: " << o.sim.robot << ", " << o.sim.runs << " cw + ccw squares of "
             << o.sim.side << " m per set, " << o.sim.passes << " pass(es), noise " << o.sim.noise
             << (o.sim.bumps ? ", bumps" : "") << ", seed " << o.sim.seed << "\n";
-  auto r = analysis::run_umbmark_simulation(o.sim, [](int done, int total) {
-    std::cerr << "  " << done << "/" << total << " squares\n";
+  ProgressLine progress("squares");
+  int driven = 0;
+  auto r = analysis::run_umbmark_simulation(o.sim, [&](int done, int total) {
+    driven = done;
+    progress.update(done, total);
   });
+  progress.finish();
   if (!r) {
     std::cerr << "odomctl umbmark simulate: " << r.error().message << "\n";
     exit_code = kExitFailed;
     return;
   }
+  std::cerr << "umbmark simulate: " << driven << " squares driven\n";
   for (const std::string& w : r->passes.front().result.warnings)
     std::cerr << "odomctl umbmark simulate: warning: " << w << "\n";
-  if (!o.store.empty() && !store_result(o.store, *r)) {
+  if (!simulate_outputs(o, *r)) {
     exit_code = kExitFailed;
     return;
   }
-  if (!o.plot.empty()) {
-    std::ostringstream title;
-    title << "UMBmark on the simulated " << o.sim.robot << ": " << o.sim.runs
-          << " cw + ccw squares of " << o.sim.side << " m, noise " << o.sim.noise << ", seed "
-          << o.sim.seed;
-    if (!write_output_file(o.plot, analysis::umbmark_svg(*r, title.str()), "umbmark simulate")) {
-      exit_code = kExitFailed;
-      return;
-    }
-  }
   if (o.json) {
-    json passes = json::array();
-    for (const analysis::UmbmarkSimPass& p : r->passes) {
-      json jp{{"e_max_syst_before", p.before.e_max_syst},
-              {"e_max_syst_after", p.after.e_max_syst},
-              {"c_l", p.result.composed.c_l},
-              {"c_r", p.result.composed.c_r},
-              {"b", p.result.composed.wheelbase},
-              {"alpha", p.result.ab.alpha},
-              {"beta", p.result.ab.beta},
-              {"sigma", opt(p.result.sigma)},
-              {"sem", p.result.sem},
-              {"second_pass_recommended", p.result.second_pass}};
-      if (p.result.eps_theta_nonsys) jp["eps_theta_nonsys"] = *p.result.eps_theta_nonsys;
-      passes.push_back(jp);
-    }
-    std::cout << json{{"passes", passes}, {"improvement", r->improvement}}.dump() << "\n";
+    print_simulate_json(*r);
   } else {
-    std::cout << "pass  E_max,syst before  after [mm]   c_l        c_r        b [mm]    "
-                 "sigma [mm]  3xSEM [mm]  2nd pass?\n";
-    int i = 1;
-    for (const analysis::UmbmarkSimPass& p : r->passes) {
-      const calib::UmbmarkResult& u = p.result;
-      std::cout << std::fixed << std::setw(4) << i++ << std::setprecision(2) << std::setw(19)
-                << p.before.e_max_syst * 1e3 << std::setw(11) << p.after.e_max_syst * 1e3
-                << std::setprecision(6) << std::setw(11) << u.composed.c_l << std::setw(11)
-                << u.composed.c_r << std::setprecision(3) << std::setw(10)
-                << u.composed.wheelbase * 1e3 << std::setprecision(2) << std::setw(12)
-                << (u.sigma ? *u.sigma * 1e3 : 0.0) << std::setw(12) << 3 * u.sem * 1e3 << "  "
-                << (u.second_pass ? "yes" : "no") << "\n";
-    }
-    std::cout << std::setprecision(1)
-              << "improvement (first before / last after): " << r->improvement << "-fold\n";
-    if (const auto& e = r->passes.front().result.eps_theta_nonsys) {
-      std::cout << std::setprecision(3) << "eps_theta,nonsys (extended UMBmark): " << *e * kDeg
-                << " deg\n";
-    }
+    print_simulate_text(*r);
   }
   exit_code = kExitOk;
 }
@@ -344,6 +386,7 @@ void add_simulate(CLI::App& parent, int& exit_code) {
   c->add_option("--seed", o->sim.seed, "random seed (default 1)");
   c->add_option("--store", o->store, "write the final factors to this calibration store");
   c->add_option("--plot", o->plot, "write an SVG of the return errors before and after");
+  c->add_option("--csv", o->csv, "write the first pass's runs (the CSV `record` writes)");
   c->add_option("--eb-form", o->eb_form,
                 "wheelbase formula: umbmark (Eq. 6.29, default) or chong (C&K Eq. 9)");
   c->add_flag("--json", o->json, "print one JSON object on stdout");
@@ -363,6 +406,7 @@ void add_umbmark(CLI::App& app, int& exit_code) {
   add_compute(*c, exit_code);
   add_scale(*c, exit_code);
   add_simulate(*c, exit_code);
+  add_record(*c, exit_code);
 }
 
 }  // namespace odo::ctl

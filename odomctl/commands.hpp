@@ -2,7 +2,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <fstream>
+#include <initializer_list>
 #include <iostream>
 #include <string>
 
@@ -15,18 +15,35 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailed = 1;
 inline constexpr int kExitBadInput = 2;
 
-// write_output_file: writes `text` to `path`; on failure says "odomctl <cmd>: <path>: cannot
-// write" on stderr and returns false.
-inline bool write_output_file(const std::string& path, const std::string& text, const char* cmd) {
-  std::ofstream f(path, std::ios::binary);
-  f << text;
-  f.close();
-  if (!f) {
-    std::cerr << "odomctl " << cmd << ": " << path << ": cannot write\n";
-    return false;
-  }
-  return true;
-}
+// write_output_file: writes `text` to a temporary file beside `path` and renames it over
+// `path` (never half-written); on failure says "odomctl <cmd>: <path>: cannot write: <reason>"
+// on stderr and returns false.
+bool write_output_file(const std::string& path, const std::string& text, const char* cmd);
+
+// output_path_problem: why `path` cannot be created or written (empty when it can), checked
+// before any work starts: "<path>: cannot create: No such file or directory".
+std::string output_path_problem(const std::string& path);
+// output_paths_ok: output_path_problem() of each non-empty path; the first problem is printed
+// as "odomctl <cmd>: <problem>" and false returned.
+bool output_paths_ok(std::initializer_list<std::string> paths, const char* cmd);
+
+// ProgressLine: on a terminal (stderr is a tty) one line "  <what> done/total, N s left" that
+// updates in place; off a terminal nothing until finish(), which prints nothing either (the
+// command's own summary says what was done).
+class ProgressLine {
+ public:
+  explicit ProgressLine(std::string what);
+  // update: done of total items finished [-].
+  void update(int done, int total);
+  // finish: ends the updating line (a newline on a terminal).
+  void finish();
+
+ private:
+  std::string what_;
+  bool tty_;
+  double start_;  // [s] monotonic
+  bool shown_ = false;
+};
 
 // take_choice: stores a command-line choice parsed from its text (the only place the text is
 // read) in `out`; on failure says "odomctl <cmd>: <error>" on stderr, sets kExitBadInput and

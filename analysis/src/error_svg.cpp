@@ -111,7 +111,10 @@ void write_axes(std::ostream& s, const Panel& q) {
 std::string error_ellipse_svg(const std::vector<PoseError>& errors, const Cov3& predicted,
                               const Cov3& sample, const PoseError& mean, const std::string& title) {
   const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
-  const double width = 3 * (kPanel + kMargin) + kMargin, height = kPanel + 2.5 * kMargin;
+  // Wide enough for the three panels and for the title, whatever its length.
+  const double width =
+      std::max(3 * (kPanel + kMargin) + kMargin, kMargin + text_width(title, 13) + 10);
+  const double height = kPanel + 2.5 * kMargin;
   std::ostringstream s;
   s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
     << "\" font-family=\"sans-serif\" font-size=\"11\">\n"

@@ -154,10 +154,11 @@ assert abs(j["improvement"] - p1["e_max_syst_before"] / p2["e_max_syst_after"]) 
 assert abs(p2["b"] - 0.337) < 0.2e-3, p2
 PY
 check "simulate json content" $?
-grep -q "6/6 squares" "$tmp/err"; check "simulate progress on stderr" $?
+grep -q "^umbmark simulate: 6 squares driven$" "$tmp/err" && ! grep -q "6/6" "$tmp/err"
+check "simulate off a terminal: a summary, no progress lines" $?
 python3 -c "import sys, xml.dom.minidom as m; d = m.parse(sys.argv[1]); \
-assert len(d.getElementsByTagName('circle')) == 6" "$tmp/u.svg"
-check "simulate svg: well-formed, one dot per run" $?
+assert len(d.getElementsByTagName('title')) == 6" "$tmp/u.svg"
+check "simulate svg: well-formed, one marker (with its tooltip) per run" $?
 printf '[loop]\nstatus_period = 0\n[calibration]\nstore = "%s"\n' "$tmp/sim.bin" >"$tmp/d2.toml"
 run "$ODOMETRYD" --config "$tmp/d2.toml" --virtual-time --duration 1 --json >"$tmp/out" 2>"$tmp/err"
 c_l=$(python3 -c "import json,sys; print('%g' % json.load(open(sys.argv[1]))['passes'][-1]['c_l'])" "$tmp/sim.json")

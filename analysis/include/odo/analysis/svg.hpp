@@ -26,4 +26,10 @@ inline std::string xml_escape(const std::string& t) {
   return out;
 }
 
+// text_width: a generous estimate [px] of one line of sans-serif text (0.62 em a character;
+// DejaVu Sans averages about 0.55 em), so that a canvas can be sized to hold it.
+inline double text_width(const std::string& t, double font_size) {
+  return 0.62 * font_size * static_cast<double>(t.size());
+}
+
 }  // namespace odo::analysis

@@ -42,6 +42,10 @@ std::ostream& operator<<(std::ostream& out, UmbmarkNoise n);
 // option (--robot, --noise) and the choices.
 Result<UmbmarkRobot> parse_umbmark_robot(std::string_view text);
 Result<UmbmarkNoise> parse_umbmark_noise(std::string_view text);
+// format_umbmark_runs: the CSV read_umbmark_runs() reads, header direction,ex,ey,etheta,bumps;
+// ex, ey [m] with 4 decimals (0.1 mm, the CAN pose resolution), etheta [rad] with 5 (empty when
+// not measured). What `umbmark simulate --csv` and `umbmark record` write.
+std::string format_umbmark_runs(const std::vector<calib::UmbmarkRun>& runs);
 
 struct UmbmarkSimOptions {
   UmbmarkRobot robot = UmbmarkRobot::kLabmate;

@@ -1,0 +1,71 @@
+#!/usr/bin/env bash
+# odomctl in a real terminal (issue 20): `umbmark record` typed into a tmux pane (send-keys,
+# capture-pane), and `umbmark simulate`'s progress as one line updated in place.
+# Skipped (exit 77) without tmux.
+set -u
+. "$(dirname "$0")/lib.sh"  # run, check, $tmp
+if ! command -v tmux >/dev/null; then
+  echo "SKIP: tmux is not installed (tools/setup.sh installs it with the test packages)"
+  exit 77
+fi
+sock="odo-tty-$$"
+tm() { tmux -L "$sock" -f /dev/null "$@"; }
+trap 'tm kill-server 2>/dev/null; rm -rf "$tmp"' EXIT
+# wait_pane TEXT: until the visible pane holds TEXT (at most 20 s).
+wait_pane() {
+  local i
+  for i in $(seq 200); do
+    tm capture-pane -p -t t >"$tmp/pane" 2>/dev/null
+    grep -q -- "$1" "$tmp/pane" && return 0
+    sleep 0.1
+  done
+  echo "timeout waiting for '$1' in the pane:"; cat "$tmp/pane"; return 1
+}
+# type TEXT: the keys of TEXT and Enter.
+type_() { tm send-keys -t t -l -- "$1"; tm send-keys -t t Enter; }
+
+printf '[loop]\nstatus_period = 0\n[calibration]\nstore = ""\n[sim]\nscenario = "idle"\n' >"$tmp/idle.toml"
+run "$ODOMETRYD" --config "$tmp/idle.toml" --virtual-time --duration 0.2 --can-log "$tmp/pose.log" >/dev/null 2>&1
+cd "$tmp" || exit 1
+tm new-session -d -s t -x 120 -y 60 \
+  "${CROSS_EMULATOR:-} $ODOMCTL umbmark record --csv runs.csv --can-log pose.log --wheelbase 0.34 \
+   --side-wall right; echo exit=\$?; sleep 30"
+wait_pane "reference point to the back wall" && type_ 500 &&
+  wait_pane "to the right wall" && type_ 300 && wait_pane "start pose" && type_ "" &&
+  wait_pane "has stopped" && type_ ""
+check "record prompts in a terminal" $?
+grep -q "right wall" "$tmp/pane" && grep -q "y_abs = right(end) - right(start)" "$tmp/pane" &&
+  grep -q "Run 1 of 10: cw" "$tmp/pane" && grep -q "odometry at start: x 0.0000 m" "$tmp/pane"
+check "record shows the sign diagram for a right wall and the start pose" $?
+# A typo is asked again on a terminal; then the end tape: 12 mm further from the back wall,
+# 3 mm further from the right wall (y_abs = +3 mm), heading not measured.
+wait_pane "tape at end: reference point to the back wall" && type_ "5l2" &&
+  wait_pane "'5l2' is not a number" && type_ 512 && wait_pane "tape at end: reference point to the right" &&
+  type_ 303 && wait_pane "heading change" && type_ "" && wait_pane "saved in runs.csv (1 of 10)"
+check "record: a typo is asked again, the run is saved" $?
+grep -q "return error (absolute - odometry): ex +12.0 mm, ey +3.0 mm" "$tmp/pane" &&
+  grep -q "cw  n 1, centre of gravity x +12.0 mm, y +3.0 mm" "$tmp/pane"
+check "record: return error and running centre of gravity on screen" $?
+# Interrupted with Ctrl-C in the next run: the saved run stays, the rerun resumes at run 2.
+wait_pane "Run 2 of 10" && tm send-keys -t t C-c && sleep 1
+grep -q "^cw,0.0120,0.0030,,0$" "$tmp/runs.csv" && [ "$(wc -l <"$tmp/runs.csv")" = 2 ]
+check "record: Ctrl-C keeps the saved run: $(tr '\n' '|' <"$tmp/runs.csv")" $?
+tm kill-session -t t 2>/dev/null
+tm new-session -d -s t -x 120 -y 60 \
+  "${CROSS_EMULATOR:-} $ODOMCTL umbmark record --csv runs.csv --can-log pose.log --wheelbase 0.34; sleep 30"
+wait_pane "1 already in runs.csv" && grep -q "Run 2 of 10: cw" "$tmp/pane"
+check "record resumes at run 2 in a terminal" $?
+tm kill-session -t t 2>/dev/null
+
+# simulate's progress: one line rewritten in place (\r), raw bytes of the pane's output.
+tm new-session -d -s t -x 120 -y 20 "sleep 1; ${CROSS_EMULATOR:-} $ODOMCTL umbmark simulate --runs 10 --passes 2 >/dev/null; echo done; sleep 30"
+tm pipe-pane -o -t t "cat >$tmp/raw"
+wait_pane "^done"
+updates=$(grep -a -o "/60 squares, [0-9]* s left" "$tmp/raw" | wc -l)
+lines=$(grep -a -c "squares, " "$tmp/raw")
+[ "$updates" -ge 2 ] && [ "$lines" -le 1 ] && grep -q "umbmark simulate: 60 squares driven" "$tmp/pane" &&
+  ! grep -q "squares, .* s left" "$tmp/pane"
+check "simulate on a terminal: $updates updates on one line ($lines line), cleared at the end" $?
+
+echo "cli_umbmark_tty: $pass passed, $fail failed"
+[ $fail = 0 ]
