@@ -32,6 +32,7 @@ struct AppliedCalibration;
 class Rig;
 class CanLink;
 class CalibrationReloader;
+class SelfCalLink;
 
 // Daemon: odometryd in three steps: configure (config, calibration store, rig, loop, CAN link,
 // reloader; start-up report), run (status thread, systemd watchdog, real-time set-up, the loop
@@ -59,6 +60,7 @@ class Daemon {
   std::unique_ptr<loop::OdometryLoop> loop_;
   std::unique_ptr<CanLink> can_;
   std::unique_ptr<CalibrationReloader> reloader_;
+  std::unique_ptr<SelfCalLink> selfcal_;  // [selfcal] enabled
 };
 
 // run_daemon: runs the firmware until stop, duration or signal; returns the process exit code.
