@@ -30,6 +30,10 @@ inline bool write_output_file(const std::string& path, const std::string& text, 
 void add_replay(CLI::App& app, int& exit_code);
 // add_calib: `odomctl calib show|set|import|export|reset` (the calibration store).
 void add_calib(CLI::App& app, int& exit_code);
+// add_calib_fit_fixes: `odomctl calib fit-fixes` (self-calibration from absolute fixes).
+void add_calib_fit_fixes(CLI::App& calib, int& exit_code);
+// add_selfcal: `odomctl selfcal simulate` (self-calibration on the simulated LabMate).
+void add_selfcal(CLI::App& app, int& exit_code);
 // add_errormodel: `odomctl errormodel validate|fit` (Chong-Kleeman error model).
 void add_errormodel(CLI::App& app, int& exit_code);
 // add_umbmark: `odomctl umbmark compute|scale|simulate` (UMBmark calibration).
