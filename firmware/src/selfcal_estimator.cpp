@@ -11,6 +11,9 @@
 namespace odo::fw {
 namespace {
 
+// What is kept of the record while no fix is in the window: a late CAN fix is at most 4.1 s old.
+constexpr TimeNs kKeep = 5'000'000'000;
+
 std::int64_t system_seconds() {
   return static_cast<std::int64_t>(std::time(nullptr));
 }
@@ -72,7 +75,9 @@ void SelfCalEstimator::take_fixes(TimeNs until) {
   std::size_t n = 0;
   for (; n < pending_.size() && pending_[n].t + s_.ripe_delay <= until; ++n) {
     const calib::PoseFix& p = pending_[n];
-    const bool before_record = window_.empty() && !segs_.empty() && p.t < segs_.front().t_start;
+    // Without a window, trim() keeps the counts of the last kKeep only: an older fix has lost
+    // the counts after it. (A fix before the first segment is fine: the robot stood still.)
+    const bool before_record = window_.empty() && p.t < until - kKeep;
     if ((!window_.empty() && p.t <= window_.back().t) || before_record) {
       ++dropped;
       continue;
@@ -96,7 +101,7 @@ void SelfCalEstimator::trim(TimeNs until) {
   }
   // Counts before the first fix of the window are of no use; without a fix, keep what a late
   // fix (at most 4.1 s on CAN) can still reach. Bounded memory for any run length.
-  const TimeNs keep_from = !window_.empty() ? window_.front().t : until - from_seconds(5.0);
+  const TimeNs keep_from = !window_.empty() ? window_.front().t : until - kKeep;
   while (!segs_.empty() && segs_.front().t_end <= keep_from) segs_.pop_front();
 }
 
