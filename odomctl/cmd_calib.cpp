@@ -6,6 +6,9 @@
 #include <iterator>
 #include <optional>
 #include <sstream>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "odo/analysis/calibration_json.hpp"
@@ -177,6 +180,82 @@ void calib_reset(const StoreOpts& o, int& exit_code) {
   if (!s) return;
   write_and_report("reset", o, *s, std::nullopt, exit_code);
 }
+// history_order: the valid records, newest first.
+std::vector<const calib::CalibrationRecord*> history_order(const calib::LoadResult& l) {
+  std::vector<const calib::CalibrationRecord*> v;
+  for (const auto& r : l.records)
+    if (r) v.push_back(&*r);
+  if (v.size() == 2 && v[1]->sequence > v[0]->sequence) std::swap(v[0], v[1]);
+  if (v.size() == 2 && v[1]->sequence == v[0]->sequence) v.pop_back();  // the first save: twice
+  return v;
+}
+
+nlohmann::json history_json(const calib::CalibrationRecord& r) {
+  nlohmann::json j{{"sequence", r.sequence},
+                   {"cleared", r.cleared},
+                   {"method", r.method},
+                   {"time", r.time},
+                   {"time_utc", calib::utc_text(r.time)},
+                   {"c_l", r.c_l},
+                   {"c_r", r.c_r},
+                   {"wheelbase", r.wheelbase ? nlohmann::json(*r.wheelbase) : nullptr}};
+  if (r.fit)
+    j["fit"] = {{"fixes_used", r.fit->fixes_used}, {"fixes_rejected", r.fit->fixes_rejected},
+                {"residual", r.fit->residual},     {"sigma_c_l", r.fit->sigma_c_l},
+                {"sigma_c_r", r.fit->sigma_c_r},   {"sigma_wheelbase", r.fit->sigma_wheelbase}};
+  return j;
+}
+
+std::string history_line(const calib::CalibrationRecord& r, bool newest) {
+  std::ostringstream o;
+  o << (newest ? "in use    " : "previous  ") << "sequence " << r.sequence << "  "
+    << calib::utc_text(r.time) << "  " << (r.cleared ? "reset" : r.method);
+  if (!r.cleared) {
+    o << "  c_l " << r.c_l << "  c_r " << r.c_r;
+    if (r.wheelbase) o << "  b " << *r.wheelbase << " m";
+  }
+  if (r.fit)
+    o << "  (" << r.fit->fixes_used << " fixes, " << r.fit->fixes_rejected
+      << " rejected, held-out chi2/dof " << r.fit->residual << ")";
+  return o.str() + "\n";
+}
+
+// calib_history: `calib history`: the records the store holds (A/B: the newest and the one
+// before it) with their provenance.
+void calib_history(const StoreOpts& o, int& exit_code) {
+  calib::LoadResult l;
+  if (!open_loaded("history", o, l, exit_code)) return;
+  const auto v = history_order(l);
+  if (o.json) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const auto* r : v) j.push_back(history_json(*r));
+    std::cout << j.dump() << "\n";
+  } else if (v.empty()) {
+    std::cout << o.path << ": " << l.describe() << "; no records\n";
+  } else {
+    for (std::size_t i = 0; i < v.size(); ++i) std::cout << history_line(*v[i], i == 0);
+  }
+  exit_code = l.status == calib::StoreStatus::kCorrupt ? kExitFailed : kExitOk;
+}
+
+// calib_rollback: `calib rollback`: the previous record becomes the newest again, written
+// through the store like any save (a power cut leaves the old newest or the restored one).
+void calib_rollback(const StoreOpts& o, int& exit_code) {
+  calib::LoadResult l;
+  auto s = open_loaded("rollback", o, l, exit_code);
+  if (!s) return;
+  const auto v = history_order(l);
+  if (v.size() < 2) {
+    std::cerr << "odomctl calib rollback: " << o.path << ": " << l.describe()
+              << "; no previous record to restore\n";
+    exit_code = kExitFailed;
+    return;
+  }
+  std::optional<calib::CalibrationRecord> prev;
+  if (!v[1]->cleared) prev = *v[1];
+  write_and_report("rollback", o, *s, prev, exit_code);
+}
+
 }  // namespace
 
 void add_calib(CLI::App& app, int& exit_code) {
@@ -216,6 +295,19 @@ void add_calib(CLI::App& app, int& exit_code) {
       "reset", "mark the store uncalibrated (the firmware then runs on nominal values)");
   add_store_options(c_reset, *reset, true);
   c_reset->callback([reset, &exit_code] { calib_reset(*reset, exit_code); });
+
+  auto hist = std::make_shared<StoreOpts>();
+  CLI::App* c_hist = calib->add_subcommand(
+      "history", "list the stored records (newest and previous) with their provenance");
+  add_store_options(c_hist, *hist, true);
+  c_hist->callback([hist, &exit_code] { calib_history(*hist, exit_code); });
+
+  auto rb = std::make_shared<StoreOpts>();
+  CLI::App* c_rb = calib->add_subcommand("rollback", "restore the previous record");
+  add_store_options(c_rb, *rb, true);
+  c_rb->callback([rb, &exit_code] { calib_rollback(*rb, exit_code); });
+
+  add_calib_fit_fixes(*calib, exit_code);
 }
 
 }  // namespace odo::ctl

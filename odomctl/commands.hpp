@@ -63,6 +63,10 @@ bool take_choice(Result<E> parsed, E& out, const char* cmd, int& exit_code) {
 void add_replay(CLI::App& app, int& exit_code);
 // add_calib: `odomctl calib show|set|import|export|reset` (the calibration store).
 void add_calib(CLI::App& app, int& exit_code);
+// add_calib_fit_fixes: `odomctl calib fit-fixes` (self-calibration from absolute fixes).
+void add_calib_fit_fixes(CLI::App& calib, int& exit_code);
+// add_selfcal: `odomctl selfcal simulate` (self-calibration on the simulated LabMate).
+void add_selfcal(CLI::App& app, int& exit_code);
 // add_errormodel: `odomctl errormodel validate|fit` (Chong-Kleeman error model).
 void add_errormodel(CLI::App& app, int& exit_code);
 // add_umbmark: `odomctl umbmark compute|scale|simulate` (UMBmark calibration).

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   odo::ctl::add_umbmark(app, exit_code);
   odo::ctl::add_decode(app, exit_code);
   odo::ctl::add_state(app, exit_code);
+  odo::ctl::add_selfcal(app, exit_code);
   // Parse errors give kExitBadInput (2), as odometryd.
   if (auto rc = odo::fw::parse_command_line(app, argc, argv, "odomctl")) return *rc;
   return exit_code;

@@ -103,6 +103,7 @@ Result<LoadResult> CalibrationStore::load() {
     const CalibrationRecord& win = *rec[static_cast<std::size_t>(out.slot)];
     out.status = win.cleared ? StoreStatus::kUncalibrated : StoreStatus::kOk;
     out.record = win;
+    out.records = rec;
   } else if (out.slots[0].blank || out.slots[1].blank) {
     out.status = StoreStatus::kUncalibrated;  // never written, or its first save was cut
   } else {

@@ -131,8 +131,12 @@ void CanBroadcaster::take_commands(CanFrame& f) noexcept {
     if (i > 0 && !bus_->receive(f)) break;
     int node = 0;
     protocol::Msg m{};
-    if (!protocol::split_id(o_.base_id, f, node, m) || node != o_.node_id ||
-        m != protocol::Msg::kSetPose)
+    if (!protocol::split_id(o_.base_id, f, node, m) || node != o_.node_id) continue;
+    if (m == protocol::Msg::kFixPose || m == protocol::Msg::kFixSigma) {
+      if (fixes_ != nullptr) take_fix(f, m);
+      continue;
+    }
+    if (m != protocol::Msg::kSetPose || !o_.set_pose)
       continue;  // not for us (a SocketCAN filter normally keeps these out)
     protocol::SetPoseCmd cmd;
     if (!protocol::decode_set_pose(f, cmd)) {
@@ -146,6 +150,31 @@ void CanBroadcaster::take_commands(CanFrame& f) noexcept {
     ++c_.set_pose_applied;
     ++pending_ack_;
   }
+}
+
+void CanBroadcaster::take_fix(const CanFrame& f, protocol::Msg m) noexcept {
+  if (m == protocol::Msg::kFixPose) {
+    have_fix_half_ = protocol::decode_fix_pose(f, fix_half_);
+    if (!have_fix_half_) ++c_.fixes_refused;
+    return;
+  }
+  protocol::FixMsg fm = fix_half_;
+  if (!have_fix_half_ || !protocol::decode_fix_sigma(f, fm) || fm.seq != fix_half_.seq) {
+    ++c_.fixes_refused;
+    return;
+  }
+  have_fix_half_ = false;
+  calib::PoseFix p;
+  p.t = rx_stamp_ - from_seconds(fm.age);
+  p.x = fm.x;
+  p.y = fm.y;
+  if (fm.sigma_theta > 0.0) p.theta = fm.theta;
+  p.sigma_xy = fm.sigma_xy;
+  p.sigma_theta = fm.sigma_theta;
+  if (fixes_->push(p))
+    ++c_.fixes_forwarded;
+  else
+    ++c_.fixes_refused;
 }
 
 void CanBroadcaster::send_pose_group(const loop::LoopSnapshot& s) noexcept {
@@ -216,7 +245,8 @@ void CanBroadcaster::on_tick(const loop::LoopSnapshot& s) noexcept {
   pending_ack_ = 0;
   // The first receive is made here: on nearly every tick it finds nothing, and the command loop
   // (take_commands) is not entered.
-  if (o_.set_pose && o_.max_rx_per_tick > 0) {
+  if ((o_.set_pose || fixes_ != nullptr) && o_.max_rx_per_tick > 0) {
+    rx_stamp_ = s.stamp;
     CanFrame f;
     if (bus_->receive(f)) take_commands(f);
   }
@@ -278,6 +308,10 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
           drivers::CanFilter{protocol::frame_id(static_cast<std::uint32_t>(s.base_id), s.node_id,
                                                 protocol::Msg::kSetPose),
                              0x7FF, false});
+    // Absolute fixes for self-calibration (dropped unless [selfcal] is enabled).
+    for (const protocol::Msg m : {protocol::Msg::kFixPose, protocol::Msg::kFixSigma})
+      so.filters.push_back(drivers::CanFilter{
+          protocol::frame_id(static_cast<std::uint32_t>(s.base_id), s.node_id, m), 0x7FF, false});
     auto bus = drivers::SocketCanBus::open(so);
     if (!bus) return std::move(bus).error();
     link->bus_ = std::move(bus).value();

@@ -231,6 +231,19 @@ void read_resume(TableReader t, ResumeSection& s, double loop_hz) {
   t.finish();
 }
 
+// ---- [selfcal] (self-calibration from absolute fixes) ----
+void read_selfcal(TableReader t, SelfCalSection& s) {
+  s.enabled = t.boolean("enabled", s.enabled);
+  for (const auto& r : kSelfCalIntegers)
+    s.*r.member = static_cast<int>(t.integer(r.key, s.*r.member, r.lo, r.hi));
+  for (const auto& r : kSelfCalNumbers)
+    s.*r.member = t.number(r.key, s.*r.member, r.lo, r.hi, r.unit);
+  if (t.ok() && s.max_fixes < s.min_fixes)
+    t.reject("max_fixes", "= " + std::to_string(s.max_fixes) + " must be >= min_fixes (" +
+                              std::to_string(s.min_fixes) + ")");
+  t.finish();
+}
+
 // first_non_ascii: the first byte >= 0x80 as "line N, column C (byte 0xXX)", or "" if none.
 // The config is plain ASCII: toml++ 3.3 (Debian 12) reaches __builtin_unreachable() on some
 // non-ASCII characters (upstream issues #190 and #295; found here by fuzz_config), so such a
@@ -289,6 +302,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_ros2(root.sub("ros2"), ros2_cfg, c.loop.rate_hz);
   c.ros2 = std::make_shared<const ros2::Config>(std::move(ros2_cfg));
   read_resume(root.sub("resume"), c.resume, c.loop.rate_hz);
+  read_selfcal(root.sub("selfcal"), c.selfcal);
   root.finish();
   if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
   return c;

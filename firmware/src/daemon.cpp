@@ -21,6 +21,7 @@
 #include "odo/firmware/realtime_setup.hpp"
 #include "odo/firmware/rig.hpp"
 #include "odo/firmware/state_persist.hpp"
+#include "odo/firmware/selfcal_estimator.hpp"
 #include "odo/firmware/timing_report.hpp"
 #include "odo/firmware/watchdog.hpp"
 #include "odo/loop/loop.hpp"
@@ -153,6 +154,25 @@ nlohmann::json report_json(const loop::LoopSnapshot& s, const loop::LoopStats& s
   return j;
 }
 
+nlohmann::json selfcal_json(const SelfCalCounters& c) {
+  nlohmann::json j = {{"fixes_received", c.fixes_received},
+                      {"fixes_dropped", c.fixes_dropped},
+                      {"fixes_rejected", c.fixes_rejected},
+                      {"fits", c.fits},
+                      {"fit_errors", c.fit_errors},
+                      {"accepted", c.accepted},
+                      {"written", c.written},
+                      {"store_errors", c.store_errors},
+                      {"segments", c.segments}};
+  if (c.last) {
+    j["last"] = {{"c_l", c.last->estimate.c_l},
+                 {"c_r", c.last->estimate.c_r},
+                 {"wheelbase", c.last->estimate.wheelbase},
+                 {"verdict", calib::verdict_name(c.last->verdict)}};
+  }
+  return j;
+}
+
 }  // namespace
 
 // ---- StatusPrinter ----
@@ -230,7 +250,14 @@ int Daemon::configure() {
   lc.rate_hz = cfg_->loop.rate_hz;
   lc.error_model = cfg_->error_model;
   lc.calibration = cal_->state;
-  auto created = loop::OdometryLoop::create(lc, *calibrated, rig_->encoder(), rig_->clock());
+  EncoderSource* encoder = &rig_->encoder();
+  if (cfg_->selfcal.enabled) {  // the loop reads through the self-calibration recorder
+    auto sc = SelfCalLink::create(*cfg_, calibrated->params(), *encoder, log_);
+    if (!sc) return fail(cfg_->source + ": " + sc.error().message);
+    selfcal_ = std::move(sc).value();
+    encoder = &selfcal_->encoder();
+  }
+  auto created = loop::OdometryLoop::create(lc, *calibrated, *encoder, rig_->clock());
   if (!created) return fail(cfg_->source + ": " + created.error().message);
   loop_ = std::move(created).value();
   if (sim::TruthRecorder* t = rig_->truth()) loop_->add_observer(t);
@@ -243,6 +270,7 @@ int Daemon::configure() {
                                  calibrated->params().wheelbase, cfg_->error_model, *loop_);
   if (!ros2) return fail(cfg_->source + ": " + ros2.error().message);
   ros2_ = std::move(ros2).value();
+  if (selfcal_) selfcal_->attach(*loop_, can_.get());
   reloader_ = std::make_unique<CalibrationReloader>(
       loop_->commands(), cfg_->robot, cfg_->calibration.store, cfg_->calibration.backend, log_);
   if (o_.reload != nullptr) reloader_->start(*o_.reload);
@@ -263,6 +291,7 @@ void Daemon::report_start(const KinematicParams& p) {
                                                   : " (nominal values from the config)\n")
        << "odometryd: can: " << (can_ ? can_->describe() : std::string("off")) << "\n"
        << (ros2_ ? "odometryd: ros2: " + ros2_->describe() + "\n" : std::string())
+       << (selfcal_ ? "odometryd: selfcal: " + selfcal_->describe() + "\n" : std::string())
        << "odometryd: loop " << cfg_->loop.rate_hz << " Hz on "
        << (o_.virtual_time ? "virtual time" : "CLOCK_MONOTONIC") << std::endl;
 }
@@ -300,7 +329,9 @@ int Daemon::run(std::atomic<bool>& stop) {
     resume_->persister->start(
         log_, resume_->offered ? std::nullopt : std::optional(resume_->reason), resume_->note);
   }
+  if (selfcal_) selfcal_->start();
   loop_->run(from_seconds(duration), stop);
+  if (selfcal_) selfcal_->stop();
   if (resume_ && resume_->persister) resume_->persister->stop();
   // Clean stop (signal or end of --duration): the final pose and a status frame that says so.
   if (can_) can_->finish(loop_->snapshot());
@@ -328,19 +359,18 @@ void Daemon::report() {
   }
   log_ << std::defaultfloat << std::setprecision(6) << std::endl;
   if (o_.stats) print_timing_stats(log_, st, loop_->period());
-  if (o_.json) {
-    nlohmann::json j = report_json(s, st, truth, can_.get());
-    if (ros2_) j["ros2"] = ros2_->json();
-    if (resume_) {
-      const loop::ResumeReason why = resume_reason(*resume_, *loop_);
-      j["resume"] = {
-          {"resumed", why == loop::ResumeReason::kResumed},
-          {"reason", std::string(loop::resume_reason_name(why))},
-          {"gap",
-           why == loop::ResumeReason::kResumed ? to_seconds(loop_->resume_decision().gap) : 0.0}};
-    }
-    out_ << j.dump() << std::endl;
+  if (!o_.json) return;
+  nlohmann::json j = report_json(s, st, truth, can_.get());
+  if (ros2_) j["ros2"] = ros2_->json();
+  if (resume_) {
+    const loop::ResumeReason why = resume_reason(*resume_, *loop_);
+    j["resume"] = {
+        {"resumed", why == loop::ResumeReason::kResumed},
+        {"reason", std::string(loop::resume_reason_name(why))},
+        {"gap", why == loop::ResumeReason::kResumed ? to_seconds(loop_->resume_decision().gap) : 0.0}};
   }
+  if (selfcal_) j["selfcal"] = selfcal_json(selfcal_->estimator().counters());
+  out_ << j.dump() << std::endl;
 }
 
 int run_daemon(const DaemonOptions& o, std::atomic<bool>& stop, std::ostream& out,

@@ -56,7 +56,7 @@ bool split_id(std::uint32_t base_id, const CanFrame& f, int& node, Msg& m) noexc
   const std::uint32_t rel = f.id - base_id;
   if (rel / 16 > static_cast<std::uint32_t>(kMaxNodeId)) return false;
   const std::uint32_t off = rel % 16;
-  if (off > 5 && off != 8) return false;
+  if (off > 5 && (off < 8 || off > 10)) return false;
   node = static_cast<int>(rel / 16);
   m = static_cast<Msg>(off);
   return true;
@@ -206,6 +206,46 @@ bool decode_set_pose(const CanFrame& f, SetPoseCmd& c) noexcept {
   c.x = get_value(f, sig::set_x);
   c.y = get_value(f, sig::set_y);
   c.theta = static_cast<double>(th) * sig::set_theta.scale;
+  return true;
+}
+
+void encode_fix(std::uint32_t id_pose, std::uint32_t id_sigma, const FixMsg& m, CanFrame& pose,
+                CanFrame& sigma) noexcept {
+  start(id_pose, pose);
+  put_value(pose, sig::fix_x, m.x);
+  put_value(pose, sig::fix_y, m.y);
+  put_raw(pose, sig::fix_seq, m.seq);
+  start(id_sigma, sigma);
+  const bool heading = m.sigma_theta > 0.0;
+  put_raw(sigma, sig::fix_theta, heading ? theta_raw(m.theta) : 0);
+  put_value(sigma, sig::fix_sigma_xy, m.sigma_xy, sig::fix_sigma_xy.raw_max);
+  // A known heading keeps a sigma of at least one step: raw 0 would say "unknown".
+  put_raw(sigma, sig::fix_sigma_theta,
+          heading ? quantise(m.sigma_theta, kFixSigmaThetaScale, 1, sig::fix_sigma_theta.raw_max,
+                             sig::fix_sigma_theta.raw_max)
+                  : 0);
+  put_value(sigma, sig::fix_age, m.age, sig::fix_age.raw_max);
+  put_raw(sigma, sig::fix_seq, m.seq);
+}
+
+bool decode_fix_pose(const CanFrame& f, FixMsg& m) noexcept {
+  if (f.len != 8) return false;
+  m.x = get_value(f, sig::fix_x);
+  m.y = get_value(f, sig::fix_y);
+  m.seq = static_cast<std::uint8_t>(get_raw(f, sig::fix_seq));
+  return true;
+}
+
+bool decode_fix_sigma(const CanFrame& f, FixMsg& m) noexcept {
+  if (f.len != 8) return false;
+  const std::int64_t th = get_raw(f, sig::fix_theta);
+  if (th < sig::fix_theta.raw_min || th > sig::fix_theta.raw_max) return false;
+  if (get_raw(f, sig::fix_sigma_xy) < sig::fix_sigma_xy.raw_min) return false;
+  m.theta = static_cast<double>(th) * sig::fix_theta.scale;
+  m.sigma_xy = get_value(f, sig::fix_sigma_xy);
+  m.sigma_theta = get_value(f, sig::fix_sigma_theta);
+  m.age = get_value(f, sig::fix_age);
+  m.seq = static_cast<std::uint8_t>(get_raw(f, sig::fix_seq));
   return true;
 }
 

@@ -3,6 +3,7 @@
 // the layout in README "CAN protocol".
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -35,13 +36,53 @@ TEST(CanIds, NodeBlocksAndSplit) {
   ASSERT_TRUE(split_id(0x400, f, node, m));
   EXPECT_EQ(node, 3);
   EXPECT_EQ(m, Msg::kTiming);
-  f.id = 0x436;  // offsets 6, 7, 9..15 are not ours
+  f.id = 0x436;  // offsets 6, 7, 11..15 are not ours
   EXPECT_FALSE(split_id(0x400, f, node, m));
   f.id = 0x3FF;
   EXPECT_FALSE(split_id(0x400, f, node, m));
   f.id = 0x410;
   f.extended = true;
   EXPECT_FALSE(split_id(0x400, f, node, m));
+}
+
+// A fix (issue 18), bytes derived by hand. FixPose: x = -2.5 m -> raw -2500 = 0xFFF63C (int24)
+// -> 3C F6 FF; y = 0.25 m -> 250 = 0x0000FA -> FA 00 00; byte 6 unused; seq 7 in byte 7.
+// FixSigma: theta 0.5 rad -> 5000 = 0x1388 -> 88 13; sigma_xy 5 mm -> 50 -> 32 00;
+// sigma_theta 0.5 deg = 8.7266e-3 rad -> 87 = 0x057 (bits 32..43), age 0.12 s -> 120 = 0x078
+// (bits 44..55): the 24-bit word 0x078057 -> 57 80 07; seq 7.
+TEST(CanFix, EncodesHandDerivedBytesAndDecodesBack) {
+  const FixMsg in{-2.5, 0.25, 0.5, 0.005, 0.5 * std::numbers::pi / 180.0, 0.12, 7};
+  CanFrame a, b;
+  encode_fix(frame_id(kDefaultBaseId, 1, Msg::kFixPose),
+             frame_id(kDefaultBaseId, 1, Msg::kFixSigma), in, a, b);
+  EXPECT_EQ(a.id, 0x419u);
+  EXPECT_EQ(b.id, 0x41Au);
+  EXPECT_EQ(a.data, (std::array<std::uint8_t, 8>{0x3C, 0xF6, 0xFF, 0xFA, 0x00, 0x00, 0x00, 0x07}));
+  EXPECT_EQ(b.data, (std::array<std::uint8_t, 8>{0x88, 0x13, 0x32, 0x00, 0x57, 0x80, 0x07, 0x07}));
+  FixMsg out;
+  ASSERT_TRUE(decode_fix_pose(a, out));
+  ASSERT_TRUE(decode_fix_sigma(b, out));
+  EXPECT_DOUBLE_EQ(out.x, -2.5);
+  EXPECT_DOUBLE_EQ(out.y, 0.25);
+  EXPECT_DOUBLE_EQ(out.theta, 0.5);
+  EXPECT_DOUBLE_EQ(out.sigma_xy, 0.005);
+  EXPECT_DOUBLE_EQ(out.sigma_theta, 87e-4);
+  EXPECT_DOUBLE_EQ(out.age, 0.12);
+  EXPECT_EQ(out.seq, 7);
+  int node = -1;
+  Msg m{};
+  ASSERT_TRUE(split_id(kDefaultBaseId, b, node, m));
+  EXPECT_EQ(m, Msg::kFixSigma);
+  // Heading unknown: sigma_theta raw 0 and theta 0 on the wire.
+  FixMsg no_heading = in;
+  no_heading.sigma_theta = 0.0;
+  encode_fix(a.id, b.id, no_heading, a, b);
+  ASSERT_TRUE(decode_fix_sigma(b, out));
+  EXPECT_EQ(out.sigma_theta, 0.0);
+  EXPECT_EQ(out.theta, 0.0);
+  // sigma_xy raw 0 is not a fix.
+  b.data[2] = b.data[3] = 0;
+  EXPECT_FALSE(decode_fix_sigma(b, out));
 }
 
 TEST(CanPose, RoundTripWithinHalfAStep) {

@@ -35,6 +35,9 @@ struct LoadResult {
   std::optional<CalibrationRecord> record;  // the newest valid record (also a reset marker)
   int slot = -1;                            // 0 (A) or 1 (B); -1 when no slot is valid
   std::array<SlotInfo, 2> slots;
+  // Both slots' records (A, B) where valid: the newest and the one before it (the history
+  // `odomctl calib history` lists and `calib rollback` restores).
+  std::array<std::optional<CalibrationRecord>, 2> records;
   // describe: one line for people: status, sequence, slot, and for corrupt stores the reasons.
   std::string describe() const;
 };

@@ -18,6 +18,7 @@
 #include "odo/hal/result.hpp"
 #include "odo/loop/command.hpp"
 #include "odo/loop/loop.hpp"
+#include "odo/loop/recording_encoder.hpp"
 #include "odo/protocol/can_protocol.hpp"
 #include "odo/protocol/candump_log.hpp"
 
@@ -88,6 +89,8 @@ struct CanBroadcastCounters {
   std::uint64_t dropped_error = 0;
   std::uint64_t set_pose_applied = 0;   // commands posted to the loop
   std::uint64_t set_pose_rejected = 0;  // for this node but malformed (length, theta range)
+  std::uint64_t fixes_forwarded = 0;    // FixPose + FixSigma pairs handed to the estimator
+  std::uint64_t fixes_refused = 0;      // fix frames malformed, unpaired or not taken (ring full)
   std::uint64_t dropped() const noexcept {
     return dropped_queue_full + dropped_link_down + dropped_error;
   }
@@ -121,11 +124,17 @@ class CanBroadcaster final : public loop::TickObserver {
 
   const CanBroadcastCounters& counters() const noexcept { return c_; }
   std::uint8_t seq() const noexcept { return seq_; }
+  // set_fix_ring: configure time; FixPose + FixSigma addressed to this node go there (null:
+  // fix frames are ignored).
+  void set_fix_ring(loop::FixRing* r) noexcept { fixes_ = r; }
 
  private:
   // take_commands: handles the received frame `f`, then receives and handles more, up to
   // max_rx_per_tick frames in all (`f` is scratch space).
   void take_commands(CanFrame& f) noexcept;
+  // take_fix: one FixPose or FixSigma frame; a FixSigma completing the FixPose of the same seq
+  // becomes a PoseFix at rx_stamp_ - age.
+  void take_fix(const CanFrame& f, protocol::Msg m) noexcept;
   void send(const CanFrame& f, std::int64_t loop_time) noexcept;
   void send_pose_group(const loop::LoopSnapshot& s) noexcept;
   void send_velocity(const loop::LoopSnapshot& s) noexcept;
@@ -151,6 +160,10 @@ class CanBroadcaster final : public loop::TickObserver {
   bool sent_any_pose_ = false;
   std::uint8_t ack_ = 0;           // set-pose commands applied (mod 256), in the status frame
   std::uint32_t pending_ack_ = 0;  // requested this tick, applied at the next one
+  loop::FixRing* fixes_ = nullptr;
+  protocol::FixMsg fix_half_;  // the last FixPose received
+  bool have_fix_half_ = false;
+  TimeNs rx_stamp_ = 0;  // sample time of the tick that receives [ns]
   // Ticks strictly between quiet_after_ and quiet_after_ + quiet_span_ + 1 are a multiple of no
   // divisor: on them the rate checks are skipped (the span is 0 until the first check).
   std::uint64_t quiet_after_ = 0;
@@ -180,6 +193,8 @@ class CanLink {
   // finish: send_final, then close_log.
   void finish(const loop::LoopSnapshot& snap);
   const CanBroadcastCounters& counters() const noexcept { return bc_->counters(); }
+  // set_fix_ring: absolute fixes received on this link go to `r` (configure time).
+  void set_fix_ring(loop::FixRing* r) noexcept { bc_->set_fix_ring(r); }
   std::uint64_t log_written() const noexcept { return log_ ? log_->written() : 0; }
   std::uint64_t log_dropped() const noexcept { return log_ ? log_->ring().dropped() : 0; }
   const std::string& describe() const noexcept { return describe_; }

@@ -236,6 +236,39 @@ struct ResumeSection {
   double max_age = 5.0;                           // [s] 0.01..3600: oldest record resumed from
 };
 
+// [selfcal]: self-calibration from absolute fixes (issue 18; README "Self-calibration").
+struct SelfCalSection {
+  bool enabled = false;
+  int min_fixes = 9;                    // fixes in the window before the first fit
+  int max_fixes = 41;                   // window: the oldest fix (and its counts) go beyond this
+  int fit_every = 4;                    // a fit after every this many new fixes
+  int hold_out_every = 4;               // every n-th excursion held out for the acceptance test
+  double max_sigma_factor = 2e-4;       // acceptance bound on sigma(c_L), sigma(c_R)
+  double max_sigma_wheelbase = 2e-4;    // [m] acceptance bound on sigma(b)
+  double prior_sigma_factor = 0.05;     // prior around the calibration in use
+  double prior_sigma_wheelbase = 0.02;  // [m]
+};
+
+// SelfCalRange: one [selfcal] number, its range and unit: the only place they are written
+// (the reader, its messages and README's table come from here).
+template <class T>
+struct SelfCalRange {
+  const char* key;
+  T SelfCalSection::*member;
+  T lo, hi;
+  const char* unit;
+};
+inline constexpr SelfCalRange<int> kSelfCalIntegers[] = {
+    {"min_fixes", &SelfCalSection::min_fixes, 3, 1000, ""},
+    {"max_fixes", &SelfCalSection::max_fixes, 3, 1000, ""},
+    {"fit_every", &SelfCalSection::fit_every, 1, 1000, ""},
+    {"hold_out_every", &SelfCalSection::hold_out_every, 2, 1000, ""}};
+inline constexpr SelfCalRange<double> kSelfCalNumbers[] = {
+    {"max_sigma_factor", &SelfCalSection::max_sigma_factor, 1e-6, 0.1, ""},
+    {"max_sigma_wheelbase", &SelfCalSection::max_sigma_wheelbase, 1e-6, 0.1, "m"},
+    {"prior_sigma_factor", &SelfCalSection::prior_sigma_factor, 1e-4, 0.5, ""},
+    {"prior_sigma_wheelbase", &SelfCalSection::prior_sigma_wheelbase, 1e-4, 1.0, "m"}};
+
 struct Config {
   std::string source = "<built-in>";  // file the config came from
   LoopSection loop;
@@ -253,6 +286,7 @@ struct Config {
   // the config was not read from text (default_config: off).
   std::shared_ptr<const ros2::Config> ros2;
   ResumeSection resume;
+  SelfCalSection selfcal;
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.

@@ -34,6 +34,7 @@ class CanLink;
 class CalibrationReloader;
 class Ros2Output;
 struct ResumeWiring;
+class SelfCalLink;
 
 // Daemon: odometryd in three steps: configure (config, calibration store, rig, loop, CAN link,
 // reloader; start-up report), run (status thread, systemd watchdog, real-time set-up, the loop
@@ -63,6 +64,7 @@ class Daemon {
   std::unique_ptr<CalibrationReloader> reloader_;
   std::unique_ptr<Ros2Output> ros2_;  // [ros2] enabled; null otherwise
   std::unique_ptr<ResumeWiring> resume_;  // issue 17: persisted state (null in virtual time)
+  std::unique_ptr<SelfCalLink> selfcal_;  // [selfcal] enabled
 };
 
 // run_daemon: runs the firmware until stop, duration or signal; returns the process exit code.

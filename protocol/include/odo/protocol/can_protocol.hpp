@@ -23,6 +23,8 @@ enum class Msg : std::uint8_t {
   kStatus = 4,       // encoder flags, calibration state, stopping, set-pose ack, missed, uptime
   kTiming = 5,       // wake-up latency p99/max, compute max, transmit drops
   kSetPose = 8,      // command to the node: set (DLC 8) or reset to zero (DLC 0)
+  kFixPose = 9,      // absolute fix to the node, part 1: x, y, seq (self-calibration, issue 18)
+  kFixSigma = 10,    // part 2: theta, sigma_xy, sigma_theta (0 = theta unknown), age, seq
 };
 
 // Scalings (physical = raw * scale).
@@ -36,6 +38,9 @@ constexpr double kSigmaThetaScale = 1e-5;     // sigma_theta [rad] (uint16, 6553
 constexpr double kRhoScale = 0.01;            // rho_xy [-] (int8, -100..100)
 constexpr double kLatencyScale = 1e-6;        // timing [s] (uint16 us, 65535 = >= 65.535 ms)
 constexpr double kSetPosScale = 1e-3;         // set-pose x, y [m] (int24: +-8388.607 m)
+constexpr double kFixSigmaXyScale = 1e-4;     // fix sigma_xy [m] (uint16, 0.1 mm .. 6.5535 m)
+constexpr double kFixSigmaThetaScale = 1e-4;  // fix sigma_theta [rad] (uint12, <= 0.4095 rad)
+constexpr double kFixAgeScale = 1e-3;         // fix age [s] (uint12 ms: up to 4.095 s late)
 
 // frame_id: the 11-bit id of message m of node `node` (base_id a multiple of 16).
 constexpr std::uint32_t frame_id(std::uint32_t base_id, int node, Msg m) noexcept {
@@ -85,6 +90,19 @@ struct SetPoseCmd {
   double theta = 0.0;  // [rad], (-pi, pi]
 };
 
+// FixMsg: an absolute pose fix for self-calibration, sent to the node as FixPose + FixSigma with
+// the same seq. age: how long before the FixSigma frame's reception the fix was true, so a
+// late fix is matched to the odometry of its moment.
+struct FixMsg {
+  double x = 0.0;            // [m], 1 mm resolution
+  double y = 0.0;            // [m]
+  double theta = 0.0;        // [rad], (-pi, pi]; ignored when sigma_theta == 0
+  double sigma_xy = 0.0;     // [m] > 0
+  double sigma_theta = 0.0;  // [rad] 0.1 mrad .. 0.4095 rad; 0 = heading unknown
+  double age = 0.0;          // [s] 0..4.095
+  std::uint8_t seq = 0;
+};
+
 // Encoders: fill f (id, len 8, data) as the frame with id `id`.
 void encode_pose_x(std::uint32_t id, const PoseMsg& p, CanFrame& f) noexcept;
 void encode_pose_y_theta(std::uint32_t id, const PoseMsg& p, CanFrame& f) noexcept;
@@ -102,6 +120,13 @@ bool decode_velocity(const CanFrame& f, VelocityMsg& v) noexcept;
 bool decode_uncertainty(const CanFrame& f, UncertaintyMsg& u) noexcept;
 bool decode_status(const CanFrame& f, StatusMsg& s) noexcept;
 bool decode_timing(const CanFrame& f, TimingMsg& t) noexcept;
+// encode_fix: the two frames of a fix (ids id_pose, id_sigma).
+void encode_fix(std::uint32_t id_pose, std::uint32_t id_sigma, const FixMsg& m, CanFrame& pose,
+                CanFrame& sigma) noexcept;
+// decode_fix_pose / decode_fix_sigma: the halves of a fix (x, y, seq / the rest); false when
+// the length is not 8, sigma_xy is 0 or theta is outside -31416..31416 raw.
+bool decode_fix_pose(const CanFrame& f, FixMsg& m) noexcept;
+bool decode_fix_sigma(const CanFrame& f, FixMsg& m) noexcept;
 // decode_set_pose: DLC 0 = reset; DLC 8 with |theta| <= pi (raw -31416..31416) = set; anything
 // else (other lengths, theta out of range) is rejected with false.
 bool decode_set_pose(const CanFrame& f, SetPoseCmd& c) noexcept;

@@ -61,6 +61,16 @@ inline constexpr Signal set_x{"set_x", 0, 24, kSetPosScale, true, kI24Min, kI24M
 inline constexpr Signal set_y{"set_y", 24, 24, kSetPosScale, true, kI24Min, kI24Max, "m"};
 inline constexpr Signal set_theta{"set_theta",   48,           16,   kThetaScale, true,
                                   -kThetaRawMax, kThetaRawMax, "rad"};
+inline constexpr Signal fix_x{"fix_x", 0, 24, kSetPosScale, true, kI24Min, kI24Max, "m"};
+inline constexpr Signal fix_y{"fix_y", 24, 24, kSetPosScale, true, kI24Min, kI24Max, "m"};
+inline constexpr Signal fix_theta{"fix_theta",  0,    16, kThetaScale, true, -kThetaRawMax,
+                                  kThetaRawMax, "rad"};
+inline constexpr Signal fix_sigma_xy{"fix_sigma_xy", 16, 16,    kFixSigmaXyScale,
+                                     false,          1,  65535, "m"};
+inline constexpr Signal fix_sigma_theta{
+    "fix_sigma_theta", 32, 12, kFixSigmaThetaScale, false, 0, 4095, "rad"};
+inline constexpr Signal fix_age{"fix_age", 44, 12, kFixAgeScale, false, 0, 4095, "s"};
+inline constexpr Signal fix_seq{"fix_seq", 56, 8, 1.0, false, 0, 255, ""};
 
 inline constexpr const Signal* kPoseX[] = {&x, &seq};
 inline constexpr const Signal* kPoseYTheta[] = {&y, &theta, &seq};
@@ -70,6 +80,9 @@ inline constexpr const Signal* kStatus[] = {&encoder_flags, &calibration_state, 
                                             &set_pose_ack,  &missed_deadlines,  &uptime};
 inline constexpr const Signal* kTiming[] = {&wakeup_p99, &wakeup_max, &compute_max, &tx_dropped};
 inline constexpr const Signal* kSetPose[] = {&set_x, &set_y, &set_theta};
+inline constexpr const Signal* kFixPose[] = {&fix_x, &fix_y, &fix_seq};
+inline constexpr const Signal* kFixSigma[] = {&fix_theta, &fix_sigma_xy, &fix_sigma_theta, &fix_age,
+                                              &fix_seq};
 }  // namespace sig
 
 // MessageSpec: one message: its offset in the node's id block, DBC name and signals in order.
@@ -88,6 +101,8 @@ inline constexpr MessageSpec kMessages[] = {
     {Msg::kStatus, "Status", false, sig::kStatus},
     {Msg::kTiming, "Timing", false, sig::kTiming},
     {Msg::kSetPose, "SetPose", true, sig::kSetPose},
+    {Msg::kFixPose, "FixPose", true, sig::kFixPose},
+    {Msg::kFixSigma, "FixSigma", true, sig::kFixSigma},
 };
 
 // message_spec: the table entry of message m (every Msg has one).
@@ -107,6 +122,14 @@ constexpr void put_raw(CanFrame& f, const Signal& s, std::int64_t raw) noexcept 
     put_le(f.data.data() + s.start_bit / 8, static_cast<std::size_t>(s.width / 8), u);
     return;
   }
+  if (s.start_bit / 8 != (s.start_bit + s.width - 1) / 8) {
+    // A bit field across bytes (the fix's 12-bit sigma_theta and age): the payload as one
+    // little-endian 64-bit word.
+    const std::uint64_t m = ((std::uint64_t{1} << s.width) - 1u) << s.start_bit;
+    const std::uint64_t w = get_le(f.data.data(), 8);
+    put_le(f.data.data(), 8, (w & ~m) | ((u << s.start_bit) & m));
+    return;
+  }
   // A bit field inside one byte (the Status flags): keep the byte's other bits.
   const auto mask = static_cast<std::uint8_t>(((1u << s.width) - 1u) << (s.start_bit % 8));
   std::uint8_t& b = f.data[static_cast<std::size_t>(s.start_bit / 8)];
@@ -118,6 +141,8 @@ constexpr std::int64_t get_raw(const CanFrame& f, const Signal& s) noexcept {
   std::uint64_t u = 0;
   if (s.start_bit % 8 == 0 && s.width % 8 == 0) {
     u = get_le(f.data.data() + s.start_bit / 8, static_cast<std::size_t>(s.width / 8));
+  } else if (s.start_bit / 8 != (s.start_bit + s.width - 1) / 8) {
+    u = (get_le(f.data.data(), 8) >> s.start_bit) & ((std::uint64_t{1} << s.width) - 1u);
   } else {
     u = (f.data[static_cast<std::size_t>(s.start_bit / 8)] >> (s.start_bit % 8)) &
         ((1u << s.width) - 1u);

@@ -1,0 +1,57 @@
+// Offline self-calibration input (`odomctl calib fit-fixes`, issue 18): a replay count log
+// recorded into segments by the loop's own recorder, and a CSV of absolute fixes.
+#pragma once
+
+#include <istream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "odo/calibration/count_recorder.hpp"
+#include "odo/calibration/selfcal.hpp"
+#include "odo/hal/result.hpp"
+#include "odo/odometry/kinematics.hpp"
+#include "odo/odometry/pose.hpp"
+#include "odo/sim/robot.hpp"
+
+namespace odo::analysis {
+
+// read_count_segments: the replay log `t,left,right` (optionally `gyro_z`, not used yet; t [s]
+// non-decreasing, raw `bits`-wide readings) passed reading by reading through
+// loop::RecordingEncoder, as the daemon records them; recorder limits from `k`. Errors name
+// `source`, the line and the field.
+Result<std::vector<calib::CountSegment>> read_count_segments(std::istream& in,
+                                                             const std::string& source,
+                                                             const Kinematics& k, int bits);
+
+// Standard deviations for fixes whose sigma fields are empty.
+struct FixDefaults {
+  double sigma_xy = 0.005;         // [m]
+  double sigma_theta = 0.0087266;  // [rad] (0.5 deg)
+};
+
+// read_fixes: CSV `t,x,y,theta,sigma_xy,sigma_theta` (t [s] on the log's clock, strictly
+// increasing; theta [rad] empty = heading unknown; sigma_xy in (0, 10] m and sigma_theta in
+// (0, 3.15] rad, empty = `d`). Errors name `source`, the line, the field and its range.
+Result<std::vector<calib::PoseFix>> read_fixes(std::istream& in, const std::string& source,
+                                               const FixDefaults& d = {});
+
+// ---- The simulated LabMate of issue 18 (sim_selfcal, odomctl selfcal simulate) ----
+
+inline constexpr double kSelfCalDn = 0.15;  // nominal wheel diameter [m]
+inline constexpr double kSelfCalBn = 0.34;  // nominal wheelbase [m]
+
+// selfcal_truth: the true absolute factors of sim::labmate_geometry: c = D_true / Dn per wheel
+// (Eq. 6.35) and b = 0.337 m.
+calib::Factors selfcal_truth();
+// selfcal_kinematics: the LabMate's nominal kinematics (Dn 0.15 m, Ce 2048, n 16) with f.
+Kinematics selfcal_kinematics(const calib::Factors& f);
+// random_excursion: two to four random pieces (turns on the spot, straights, arcs), then turn
+// towards the dock (origin), drive there and turn back to heading 0 (planned from the true
+// pose, as any planner would). Wheel speeds as the robot commands them (nominal geometry).
+sim::Scenario random_excursion(std::mt19937_64& rng, const Pose2& start);
+// selfcal_e_max_syst: UMBmark E_max,syst [m] of the LabMate using f: 5 cw + 5 ccw 4 m squares
+// (floor seeds 500..509; rough: the report's floor), return error = true pose - odometry.
+double selfcal_e_max_syst(const calib::Factors& f, bool rough);
+
+}  // namespace odo::analysis

@@ -1,0 +1,288 @@
+#include "odo/firmware/selfcal_estimator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+
+#include "odo/firmware/calibration_store.hpp"
+#include "odo/firmware/can_broadcast.hpp"
+#include "odo/loop/loop.hpp"
+
+namespace odo::fw {
+namespace {
+
+// What is kept of the record while no fix is in the window: a late CAN fix is at most 4.1 s old.
+constexpr TimeNs kKeep = 5'000'000'000;
+
+std::int64_t system_seconds() {
+  return static_cast<std::int64_t>(std::time(nullptr));
+}
+
+// metres_per_count: c_m of `p` without the wheel factors (what fit_fixes scales).
+double nominal_metres_per_count(KinematicParams p) {
+  p.c_l = p.c_r = 1.0;
+  auto k = Kinematics::create(p);
+  return k ? k->metres_per_count() : 0.0;
+}
+
+}  // namespace
+
+SelfCalEstimator::SelfCalEstimator(const SelfCalSetup& s, calib::CalibrationStore* store,
+                                   loop::CommandQueue& commands, loop::SegmentRing& segments,
+                                   const loop::RecordingEncoder& recorder, std::ostream& log,
+                                   WallClock clock)
+    : s_(s),
+      store_(store),
+      commands_(commands),
+      segments_(segments),
+      recorder_(recorder),
+      log_(log),
+      clock_(clock != nullptr ? clock : &system_seconds),
+      ring_(s.fix_capacity) {}
+
+void SelfCalEstimator::submit(const calib::PoseFix& f) {
+  std::lock_guard lk(m_);
+  submitted_.push_back(f);
+}
+
+SelfCalCounters SelfCalEstimator::counters() const {
+  std::lock_guard lk(m_);
+  return counters_;
+}
+
+KinematicParams SelfCalEstimator::in_use() const {
+  std::lock_guard lk(m_);
+  return s_.in_use;
+}
+
+void SelfCalEstimator::take_fixes(TimeNs until) {
+  calib::PoseFix f;
+  std::uint64_t received = 0, dropped = 0;
+  while (ring_.pop(f)) {
+    pending_.push_back(f);
+    ++received;
+  }
+  {
+    std::lock_guard lk(m_);
+    received += submitted_.size();
+    pending_.insert(pending_.end(), submitted_.begin(), submitted_.end());
+    submitted_.clear();
+  }
+  std::stable_sort(pending_.begin(), pending_.end(),
+                   [](const calib::PoseFix& a, const calib::PoseFix& b) { return a.t < b.t; });
+  // Ripe: every count up to the fix time has been taken from the ring (the open segment closes
+  // within ripe_delay of the recorded time).
+  std::size_t n = 0;
+  for (; n < pending_.size() && pending_[n].t + s_.ripe_delay <= until; ++n) {
+    const calib::PoseFix& p = pending_[n];
+    // Without a window, trim() keeps the counts of the last kKeep only: an older fix has lost
+    // the counts after it. (A fix before the first segment is fine: the robot stood still.)
+    const bool before_record = window_.empty() && p.t < until - kKeep;
+    if ((!window_.empty() && p.t <= window_.back().t) || before_record) {
+      ++dropped;
+      continue;
+    }
+    window_.push_back(p);
+    flagged_.push_back(false);
+    ++new_fixes_;
+  }
+  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(n));
+  std::lock_guard lk(m_);
+  counters_.fixes_received += received;
+  counters_.fixes_dropped += dropped;
+}
+
+void SelfCalEstimator::trim(TimeNs until) {
+  const auto max_fixes = static_cast<std::size_t>(s_.cfg.max_fixes);
+  if (window_.size() > max_fixes) {
+    const auto cut = static_cast<std::ptrdiff_t>(window_.size() - max_fixes);
+    window_.erase(window_.begin(), window_.begin() + cut);
+    flagged_.erase(flagged_.begin(), flagged_.begin() + cut);
+  }
+  // Counts before the first fix of the window are of no use; without a fix, keep what a late
+  // fix (at most 4.1 s on CAN) can still reach. Bounded memory for any run length.
+  const TimeNs keep_from = !window_.empty() ? window_.front().t : until - kKeep;
+  while (!segs_.empty() && segs_.front().t_end <= keep_from) segs_.pop_front();
+}
+
+void SelfCalEstimator::step() {
+  // Read before draining: every segment the recorder closed up to `until` is in the ring then
+  // (it pushes before it publishes the time).
+  const TimeNs until = recorder_.recorded_until();
+  calib::CountSegment seg;
+  std::uint64_t n = 0;
+  while (segments_.pop(seg)) {
+    segs_.push_back(seg);
+    ++n;
+  }
+  {
+    std::lock_guard lk(m_);
+    counters_.segments += n;
+  }
+  take_fixes(until);
+  trim(until);
+  if (static_cast<int>(window_.size()) >= s_.cfg.min_fixes && new_fixes_ >= s_.cfg.fit_every) {
+    new_fixes_ = 0;
+    fit();
+  }
+}
+
+void SelfCalEstimator::fit() {
+  calib::SelfCalConfig c;
+  KinematicParams use = in_use();
+  c.metres_per_count = nominal_metres_per_count(use);
+  c.in_use = {use.c_l, use.c_r, use.wheelbase};
+  c.prior_sigma_factor = s_.cfg.prior_sigma_factor;
+  c.prior_sigma_wheelbase = s_.cfg.prior_sigma_wheelbase;
+  c.odometry_noise = s_.noise;
+  c.hold_out_every = s_.cfg.hold_out_every;
+  c.max_sigma_factor = s_.cfg.max_sigma_factor;
+  c.max_sigma_wheelbase = s_.cfg.max_sigma_wheelbase;
+  const std::vector<calib::CountSegment> segs(segs_.begin(), segs_.end());
+  auto track = calib::build_track(segs, window_);
+  auto r = track ? calib::fit_fixes(*track, c) : Result<calib::SelfCalResult>(track.error());
+  std::unique_lock lk(m_);
+  ++counters_.fits;
+  if (!r) {
+    ++counters_.fit_errors;
+    lk.unlock();
+    log_ << "odometryd: selfcal: fit failed: " << r.error().message << std::endl;
+    return;
+  }
+  for (int i : r->rejected) {
+    if (flagged_[static_cast<std::size_t>(i)]) continue;
+    flagged_[static_cast<std::size_t>(i)] = true;
+    ++counters_.fixes_rejected;
+  }
+  counters_.last = *r;
+  lk.unlock();
+  log_ << "odometryd: selfcal: " << window_.size() << " fixes (" << r->fixes_rejected
+       << " rejected): c_l=" << r->estimate.c_l << " c_r=" << r->estimate.c_r
+       << " b=" << r->estimate.wheelbase << " m, held-out chi2/dof " << r->score_candidate << " vs "
+       << r->score_in_use << " in use: " << calib::verdict_name(r->verdict) << std::endl;
+  if (r->verdict == calib::Verdict::kAccepted) apply(*r);
+}
+
+void SelfCalEstimator::apply(const calib::SelfCalResult& r) {
+  KinematicParams p = in_use();
+  p.c_l = r.estimate.c_l;
+  p.c_r = r.estimate.c_r;
+  p.wheelbase = r.estimate.wheelbase;
+  auto k = Kinematics::create(p);
+  calib::CalibrationRecord rec;
+  rec.c_l = p.c_l;
+  rec.c_r = p.c_r;
+  rec.wheelbase = p.wheelbase;
+  if (p.wheel_diameter != s_.nominal.wheel_diameter) rec.wheel_diameter = p.wheel_diameter;
+  rec.time = clock_();
+  rec.method = "online";
+  rec.fit = calib::FixFitProvenance{static_cast<std::uint32_t>(r.fixes_used),
+                                    static_cast<std::uint32_t>(r.fixes_rejected),
+                                    r.score_candidate,
+                                    r.sigma[0],
+                                    r.sigma[1],
+                                    r.sigma[2]};
+  // Values the store or the kinematics refuse are not applied either: nothing half-done.
+  if (auto v = calib::validate_record(rec); !v || !k) {
+    log_ << "odometryd: selfcal: candidate refused: "
+         << (!k ? k.error().message : v.error().message) << std::endl;
+    return;
+  }
+  calib::StoreStatus state = calib::StoreStatus::kUncalibrated;
+  if (store_ != nullptr) {
+    auto seq = store_->save(rec);
+    std::lock_guard lk(m_);
+    if (!seq) {
+      ++counters_.store_errors;
+      log_ << "odometryd: selfcal: store write failed, calibration not applied: "
+           << seq.error().message << std::endl;
+      return;
+    }
+    ++counters_.written;
+    state = calib::StoreStatus::kOk;
+  }
+  while (!commands_.post(loop::SetKinematics{*k, state}))
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  {
+    std::lock_guard lk(m_);
+    s_.in_use = p;
+    ++counters_.accepted;
+  }
+  log_ << "odometryd: selfcal: applied c_l=" << p.c_l << " c_r=" << p.c_r << " b=" << p.wheelbase
+       << " m" << (store_ != nullptr ? " (stored)" : " (no store configured)") << std::endl;
+  // The next candidate must beat this one on fixes it has not seen: start a new window at the
+  // newest fix.
+  window_.erase(window_.begin(), window_.end() - 1);
+  flagged_.assign(1, false);
+}
+
+void SelfCalEstimator::start(double period) {
+  thread_ = std::thread([this, period] {
+    std::unique_lock lk(m_);
+    while (!cv_.wait_for(lk, std::chrono::duration<double>(period), [this] { return done_; })) {
+      lk.unlock();
+      step();
+      lk.lock();
+    }
+  });
+}
+
+void SelfCalEstimator::stop() {
+  if (!thread_.joinable()) return;
+  {
+    std::lock_guard lk(m_);
+    done_ = true;
+  }
+  cv_.notify_all();
+  thread_.join();
+  step();
+}
+
+}  // namespace odo::fw
+
+// ---- SelfCalLink ----
+
+namespace odo::fw {
+
+SelfCalLink::~SelfCalLink() {
+  if (estimator_) estimator_->stop();
+}
+
+Result<std::unique_ptr<SelfCalLink>> SelfCalLink::create(const Config& cfg,
+                                                         const KinematicParams& in_use,
+                                                         EncoderSource& encoder,
+                                                         std::ostream& log) {
+  std::unique_ptr<SelfCalLink> l(new SelfCalLink());
+  auto k = Kinematics::create(in_use);
+  if (!k) return std::move(k).error();
+  auto limits = calib::recorder_limits(*k);
+  if (!limits) return std::move(limits).error();
+  l->setup_.cfg = cfg.selfcal;
+  l->setup_.nominal = cfg.robot;
+  l->setup_.in_use = in_use;
+  l->setup_.noise = cfg.error_model;
+  // The open segment closes within max_duration after its last counts, seen one tick later.
+  l->setup_.ripe_delay = limits->max_duration + 2 * from_seconds(1.0 / cfg.loop.rate_hz);
+  if (!cfg.calibration.store.empty()) {
+    auto st = open_calibration_store(cfg.calibration.store, cfg.calibration.backend);
+    if (!st) return make_error(st.error().code, "selfcal: " + st.error().message);
+    l->store_ = std::make_unique<OpenStore>(std::move(st).value());
+  }
+  // 8192 segments: 160 s of motion at one segment per 20 ms, for an estimator that stalls.
+  l->segments_ = std::make_unique<loop::SegmentRing>(8192);
+  l->recorder_ = std::make_unique<loop::RecordingEncoder>(encoder, *limits, *l->segments_);
+  l->log_ = &log;
+  l->describe_ = "on, fit after " + std::to_string(cfg.selfcal.min_fixes) + " fixes, window " +
+                 std::to_string(cfg.selfcal.max_fixes) +
+                 (l->store_ ? ", writes " + cfg.calibration.store : std::string(", no store"));
+  return l;
+}
+
+void SelfCalLink::attach(loop::OdometryLoop& loop, CanLink* can) {
+  calib::CalibrationStore* store = store_ && store_->store ? &*store_->store : nullptr;
+  estimator_ = std::make_unique<SelfCalEstimator>(setup_, store, loop.commands(), *segments_,
+                                                  *recorder_, *log_);
+  if (can != nullptr) can->set_fix_ring(&estimator_->fix_ring());
+}
+
+}  // namespace odo::fw

@@ -1,0 +1,361 @@
+// odomctl calib fit-fixes: self-calibration from absolute fixes offline (issue 18), with the
+// daemon's recorder and estimator on a replay count log and a CSV of fixes.
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <numbers>
+#include <random>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "odo/analysis/selfcal_tools.hpp"
+#include "odo/analysis/umbmark_tools.hpp"
+#include "odo/calibration/selfcal.hpp"
+#include "odo/firmware/selfcal_estimator.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/sim/floor.hpp"
+#include "odo/sim/sim_encoder.hpp"
+#include "odo/sim/sim_nv_storage.hpp"
+#include "odo/sim/virtual_clock.hpp"
+
+namespace odo::ctl {
+namespace {
+
+struct FitFixesOpts {
+  std::string ticks, fixes;
+  double wheel_diameter = 0, counts_per_rev = 0, gear_ratio = 1, wheelbase = 0;
+  double cl = 1, cr = 1;
+  int bits = 64;
+  calib::SelfCalConfig fit;
+  bool json = false;
+};
+
+// fit_input: kinematics, segments and fixes; false (message printed) on bad input.
+bool fit_input(const FitFixesOpts& o, calib::FixTrack& track, calib::SelfCalConfig& c) {
+  const char* cmd = "odomctl calib fit-fixes: ";
+  KinematicParams p;
+  p.wheel_diameter = o.wheel_diameter;
+  p.counts_per_rev = o.counts_per_rev;
+  p.gear_ratio = o.gear_ratio;
+  p.wheelbase_nominal = p.wheelbase = o.wheelbase;
+  p.c_l = o.cl;
+  p.c_r = o.cr;
+  auto k = Kinematics::create(p);
+  if (!k) {
+    std::cerr << cmd << k.error().message << "\n";
+    return false;
+  }
+  std::ifstream ticks(o.ticks, std::ios::binary), fixes(o.fixes, std::ios::binary);
+  for (const auto& [f, name] : {std::pair{&ticks, &o.ticks}, std::pair{&fixes, &o.fixes}}) {
+    if (!*f) {
+      std::cerr << cmd << *name << ": cannot open\n";
+      return false;
+    }
+  }
+  auto segs = analysis::read_count_segments(ticks, o.ticks, *k, o.bits);
+  if (!segs) {
+    std::cerr << cmd << segs.error().message << "\n";
+    return false;
+  }
+  auto fx = analysis::read_fixes(fixes, o.fixes);
+  if (!fx) {
+    std::cerr << cmd << fx.error().message << "\n";
+    return false;
+  }
+  auto t = calib::build_track(*segs, *fx);
+  if (!t) {
+    std::cerr << cmd << o.fixes << ": " << t.error().message << "\n";
+    return false;
+  }
+  track = std::move(t).value();
+  c = o.fit;
+  p.c_l = p.c_r = 1.0;
+  c.metres_per_count = Kinematics::create(p)->metres_per_count();
+  c.in_use = {o.cl, o.cr, o.wheelbase};
+  if (auto s = calib::check_selfcal_config(c); !s) {
+    std::cerr << cmd << s.error().message << "\n";
+    return false;
+  }
+  return true;
+}
+
+void print_result(const calib::SelfCalResult& r, bool json) {
+  std::vector<int> rejected;  // fix numbers, 1 = the first data row of FIXES.csv
+  for (int i : r.rejected) rejected.push_back(i + 1);
+  if (json) {
+    nlohmann::json j{{"c_l", r.estimate.c_l},
+                     {"c_r", r.estimate.c_r},
+                     {"wheelbase", r.estimate.wheelbase},
+                     {"sigma_c_l", r.sigma[0]},
+                     {"sigma_c_r", r.sigma[1]},
+                     {"sigma_wheelbase", r.sigma[2]},
+                     {"scale_held", r.scale_held},
+                     {"fixes_used", r.fixes_used},
+                     {"fixes_rejected", r.fixes_rejected},
+                     {"rejected", rejected},
+                     {"excursions_fit", r.excursions_fit},
+                     {"excursions_held_out", r.excursions_held_out},
+                     {"excursions_skipped", r.excursions_skipped},
+                     {"chi2_per_dof", r.chi2_per_dof},
+                     {"held_out_candidate", r.score_candidate},
+                     {"held_out_in_use", r.score_in_use},
+                     {"verdict", calib::verdict_name(r.verdict)}};
+    std::cout << j.dump() << "\n";
+    return;
+  }
+  std::cout << "c_l         " << r.estimate.c_l << " (sigma " << r.sigma[0] << ")\n"
+            << "c_r         " << r.estimate.c_r << " (sigma " << r.sigma[1] << ")\n"
+            << "wheelbase   " << r.estimate.wheelbase << " m (sigma " << r.sigma[2] << " m)\n"
+            << "scale       "
+            << (r.scale_held ? "held at the value in use (the fixes do not determine it)"
+                             : "from the fixes")
+            << "\n"
+            << "fixes       " << r.fixes_used << " used, " << r.fixes_rejected << " rejected";
+  for (std::size_t i = 0; i < rejected.size(); ++i)
+    std::cout << (i == 0 ? " (fix " : ", ") << rejected[i] << (i + 1 == rejected.size() ? ")" : "");
+  std::cout << "\nexcursions  " << r.excursions_fit << " fit, " << r.excursions_held_out
+            << " held out, " << r.excursions_skipped << " skipped\n"
+            << "residual    chi2/dof " << r.chi2_per_dof << " (fit); held out " << r.score_candidate
+            << " against " << r.score_in_use << " with the values in use\n"
+            << "verdict     " << calib::verdict_name(r.verdict) << "\n";
+}
+
+void run_fit_fixes(const FitFixesOpts& o, int& exit_code) {
+  calib::FixTrack track;
+  calib::SelfCalConfig c;
+  if (!fit_input(o, track, c)) {
+    exit_code = kExitBadInput;
+    return;
+  }
+  auto r = calib::fit_fixes(track, c);
+  if (!r) {
+    std::cerr << "odomctl calib fit-fixes: " << r.error().message << "\n";
+    exit_code = kExitFailed;
+    return;
+  }
+  print_result(*r, o.json);
+  exit_code = kExitOk;
+}
+
+struct SimulateOpts {
+  int excursions = 20;
+  double sigma_xy = 0.005;   // [m]
+  double sigma_theta = 0.5;  // [deg]
+  double outliers = 0.0;     // fraction of fixes moved 0.5 .. 5 m
+  double late = 0.3;         // [s] a fix arrives this long after its moment
+  bool smooth = false;       // no floor roughness
+  int min_fixes = 0;         // 0: excursions + 1 (one fit at the end)
+  int fit_every = 4;
+  std::uint64_t seed = 1;
+  bool json = false;
+};
+
+// SimDrive: the random excursions as one scenario and the fix moments (ticks in the final
+// pause of each excursion, and one at the start).
+struct SimDrive {
+  sim::Scenario scenario;
+  std::vector<TimeNs> fix_times;
+};
+
+SimDrive plan_drive(const SimulateOpts& o, std::mt19937_64& rng) {
+  SimDrive d;
+  d.scenario.push_back({0.5, 0.0, 0.0});
+  d.fix_times.push_back(from_seconds(0.3));
+  Pose2 pose;
+  for (int e = 0; e < o.excursions; ++e) {
+    const sim::Scenario ex = analysis::random_excursion(rng, pose);
+    d.scenario.insert(d.scenario.end(), ex.begin(), ex.end());
+    d.scenario.push_back({0.5, 0.0, 0.0});
+    const double end = sim::scenario_duration(d.scenario);
+    d.fix_times.push_back(from_seconds(std::round((end - 0.3) * 100.0) / 100.0));
+    auto r = *sim::SimRobot::create(sim::labmate_geometry(analysis::kSelfCalDn), d.scenario);
+    r.advance_to(from_seconds(end));
+    pose = r.true_pose();  // the planner's view (no floor): any planner will do
+  }
+  return d;
+}
+
+struct SimOutcome {
+  fw::SelfCalCounters counters;
+  KinematicParams final;
+  std::string log;
+  int corrupted = 0;
+};
+
+// simulate_drive: the daemon's loop, recorder and estimator on the simulated LabMate.
+SimOutcome simulate_drive(const SimulateOpts& o, const SimDrive& d, std::mt19937_64& rng) {
+  const Kinematics believed = analysis::selfcal_kinematics({1.0, 1.0, analysis::kSelfCalBn});
+  sim::VirtualClock clock;
+  auto robot = *sim::SimRobot::create(sim::labmate_geometry(analysis::kSelfCalDn), d.scenario);
+  sim::UmbmarkFloor::Options fo;
+  fo.roughness_height = o.smooth ? 0.0 : analysis::kPaperRoughness;
+  sim::UmbmarkFloor floor(fo, o.seed * 1000);
+  robot.set_travel_perturbation(&floor);
+  sim::SimEncoderSource enc(robot, 32);
+  loop::SegmentRing segments(8192);
+  loop::RecordingEncoder rec(enc, *calib::recorder_limits(believed), segments);
+  auto lp = loop::OdometryLoop::create(loop::LoopConfig{}, believed, rec, clock).value();
+  sim::SimNvStorage medium(sim::SimMedium::kEeprom, 1024, 0, 16);
+  auto store = *calib::CalibrationStore::create(medium);
+  fw::SelfCalSetup setup;
+  setup.cfg.enabled = true;
+  setup.cfg.min_fixes = o.min_fixes > 0 ? o.min_fixes : o.excursions + 1;
+  setup.cfg.max_fixes = std::max(setup.cfg.min_fixes, 41);
+  setup.cfg.fit_every = o.fit_every;
+  setup.nominal = setup.in_use = believed.params();
+  setup.ripe_delay = from_seconds(0.04);
+  std::ostringstream log;
+  fw::SelfCalEstimator est(setup, &store, lp->commands(), segments, rec, log);
+  std::normal_distribution<double> n01;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double sth = o.sigma_theta * std::numbers::pi / 180.0;
+  std::vector<calib::PoseFix> waiting;
+  SimOutcome out;
+  std::size_t next = 0;
+  lp->start();
+  const TimeNs end = from_seconds(sim::scenario_duration(d.scenario) + 1.0);
+  while (lp->snapshot().stamp < end) {
+    lp->tick();
+    const TimeNs now = lp->snapshot().stamp;
+    if (next < d.fix_times.size() && now >= d.fix_times[next]) {
+      const Pose2& p = robot.true_pose();
+      calib::PoseFix f{now,
+                       p.x + o.sigma_xy * n01(rng),
+                       p.y + o.sigma_xy * n01(rng),
+                       wrap_angle(p.theta + sth * n01(rng)),
+                       o.sigma_xy,
+                       sth};
+      if (next > 0 && u(rng) < o.outliers) {  // a wrong landmark match
+        const double r = 0.5 + 4.5 * u(rng), a = 2 * std::numbers::pi * u(rng);
+        f.x += r * std::cos(a);
+        f.y += r * std::sin(a);
+        ++out.corrupted;
+      }
+      waiting.push_back(f);
+      ++next;
+    }
+    if (!waiting.empty() && now >= waiting.front().t + from_seconds(o.late)) {
+      est.submit(waiting.front());
+      waiting.erase(waiting.begin());
+    }
+    if (lp->snapshot().tick % 5 == 0) est.step();
+  }
+  est.step();
+  out.counters = est.counters();
+  out.final = est.in_use();
+  out.log = log.str();
+  return out;
+}
+
+void run_simulate(const SimulateOpts& o, int& exit_code) {
+  std::mt19937_64 rng(o.seed);
+  const SimDrive d = plan_drive(o, rng);
+  const SimOutcome r = simulate_drive(o, d, rng);
+  const calib::Factors truth = analysis::selfcal_truth();
+  const calib::Factors fin{r.final.c_l, r.final.c_r, r.final.wheelbase};
+  const double before = analysis::selfcal_e_max_syst({1.0, 1.0, analysis::kSelfCalBn}, !o.smooth);
+  const double after = analysis::selfcal_e_max_syst(fin, !o.smooth);
+  analysis::UmbmarkSimOptions uo;
+  uo.noise = o.smooth ? "none" : "paper";
+  uo.seed = o.seed;
+  auto manual = analysis::run_umbmark_simulation(uo);
+  const double e_manual =
+      manual ? analysis::selfcal_e_max_syst(manual->passes[0].result.composed, !o.smooth) : NAN;
+  const fw::SelfCalCounters& c = r.counters;
+  if (o.json) {
+    nlohmann::json j{{"excursions", o.excursions},
+                     {"fixes", c.fixes_received},
+                     {"corrupted", r.corrupted},
+                     {"rejected", c.fixes_rejected},
+                     {"fits", c.fits},
+                     {"applied", c.accepted},
+                     {"c_l", fin.c_l},
+                     {"c_r", fin.c_r},
+                     {"wheelbase", fin.wheelbase},
+                     {"truth_c_l", truth.c_l},
+                     {"truth_c_r", truth.c_r},
+                     {"truth_wheelbase", truth.wheelbase},
+                     {"e_max_syst_before", before},
+                     {"e_max_syst_after", after},
+                     {"e_max_syst_manual_pass", e_manual}};
+    std::cout << j.dump() << "\n";
+  } else {
+    std::cout << r.log << "excursions  " << o.excursions << ", fixes " << c.fixes_received << " ("
+              << r.corrupted << " corrupted, " << c.fixes_rejected << " rejected), fits " << c.fits
+              << ", applied " << c.accepted << "\n"
+              << "c_l         " << fin.c_l << " (truth " << truth.c_l << ")\n"
+              << "c_r         " << fin.c_r << " (truth " << truth.c_r << ")\n"
+              << "wheelbase   " << fin.wheelbase << " m (truth " << truth.wheelbase << " m)\n"
+              << "E_max,syst  " << before * 1e3 << " mm nominal, " << after * 1e3
+              << " mm self-calibrated, " << e_manual * 1e3 << " mm after one manual UMBmark pass\n";
+  }
+  exit_code = kExitOk;
+}
+
+}  // namespace
+
+void add_selfcal(CLI::App& app, int& exit_code) {
+  CLI::App* sc = app.add_subcommand("selfcal", "self-calibration from absolute fixes");
+  sc->require_subcommand(1);
+  auto o = std::make_shared<SimulateOpts>();
+  CLI::App* c = sc->add_subcommand(
+      "simulate", "random excursions from a dock with fixes, through the daemon's estimator");
+  c->add_option("--excursions", o->excursions, "excursions, 1..1000")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  c->add_option("--sigma-xy", o->sigma_xy, "fix noise [m], 1e-4..1")
+      ->check(CLI::Range(1e-4, 1.0))
+      ->capture_default_str();
+  c->add_option("--sigma-theta", o->sigma_theta, "fix heading noise [deg], 0.01..20")
+      ->check(CLI::Range(0.01, 20.0))
+      ->capture_default_str();
+  c->add_option("--outliers", o->outliers, "fraction of fixes moved 0.5-5 m, 0..0.5")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
+  c->add_option("--late", o->late, "delay of every fix [s], 0..4")
+      ->check(CLI::Range(0.0, 4.0))
+      ->capture_default_str();
+  c->add_flag("--smooth-floor", o->smooth, "no floor roughness (default: the report's floor)");
+  c->add_option("--min-fixes", o->min_fixes, "fixes before the first fit (0: excursions + 1)")
+      ->check(CLI::Range(0, 1000));
+  c->add_option("--fit-every", o->fit_every, "a fit after every n new fixes, 1..1000")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  c->add_option("--seed", o->seed, "random seed")->capture_default_str();
+  c->add_flag("--json", o->json, "print one JSON object");
+  c->callback([o, &exit_code] { run_simulate(*o, exit_code); });
+}
+
+void add_calib_fit_fixes(CLI::App& calib, int& exit_code) {
+  auto o = std::make_shared<FitFixesOpts>();
+  CLI::App* c = calib.add_subcommand(
+      "fit-fixes", "estimate c_L, c_R and b from a count log and absolute pose fixes");
+  c->add_option("--ticks", o->ticks, "count log: CSV t,left,right[,gyro_z]")->required();
+  c->add_option("--fixes", o->fixes, "fixes: CSV t,x,y,theta,sigma_xy,sigma_theta")->required();
+  c->add_option("--wheel-diameter", o->wheel_diameter, "nominal wheel diameter Dn [m]")->required();
+  c->add_option("--counts-per-rev", o->counts_per_rev,
+                "encoder counts per motor revolution after quadrature (Ce)")
+      ->required();
+  c->add_option("--gear-ratio", o->gear_ratio, "motor revolutions per wheel revolution (n)");
+  c->add_option("--wheelbase", o->wheelbase, "wheelbase b in use while recording [m]")->required();
+  c->add_option("--cl", o->cl, "c_L in use while recording");
+  c->add_option("--cr", o->cr, "c_R in use while recording");
+  c->add_option("--counter-bits", o->bits, "counter width in bits, 16..64 (default 64)");
+  c->add_option("--k-left", o->fit.odometry_noise.k_left, "wheel noise k_L [m^(1/2)]")
+      ->capture_default_str();
+  c->add_option("--k-right", o->fit.odometry_noise.k_right, "wheel noise k_R [m^(1/2)]")
+      ->capture_default_str();
+  c->add_option("--hold-out-every", o->fit.hold_out_every, "hold out every n-th excursion")
+      ->capture_default_str();
+  c->add_option("--max-sigma-factor", o->fit.max_sigma_factor, "acceptance bound on sigma(c)")
+      ->capture_default_str();
+  c->add_option("--max-sigma-wheelbase", o->fit.max_sigma_wheelbase,
+                "acceptance bound on sigma(b) [m]")
+      ->capture_default_str();
+  c->add_flag("--json", o->json, "print one JSON object");
+  c->callback([o, &exit_code] { run_fit_fixes(*o, exit_code); });
+}
+
+}  // namespace odo::ctl

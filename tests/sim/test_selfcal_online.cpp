@@ -1,0 +1,181 @@
+// The daemon's self-calibration path end to end (issue 18): the firmware's loop reads a
+// simulated LabMate (b 0.337 m against 0.340 nominal, diameter ratio 0.9985) through the
+// RecordingEncoder; dock fixes (true pose, noise-free, declared 0.1 mm / 0.1 mrad) arrive
+// 0.3 s late at the SelfCalEstimator, which fits, writes the store and posts SetKinematics.
+// The same raw readings and fixes written as CSV and fitted offline (odomctl calib fit-fixes'
+// code) give the same result.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <sstream>
+#include <vector>
+
+#include "odo/analysis/selfcal_tools.hpp"
+#include "odo/calibration/selfcal.hpp"
+#include "odo/calibration/store.hpp"
+#include "odo/firmware/selfcal_estimator.hpp"
+#include "odo/loop/loop.hpp"
+#include "odo/loop/recording_encoder.hpp"
+#include "odo/sim/robot.hpp"
+#include "odo/sim/sim_encoder.hpp"
+#include "odo/sim/sim_nv_storage.hpp"
+#include "odo/sim/virtual_clock.hpp"
+
+namespace odo {
+namespace {
+
+constexpr double kDn = 0.15, kBn = 0.34;
+
+KinematicParams nominal() {
+  return KinematicParams{kDn, 2048, 16, kBn, kBn, 1.0, 1.0};
+}
+
+// LoggingEncoder: keeps every reading the loop makes (test only: it allocates).
+class LoggingEncoder final : public EncoderSource {
+ public:
+  explicit LoggingEncoder(EncoderSource& e) : e_(e) {}
+  EncoderSample read(TimeNs now) noexcept override {
+    const EncoderSample s = e_.read(now);
+    log.push_back(s);
+    return s;
+  }
+  int counter_bits() const noexcept override { return e_.counter_bits(); }
+  std::vector<EncoderSample> log;
+
+ private:
+  EncoderSource& e_;
+};
+
+struct Drive {
+  sim::Scenario scenario;
+  std::vector<double> fix_times;  // [s]
+};
+
+// Ten UMBmark squares, cw and ccw in turn, from the dock; a fix 0.25 s after each (standing
+// still in the square's final pause) and one at the start.
+Drive squares(const Kinematics& believed) {
+  Drive d;
+  d.fix_times.push_back(0.25);
+  sim::Scenario lead{{0.5, 0.0, 0.0}};
+  d.scenario = lead;
+  for (int i = 0; i < 10; ++i) {
+    sim::SquareOptions o;
+    o.direction = i % 2 == 0 ? sim::Turn::kClockwise : sim::Turn::kCounterClockwise;
+    const sim::Scenario sq = sim::square_scenario(believed, o);
+    d.scenario.insert(d.scenario.end(), sq.begin(), sq.end());
+    d.scenario.push_back({1.0, 0.0, 0.0});
+    d.fix_times.push_back(sim::scenario_duration(d.scenario) - 0.5);
+  }
+  return d;
+}
+
+std::vector<calib::PoseFix> true_fixes(const sim::RobotGeometry& g, const Drive& d) {
+  auto robot = *sim::SimRobot::create(g, d.scenario);
+  std::vector<calib::PoseFix> out;
+  for (double t : d.fix_times) {
+    robot.advance_to(from_seconds(t));
+    const Pose2 p = robot.true_pose();
+    out.push_back({from_seconds(t), p.x, p.y, wrap_angle(p.theta), 1e-4, 1e-4});
+  }
+  return out;
+}
+
+TEST(SelfCalOnline, LoopRecordsEstimatorAppliesAndOfflineFitAgrees) {
+  const sim::RobotGeometry truth = sim::labmate_geometry(kDn);
+  const Kinematics believed = *Kinematics::create(nominal());
+  const Drive d = squares(believed);
+  const std::vector<calib::PoseFix> fixes = true_fixes(truth, d);
+
+  sim::VirtualClock clock;
+  auto robot = *sim::SimRobot::create(truth, d.scenario);
+  sim::SimEncoderSource enc(robot, 32);
+  LoggingEncoder logged(enc);
+  logged.log.reserve(200000);
+  loop::SegmentRing segments(8192);
+  loop::RecordingEncoder rec(logged, *calib::recorder_limits(believed), segments);
+  loop::LoopConfig lc;
+  auto lp = loop::OdometryLoop::create(lc, believed, rec, clock).value();
+
+  sim::SimNvStorage medium(sim::SimMedium::kEeprom, 1024, 0, 16);
+  auto store = *calib::CalibrationStore::create(medium);
+  fw::SelfCalSetup setup;
+  setup.cfg.enabled = true;
+  setup.cfg.min_fixes = 11;  // one fit, when the last fix is in
+  setup.cfg.fit_every = 1;
+  setup.nominal = setup.in_use = nominal();
+  setup.ripe_delay = from_seconds(0.04);
+  std::ostringstream log;
+  fw::SelfCalEstimator est(setup, &store, lp->commands(), segments, rec, log,
+                           [] { return std::int64_t{1'700'000'000}; });
+
+  lp->start();
+  std::size_t next_fix = 0;
+  const TimeNs end = from_seconds(sim::scenario_duration(d.scenario) + 1.0);
+  while (lp->snapshot().stamp < end) {
+    lp->tick();
+    const TimeNs now = lp->snapshot().stamp;
+    // Each fix arrives 0.3 s after the moment it describes.
+    if (next_fix < fixes.size() && now >= fixes[next_fix].t + from_seconds(0.3))
+      est.submit(fixes[next_fix++]);
+    if (lp->snapshot().tick % 5 == 0) est.step();  // the estimator thread's pace
+  }
+  for (int i = 0; i < 3; ++i) lp->tick();  // the SetKinematics posted by the last step
+  const fw::SelfCalCounters c = est.counters();
+  std::printf("%s", log.str().c_str());
+  ASSERT_TRUE(c.last.has_value());
+  EXPECT_EQ(c.fixes_received, 11u);
+  EXPECT_EQ(c.fits, 1u);
+  EXPECT_EQ(c.fixes_rejected, 0u);
+  EXPECT_EQ(segments.dropped(), 0u);
+  ASSERT_EQ(c.last->verdict, calib::Verdict::kAccepted) << log.str();
+  EXPECT_EQ(c.accepted, 1u);
+  EXPECT_EQ(c.written, 1u);
+  // The wheelbase: 0.337 m true; the scale is held at the in-use 1 (dock fixes cannot see it).
+  EXPECT_NEAR(c.last->estimate.wheelbase, truth.wheelbase, 5e-4 * truth.wheelbase);
+  // Applied to the loop and stored with its provenance.
+  EXPECT_GE(lp->commands_applied(), 1u);
+  EXPECT_DOUBLE_EQ(lp->odometry().kinematics().params().wheelbase, c.last->estimate.wheelbase);
+  auto loaded = *store.load();
+  ASSERT_EQ(loaded.status, calib::StoreStatus::kOk);
+  EXPECT_EQ(loaded.record->method, "online");
+  EXPECT_EQ(loaded.record->time, 1'700'000'000);
+  ASSERT_TRUE(loaded.record->fit.has_value());
+  EXPECT_EQ(loaded.record->fit->fixes_used, 11u);
+  EXPECT_DOUBLE_EQ(loaded.record->fit->residual, c.last->score_candidate);
+
+  // Offline: the readings and fixes as odomctl calib fit-fixes reads them.
+  std::ostringstream ticks, fx;
+  ticks << "t,left,right\n";
+  char line[128];
+  for (const EncoderSample& s : logged.log) {
+    std::snprintf(line, sizeof line, "%.9f,%lld,%lld\n", to_seconds(s.stamp),
+                  static_cast<long long>(s.left), static_cast<long long>(s.right));
+    ticks << line;
+  }
+  fx << "t,x,y,theta,sigma_xy,sigma_theta\n";
+  for (const calib::PoseFix& f : fixes) {
+    std::snprintf(line, sizeof line, "%.9f,%.17g,%.17g,%.17g,%.17g,%.17g\n", to_seconds(f.t), f.x,
+                  f.y, *f.theta, f.sigma_xy, f.sigma_theta);
+    fx << line;
+  }
+  std::istringstream ti(ticks.str()), fi(fx.str());
+  auto segs = analysis::read_count_segments(ti, "ticks.csv", believed, 32);
+  ASSERT_TRUE(segs) << segs.error().message;
+  auto off_fixes = analysis::read_fixes(fi, "fixes.csv");
+  ASSERT_TRUE(off_fixes) << off_fixes.error().message;
+  auto track = calib::build_track(*segs, *off_fixes);
+  ASSERT_TRUE(track);
+  calib::SelfCalConfig cfg;
+  cfg.metres_per_count = believed.metres_per_count();
+  cfg.in_use = {1.0, 1.0, kBn};
+  auto off = calib::fit_fixes(*track, cfg);
+  ASSERT_TRUE(off) << off.error().message;
+  EXPECT_EQ(off->estimate.c_l, c.last->estimate.c_l);
+  EXPECT_EQ(off->estimate.c_r, c.last->estimate.c_r);
+  EXPECT_EQ(off->estimate.wheelbase, c.last->estimate.wheelbase);
+  EXPECT_EQ(off->score_candidate, c.last->score_candidate);
+  EXPECT_EQ(off->fixes_used, c.last->fixes_used);
+}
+
+}  // namespace
+}  // namespace odo
