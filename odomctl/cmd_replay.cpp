@@ -16,7 +16,16 @@ struct ReplayOpts {
   double cl = 1, cr = 1;
   int bits = 64;
   bool json = false;
+  bool no_gyro = false;  // ignore a gyro_z column
 };
+
+// gyro_json: the fusion's counters of a replay with a gyro_z column.
+nlohmann::json gyro_json(const FusionCounters& c) {
+  return {{"disagreements", c.disagreements},
+          {"speed_events", c.speed_events},
+          {"accel_events", c.accel_events},
+          {"gyro_used_ticks", c.flagged_ticks}};
+}
 
 // run_replay: `odomctl ... replay` once its options are parsed; sets exit_code.
 void run_replay(const ReplayOpts& o, int& exit_code) {
@@ -39,7 +48,9 @@ void run_replay(const ReplayOpts& o, int& exit_code) {
     exit_code = kExitBadInput;
     return;
   }
-  auto r = analysis::replay_ticks(in, o.ticks, *k, o.bits);
+  analysis::ReplayGyro gyro;  // the loop's default fusion parameters (README "Gyro")
+  gyro.use = !o.no_gyro;
+  auto r = analysis::replay_ticks(in, o.ticks, *k, o.bits, gyro);
   if (!r) {
     std::cerr << "odomctl replay: " << r.error().message << "\n";
     exit_code = kExitBadInput;
@@ -51,6 +62,7 @@ void run_replay(const ReplayOpts& o, int& exit_code) {
                      {"theta", r->pose.theta},
                      {"distance", r->distance},
                      {"samples", r->samples}};
+    if (r->fused) j["gyro"] = gyro_json(r->fusion);
     std::cout << j.dump() << "\n";
   } else {
     std::cout << "samples   " << r->samples << "\n"
@@ -59,6 +71,10 @@ void run_replay(const ReplayOpts& o, int& exit_code) {
               << "theta     " << r->pose.theta << " rad (cumulative, "
               << r->pose.theta * 180.0 / 3.14159265358979323846 << " deg)\n"
               << "distance  " << r->distance << " m\n";
+    if (r->fused)
+      std::cout << "gyro      fused: " << r->fusion.disagreements << " disagreements, "
+                << r->fusion.speed_events + r->fusion.accel_events << " limit events, "
+                << r->fusion.flagged_ticks << " gyro-heading ticks\n";
   }
   exit_code = kExitOk;
 }
@@ -68,7 +84,9 @@ void run_replay(const ReplayOpts& o, int& exit_code) {
 void add_replay(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<ReplayOpts>();
   CLI::App* c = app.add_subcommand("replay", "integrate a CSV log of raw counter readings");
-  c->add_option("--ticks", o->ticks, "CSV file with header t,left,right")->required();
+  c->add_option("--ticks", o->ticks,
+                "CSV file with header t,left,right[,gyro_z] (gyro_z [rad/s]: fused)")
+      ->required();
   c->add_option("--wheel-diameter", o->wheel_diameter, "nominal wheel diameter Dn [m]")->required();
   c->add_option("--counts-per-rev", o->counts_per_rev,
                 "encoder counts per motor revolution after quadrature (Ce)")
@@ -79,6 +97,7 @@ void add_replay(CLI::App& app, int& exit_code) {
   c->add_option("--cr", o->cr, "right wheel correction factor c_R");
   c->add_option("--counter-bits", o->bits, "counter width in bits, 16..64 (default 64)");
   c->add_flag("--json", o->json, "print one JSON object");
+  c->add_flag("--no-gyro", o->no_gyro, "ignore the gyro_z column (odometry alone)");
   c->callback([o, &exit_code] { run_replay(*o, exit_code); });
 }
 

@@ -257,6 +257,27 @@ struct SimulateOpts {
   bool json = false;
 };
 
+// gyro_comparison_json / print_gyro_comparison: the --gyro figures (README "Gyro").
+json gyro_comparison_json(const analysis::UmbmarkGyroComparison& g) {
+  return json{{"eps_theta_nonsys_plain", opt(g.eps_plain)},
+              {"eps_theta_nonsys_fused", opt(g.eps_fused)},
+              {"uncal_plain_bumps", g.uncal_plain_bumps},
+              {"cal_fused_bumps", g.cal_fused_bumps},
+              {"cal_plain_smooth", g.cal_plain_smooth},
+              {"cal_fused_smooth", g.cal_fused_smooth},
+              {"events", g.events}};
+}
+
+void print_gyro_comparison(const analysis::UmbmarkGyroComparison& g, const std::string& cls) {
+  std::cout << std::setprecision(3) << "gyro (" << cls
+            << ", exact reference): eps_theta,nonsys plain " << g.eps_plain.value_or(0.0) * kDeg
+            << " deg, fused " << g.eps_fused.value_or(0.0) * kDeg << " deg\n"
+            << "  mean return error, bumps: uncalibrated plain " << g.uncal_plain_bumps * 1e3
+            << " mm, calibrated fused " << g.cal_fused_bumps * 1e3 << " mm\n"
+            << "  mean return error, smooth, calibrated: plain " << g.cal_plain_smooth * 1e3
+            << " mm, fused " << g.cal_fused_smooth * 1e3 << " mm\n";
+}
+
 // simulate_options_ok: the options, the formula and every output path, before any square.
 bool simulate_options_ok(SimulateOpts& o) {
   if (o.eb_form != "umbmark" && o.eb_form != "chong") {
@@ -310,10 +331,12 @@ void print_simulate_json(const analysis::UmbmarkSimResult& r) {
     if (p.result.eps_theta_nonsys) jp["eps_theta_nonsys"] = *p.result.eps_theta_nonsys;
     passes.push_back(jp);
   }
-  std::cout << json{{"passes", passes}, {"improvement", r.improvement}}.dump() << "\n";
+  json out{{"passes", passes}, {"improvement", r.improvement}};
+  if (r.gyro) out["gyro"] = gyro_comparison_json(*r.gyro);
+  std::cout << out.dump() << "\n";
 }
 
-void print_simulate_text(const analysis::UmbmarkSimResult& r) {
+void print_simulate_text(const analysis::UmbmarkSimResult& r, const std::string& gyro_class) {
   std::cout << "pass  E_max,syst before  after [mm]   c_l        c_r        b [mm]    "
                "sigma [mm]  3xSEM [mm]  2nd pass?\n";
   int i = 1;
@@ -333,6 +356,7 @@ void print_simulate_text(const analysis::UmbmarkSimResult& r) {
     std::cout << std::setprecision(3) << "eps_theta,nonsys (extended UMBmark): " << *e * kDeg
               << " deg\n";
   }
+  if (r.gyro) print_gyro_comparison(*r.gyro, gyro_class);
 }
 
 // run_simulate: `odomctl ... simulate` once its options are parsed; sets exit_code.
@@ -366,7 +390,7 @@ void run_simulate(SimulateOpts o, int& exit_code) {  // a copy: sets o.sim.formu
   if (o.json) {
     print_simulate_json(*r);
   } else {
-    print_simulate_text(*r);
+    print_simulate_text(*r, o.sim.gyro);
   }
   exit_code = kExitOk;
 }
@@ -384,6 +408,8 @@ void add_simulate(CLI::App& parent, int& exit_code) {
   c->add_option("--noise", o->noise, "none | paper (floor roughness, reference error)");
   c->add_flag("--bumps", o->sim.bumps, "add extended-UMBmark runs (ten 10 mm bumps)");
   c->add_option("--seed", o->sim.seed, "random seed (default 1)");
+  c->add_option("--gyro", o->sim.gyro,
+                "none | consumer | industrial: also compare odometry with the gyro fused");
   c->add_option("--store", o->store, "write the final factors to this calibration store");
   c->add_option("--plot", o->plot, "write an SVG of the return errors before and after");
   c->add_option("--csv", o->csv, "write the first pass's runs (the CSV `record` writes)");

@@ -7,8 +7,10 @@
 #include "odo/analysis/seed.hpp"
 #include "odo/analysis/umbmark_tools.hpp"
 #include "odo/hal/field_range.hpp"
+#include "odo/odometry/gyrodometry.hpp"
 #include "odo/sim/floor.hpp"
 #include "odo/sim/robot.hpp"
+#include "odo/sim/sim_gyro.hpp"
 #include "odo/sim/sim_run.hpp"
 
 namespace odo::analysis {
@@ -27,6 +29,9 @@ struct Driver {
   std::uint64_t run_index = 0;  // every run draws its own random sequences
   int done = 0, total = 0;
   const std::function<void(int, int)>& progress;
+  const sim::GyroModel* gyro = nullptr;  // the fused squares' gyro (--gyro); null: plain
+  bool exact_reference = false;          // no reference-sensor error (gyro comparison)
+  std::uint64_t events = 0;              // flagged intervals of the fused squares
 
   // square: one square in direction d with factors f; the return error truth - odometry in the
   // start frame (which is the odometry frame: both start at the origin, heading 0).
@@ -52,10 +57,16 @@ struct Driver {
     sim::UmbmarkFloor floor(fo, seed);
     sim::SimRunOptions ro;
     ro.perturbation = &floor;
+    ro.gyro = gyro;
+    ro.gyro_seed = seed ^ 0x6E0ULL;
     auto run = sim::SimRun::create(truth, *k, sim::square_scenario(*k, so), ro);
     if (!run) return std::move(run).error();
     // One second of standstill after the path: the last readings see the robot stopped.
     (*run)->drive(1.0);
+    if (const Gyrodometry* g = (*run)->loop().fusion()) {
+      const FusionCounters& c = g->counters();
+      events += c.disagreements + c.speed_events + c.accel_events;
+    }
     const Pose2 e = (*run)->error();
     UmbmarkRun r;
     r.direction = d;
@@ -63,7 +74,7 @@ struct Driver {
     r.ex = e.x;
     r.ey = e.y;
     r.etheta = e.theta;
-    if (paper) {
+    if (paper && !exact_reference) {
       // The reference ("sonar calibrator") measures the absolute pose with its own error.
       std::mt19937_64 rng(seed ^ 0x5EC0ADULL);
       std::normal_distribution<double> n01(0.0, 1.0);
@@ -93,6 +104,58 @@ struct Driver {
   }
 };
 
+// mean_position_error: mean |(ex, ey)| over the runs [m].
+double mean_position_error(const std::vector<UmbmarkRun>& runs) {
+  double sum = 0.0;
+  for (const UmbmarkRun& r : runs) sum += std::hypot(r.ex, r.ey);
+  return runs.empty() ? 0.0 : sum / static_cast<double>(runs.size());
+}
+
+// gyro_comparison: the --gyro sets. Each pair of sets starts at the same run index, so plain and
+// fused squares see the same seeds (floor, bumps); the reference is exact throughout.
+Result<UmbmarkGyroComparison> gyro_comparison(Driver& drv, const Factors& uncal, const Factors& cal,
+                                              const sim::GyroModel& model) {
+  const auto n = static_cast<std::uint64_t>(2 * drv.o.runs);
+  const std::uint64_t base = drv.run_index;  // smooth: base, bumps: base + n, calibrated: + 2n
+  drv.exact_reference = true;
+  UmbmarkGyroComparison c;
+  auto pair = [&](const Factors& f, bool bumps, std::uint64_t at,
+                  const sim::GyroModel* g) -> Result<UmbmarkRunSet> {
+    drv.run_index = at;
+    drv.gyro = g;
+    return drv.set(f, bumps);
+  };
+  std::vector<UmbmarkRun> plain, fused;
+  for (const bool bumps : {false, true}) {
+    auto p = pair(uncal, bumps, base + (bumps ? n : 0), nullptr);
+    if (!p) return std::move(p).error();
+    auto f = pair(uncal, bumps, base + (bumps ? n : 0), &model);
+    if (!f) return std::move(f).error();
+    plain.insert(plain.end(), p->runs.begin(), p->runs.end());
+    fused.insert(fused.end(), f->runs.begin(), f->runs.end());
+    if (bumps) c.uncal_plain_bumps = mean_position_error(p->runs);
+  }
+  auto ep = calib::eps_theta_nonsys(plain);
+  if (!ep) return std::move(ep).error();
+  auto ef = calib::eps_theta_nonsys(fused);
+  if (!ef) return std::move(ef).error();
+  c.eps_plain = *ep;
+  c.eps_fused = *ef;
+  auto cal_bumps = pair(cal, true, base + n, &model);
+  if (!cal_bumps) return std::move(cal_bumps).error();
+  c.cal_fused_bumps = mean_position_error(cal_bumps->runs);
+  auto cal_plain = pair(cal, false, base + 2 * n, nullptr);
+  if (!cal_plain) return std::move(cal_plain).error();
+  auto cal_fused = pair(cal, false, base + 2 * n, &model);
+  if (!cal_fused) return std::move(cal_fused).error();
+  c.cal_plain_smooth = mean_position_error(cal_plain->runs);
+  c.cal_fused_smooth = mean_position_error(cal_fused->runs);
+  c.events = drv.events;
+  drv.gyro = nullptr;
+  drv.exact_reference = false;
+  return c;
+}
+
 }  // namespace
 
 std::ostream& operator<<(std::ostream& out, UmbmarkRobot r) {
@@ -120,6 +183,9 @@ Status check_umbmark_sim_options(const UmbmarkSimOptions& o) {
   if (o.runs < 1 || o.runs > 1000) return range_error(integer_range("--runs", o.runs, 1, 1000));
   if (o.passes < 1 || o.passes > 10) return range_error(integer_range("--passes", o.passes, 1, 10));
   if (!(o.side >= 0.5 && o.side <= 20.0)) return range_error({"--side", o.side, 0.5, 20.0, "m"});
+  if (o.gyro != "none" && o.gyro != "consumer" && o.gyro != "industrial")
+    return make_error(Errc::kInvalidArgument,
+                      "--gyro = '" + o.gyro + "' must be none, consumer or industrial");
   return Ok{};
 }
 
@@ -129,7 +195,7 @@ Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
   Driver drv{o, sim::labmate_geometry(kNominalDiameter), 0, 0, 0, progress};
   // Pass 1 drives a "before" set (plus the bump runs) and a verification; later passes reuse
   // the previous verification as their "before" set.
-  drv.total = 2 * o.runs * (1 + (o.bumps ? 1 : 0) + o.passes);
+  drv.total = 2 * o.runs * (1 + (o.bumps ? 1 : 0) + o.passes + (o.gyro != "none" ? 7 : 0));
   UmbmarkSimResult res;
   auto first = drv.set(Factors{1.0, 1.0, kNominalWheelbase}, false);
   if (!first) return std::move(first).error();
@@ -152,6 +218,13 @@ Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
     if (!after) return std::move(after).error();
     res.passes.push_back(UmbmarkSimPass{std::move(before), std::move(r).value(), *after});
     before = std::move(after).value();
+  }
+  if (o.gyro != "none") {
+    const sim::GyroModel m = o.gyro == "industrial" ? sim::industrial_gyro() : sim::consumer_gyro();
+    auto g = gyro_comparison(drv, res.passes.front().before.factors,
+                             res.passes.back().result.composed, m);
+    if (!g) return std::move(g).error();
+    res.gyro = *g;
   }
   const double last = res.passes.back().after.e_max_syst;
   res.improvement = last > 0.0 ? res.passes.front().before.e_max_syst / last : 0.0;

@@ -14,6 +14,18 @@
 
 namespace odo::fw {
 
+namespace {
+
+// gyro_state: the Status frame's gyro_state (protocol/odometry.dbc): 0 no gyro, 1 fusing,
+// 2 learning the bias, 3 gyro fault.
+std::uint8_t gyro_state(const loop::LoopGyroStatus& g) noexcept {
+  if (!g.enabled) return 0;
+  if ((g.fusion_flags & kFusionGyroFault) != 0) return 3;
+  return g.bias_valid ? 1 : 2;
+}
+
+}  // namespace
+
 // ---- CanFrameRing ----
 
 CanFrameRing::CanFrameRing(std::size_t capacity_pow2) {
@@ -216,6 +228,10 @@ void CanBroadcaster::send_status(const loop::LoopSnapshot& s, bool stopping) noe
   m.encoder_flags = static_cast<std::uint8_t>(s.encoder_flags & 0xFFu);
   m.calibration_state = static_cast<std::uint8_t>(s.calibration_state);
   m.stopping = stopping;
+  m.gyro_state = gyro_state(s.gyro);
+  const FusionCounters& c = s.gyro.fusion;
+  m.gyro_events =
+      static_cast<std::uint8_t>((c.disagreements + c.speed_events + c.accel_events) & 7u);
   m.set_pose_ack = ack_;
   m.missed_deadlines = s.stats.missed_deadlines > 0xFFFFFFFFu
                            ? 0xFFFFFFFFu

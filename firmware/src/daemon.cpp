@@ -124,6 +124,26 @@ class StatusPrinter {
   std::thread thread_;
 };
 
+// gyro_json: the gyro and its fusion ([gyro]; README "Gyro").
+nlohmann::json gyro_json(const loop::LoopGyroStatus& g) {
+  nlohmann::json j;
+  j["bumps_detected"] = g.fusion.disagreements;
+  j["speed_events"] = g.fusion.speed_events;
+  j["accel_events"] = g.fusion.accel_events;
+  j["gyro_used_ticks"] = g.fusion.flagged_ticks;
+  j["faults"] = g.fusion.gyro_faults;
+  j["bias"] = g.bias;
+  j["bias_valid"] = g.bias_valid;
+  j["scale"] = g.scale;
+  j["flags"] = g.gyro_flags;
+  j["samples"] = g.gyro.samples;
+  j["stale_events"] = g.gyro.stale_events;
+  j["saturated"] = g.gyro.saturated;
+  j["invalid"] = g.gyro.invalid;
+  j["read_errors"] = g.gyro.read_errors;
+  return j;
+}
+
 // report_json: the --json object at exit.
 nlohmann::json report_json(const loop::LoopSnapshot& s, const loop::LoopStats& st,
                            const sim::TruthSample* truth, const CanLink* can) {
@@ -145,6 +165,7 @@ nlohmann::json report_json(const loop::LoopSnapshot& s, const loop::LoopStats& s
   j["stale_events"] = s.encoder_counters.stale_events;
   j["read_errors"] = s.encoder_counters.read_errors;
   j["calibration_state"] = static_cast<int>(s.calibration_state);
+  if (s.gyro.enabled) j["gyro"] = gyro_json(s.gyro);
   if (can != nullptr) j["can"] = can_json(*can);
   if (truth != nullptr) {
     j["truth"] = {
@@ -257,7 +278,10 @@ int Daemon::configure() {
     selfcal_ = std::move(sc).value();
     encoder = &selfcal_->encoder();
   }
-  auto created = loop::OdometryLoop::create(lc, *calibrated, *encoder, rig_->clock());
+  lc.gyrodometry = rig_->gyrodometry();
+  lc.gyro_scale_estimation = cfg_->gyro.scale_estimation;
+  auto created =
+      loop::OdometryLoop::create(lc, *calibrated, *encoder, rig_->clock(), rig_->gyro());
   if (!created) return fail(cfg_->source + ": " + created.error().message);
   loop_ = std::move(created).value();
   if (sim::TruthRecorder* t = rig_->truth()) loop_->add_observer(t);

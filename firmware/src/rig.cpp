@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "encoder_backends.hpp"
+#include "gyro_backend.hpp"
 #include "odo/drivers/monotonic_clock.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_encoder.hpp"
@@ -43,6 +44,9 @@ struct Rig::Impl {
   std::unique_ptr<EncoderBackend> backend;  // hctl1100 / gpio (encoder_backends.hpp)
   std::string description;
   double scenario_duration = 0.0;
+  std::unique_ptr<GyroWiring> gyro;  // [gyro]; null: none
+  GyroSection gyro_cfg;
+  TimeNs sim_epoch = 0;  // real-time simulation: the robot's time zero of the fixed-epoch backends
 };
 
 Rig::Rig(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -64,6 +68,35 @@ const std::string& Rig::describe() const noexcept {
 }
 double Rig::scenario_duration() const noexcept {
   return impl_->scenario_duration;
+}
+YawRateSource* Rig::gyro() noexcept {
+  return impl_->gyro ? &impl_->gyro->gyro() : nullptr;
+}
+GyrodometryParams Rig::gyrodometry() const {
+  return gyrodometry_params(impl_->gyro_cfg);
+}
+
+// add_gyro: [gyro] on top of the wired encoders: the IIO device, or the simulated gyro on the
+// simulated robot (on its clock: virtual, the EpochEncoder's epoch, or the backends' fixed one).
+Status Rig::add_gyro(const Config& cfg, Impl& impl, bool virtual_time) {
+  impl.gyro_cfg = cfg.gyro;
+  const GyroBackend be = cfg.gyro.backend;
+  if (be == GyroBackend::kNone) return Ok{};
+  if (be == GyroBackend::kSim && impl.robot == nullptr)
+    return make_error(Errc::kInvalidArgument,
+                      cfg.source +
+                          ": gyro.backend = \"sim\" needs a simulated robot (encoder "
+                          "backend sim, or hctl1100/can_encoder with bus = \"sim\")");
+  const TimeNs* epoch = nullptr;
+  if (be == GyroBackend::kSim && !virtual_time) {
+    auto* e = dynamic_cast<sim::EpochEncoder*>(impl.encoder_wrapper.get());
+    epoch = impl.backend ? &impl.sim_epoch : &e->epoch();
+  }
+  auto g = be == GyroBackend::kIio ? make_iio_gyro(cfg) : make_sim_gyro(cfg, *impl.robot, epoch);
+  if (!g) return std::move(g).error();
+  impl.gyro = std::move(g).value();
+  impl.description += ", " + impl.gyro->describe();
+  return Ok{};
 }
 
 namespace {
@@ -114,10 +147,14 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     impl->clock = std::make_unique<drivers::MonotonicClock>();
     impl->encoder = &impl->backend->encoder();
     impl->description = impl->backend->describe() + ", real time (CLOCK_MONOTONIC)";
+    if (auto st = add_gyro(cfg, *impl, virtual_time); !st) return std::move(st).error();
     return Rig(std::move(impl));
   }
   const sim::RobotGeometry g = sim_geometry(cfg.sim, k.params());
   sim::Scenario scenario = make_scenario(cfg.sim, k);
+  // With a gyro the robot first stands still for a second, as a real one does after power-up:
+  // the fusion learns the gyro's bias before the first move (detection is off until then).
+  if (cfg.gyro.backend == GyroBackend::kSim) scenario.insert(scenario.begin(), {1.0, 0.0, 0.0});
   impl->scenario_duration = sim::scenario_duration(scenario);
   auto robot = sim::SimRobot::create(g, std::move(scenario));
   if (!robot) return std::move(robot).error();
@@ -133,6 +170,7 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
   }
   if (hctl_sim || can_sim) {
     const TimeNs epoch = virtual_time ? 0 : impl->clock->now();
+    impl->sim_epoch = epoch;
     auto b = hctl_sim ? make_hctl_sim_backend(cfg, k, *impl->robot, *impl->clock, epoch)
                       : make_can_sim_backend(cfg, k, *impl->robot, epoch);
     if (!b) return std::move(b).error();
@@ -148,6 +186,7 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
     << (hctl_sim || can_sim ? impl->backend->describe() + ", " : std::string())
     << (virtual_time ? "virtual time" : "real time (CLOCK_MONOTONIC)");
   impl->description = d.str();
+  if (auto st = add_gyro(cfg, *impl, virtual_time); !st) return std::move(st).error();
   return Rig(std::move(impl));
 }
 

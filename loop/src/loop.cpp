@@ -10,7 +10,8 @@ namespace odo::loop {
 
 Result<std::unique_ptr<OdometryLoop>> OdometryLoop::create(const LoopConfig& cfg,
                                                            const Kinematics& k,
-                                                           EncoderSource& encoder, Clock& clock) {
+                                                           EncoderSource& encoder, Clock& clock,
+                                                           YawRateSource* gyro) {
   if (!kLoopRateLimit.contains(cfg.rate_hz)) {
     const Limit l = kLoopRateLimit;
     return range_error({"loop.rate_hz", cfg.rate_hz, l.lo, l.hi, "Hz", false});
@@ -20,7 +21,22 @@ Result<std::unique_ptr<OdometryLoop>> OdometryLoop::create(const LoopConfig& cfg
     return make_error(Errc::kInvalidArgument, "error_model." + s.error().message);
   }
   const auto period = static_cast<TimeNs>(std::llround(1e9 / cfg.rate_hz));
-  return std::unique_ptr<OdometryLoop>(new OdometryLoop(period, cfg, k, encoder, clock));
+  std::optional<Gyrodometry> fusion;
+  if (gyro != nullptr) {
+    GyrodometryParams p = cfg.gyrodometry;
+    p.tick = to_seconds(period);
+    // One count on each wheel: the resolution of odometry's heading over any window.
+    p.heading_quantum = (k.metres_per_count_left() + k.metres_per_count_right()) / k.wheelbase();
+    auto f = Gyrodometry::create(p);
+    if (!f) return std::move(f).error();
+    fusion.emplace(std::move(f).value());
+  }
+  std::unique_ptr<OdometryLoop> loop(new OdometryLoop(period, cfg, k, encoder, clock));
+  loop->gyro_ = gyro;
+  loop->fusion_ = std::move(fusion);
+  loop->gyro_scale_estimation_ = cfg.gyro_scale_estimation;
+  if (loop->fusion_) loop->fusion_->set_scale_estimation(loop->scale_estimation_wanted());
+  return loop;
 }
 
 OdometryLoop::OdometryLoop(TimeNs period, const LoopConfig& cfg, const Kinematics& k,
@@ -41,6 +57,8 @@ bool OdometryLoop::add_observer(TickObserver* o) noexcept {
 void OdometryLoop::start() noexcept {
   const EncoderSample s = enc_->read(clock_->now());
   if (resume_offered_) apply_resume(s);
+  // The gyro's samples up to now belong to no interval of the encoders: dropped.
+  if (gyro_ != nullptr) last_gyro_ = gyro_->read(clock_->now());
   prev_left_ = s.left;
   prev_right_ = s.right;
   prev_stamp_ = s.stamp;
@@ -56,6 +74,7 @@ void OdometryLoop::start() noexcept {
   b.pose = odom_.pose();
   b.distance = odom_.distance();
   b.cov = odom_.covariance();
+  fill_gyro_status(b.gyro);
   published_.publish();
   resume_decided_.store(true, std::memory_order_release);
 }
@@ -87,38 +106,80 @@ void OdometryLoop::apply_commands() noexcept {
   const std::size_t n = commands_.drain([this](const Command& c) {
     if (const auto* p = std::get_if<SetPose>(&c)) {
       odom_.reset(p->pose);  // and its covariance: a set pose is exact
+      // The window's increments led to the old pose: a flagged interval must not replace them.
+      if (fusion_) fusion_->reset();
     } else if (const auto* k = std::get_if<SetKinematics>(&c)) {
       odom_.set_kinematics(k->kinematics);
       calibration_ = k->calibration;
+      if (fusion_) fusion_->set_scale_estimation(scale_estimation_wanted());
     }
   });
   commands_applied_.fetch_add(n, std::memory_order_release);
 }
 
 void OdometryLoop::tick() noexcept {
-  clock_->sleep_until(deadline_);
-  const TimeNs woke = clock_->now();
+  const TimeNs woke = wait_for_deadline();
   const TimeNs latency = woke - deadline_;
-
   // Commands take effect before this tick's motion is added; nearly every tick finds none.
   if (!commands_.empty()) apply_commands();
-
   const EncoderSample s = enc_->read(woke);
-  if ((s.flags & kEncoderReadError) == 0) {
-    // Counts are cumulative, so a late tick simply integrates a longer interval: nothing is lost.
-    const std::int64_t dl = wrap_delta(prev_left_, s.left, bits_);
-    const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
-    odom_.advance(dl, dr, to_seconds(s.stamp - prev_stamp_));
-    prev_left_ = s.left;
-    prev_right_ = s.right;
-    prev_stamp_ = s.stamp;
-  }
+  integrate(s);
+  record_wakeup(latency);
+  LoopSnapshot& snap = fill_snapshot(s, woke);
+  for (std::size_t i = 0; i < n_observers_; ++i) observers_[i]->on_tick(snap);
+  const TimeNs done = clock_->now();
+  record_compute(snap, latency, woke, done);
+  heartbeat_.store(stats_.ticks, std::memory_order_relaxed);
+  schedule_next(snap, done);
+  published_.publish();
+}
 
+TimeNs OdometryLoop::wait_for_deadline() noexcept {
+  clock_->sleep_until(deadline_);
+  return clock_->now();
+}
+
+void OdometryLoop::integrate(const EncoderSample& s) noexcept {
+  // After a failed encoder read the gyro is not read either: its samples keep accumulating and
+  // the next read averages them over the same (longer) interval as the next good counts.
+  if ((s.flags & kEncoderReadError) != 0) return;
+  // Counts are cumulative, so a late tick simply integrates a longer interval: nothing is lost.
+  const std::int64_t dl = wrap_delta(prev_left_, s.left, bits_);
+  const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
+  const double dt = to_seconds(s.stamp - prev_stamp_);
+  if (fusion_) {
+    integrate_fused(dl, dr, dt, gyro_->read(s.stamp));
+  } else {
+    odom_.advance(dl, dr, dt);
+  }
+  prev_left_ = s.left;
+  prev_right_ = s.right;
+  prev_stamp_ = s.stamp;
+}
+
+void OdometryLoop::integrate_fused(std::int64_t dl, std::int64_t dr, double dt,
+                                   const GyroSample& g) noexcept {
+  last_gyro_ = g;
+  const Kinematics& k = odom_.kinematics();
+  FusionInput in;
+  in.dt = dt;
+  in.d_left = static_cast<double>(dl) * k.metres_per_count_left();
+  in.d_right = static_cast<double>(dr) * k.metres_per_count_right();
+  in.wheelbase = k.wheelbase();
+  in.gyro = g;
+  const FusedTick f = fusion_->step(in);
+  last_fusion_flags_ = f.flags;
+  odom_.advance_fused(dl, dr, dt, f.dtheta, (f.flags & kFusionGyroUsed) != 0, f.var_heading);
+}
+
+void OdometryLoop::record_wakeup(TimeNs latency) noexcept {
   ++stats_.ticks;
   stats_.wakeup_latency_last = latency;
   stats_.wakeup_latency_sum += latency;
   if (latency > stats_.wakeup_latency_max) stats_.wakeup_latency_max = latency;
+}
 
+LoopSnapshot& OdometryLoop::fill_snapshot(const EncoderSample& s, TimeNs woke) noexcept {
   // Built where the status thread will read it: the back slot of the triple buffer. That slot
   // holds a snapshot two or three ticks old, so every field that changes is written here or by
   // the observers on every tick.
@@ -135,12 +196,28 @@ void OdometryLoop::tick() noexcept {
   snap.calibration_state = calibration_;
   snap.encoder_flags = s.flags;
   snap.encoder_counters = s.counters;
+  fill_gyro_status(snap.gyro);
   // Observers see the statistics up to this tick's wake-up; the fields that change after them
   // are patched in below, so the published snapshot carries the statistics of the whole tick.
   snap.stats = stats_;
-  for (std::size_t i = 0; i < n_observers_; ++i) observers_[i]->on_tick(snap);
+  return snap;
+}
 
-  const TimeNs done = clock_->now();
+void OdometryLoop::fill_gyro_status(LoopGyroStatus& g) const noexcept {
+  if (!fusion_) return;  // stays all zero: the default of every slot
+  g.enabled = true;
+  g.gyro_flags = last_gyro_.flags;
+  g.fusion_flags = last_fusion_flags_;
+  g.rate_z = last_gyro_.rate_z;
+  g.bias = fusion_->bias();
+  g.bias_valid = fusion_->bias_valid();
+  g.scale = fusion_->scale();
+  g.fusion = fusion_->counters();
+  g.gyro = last_gyro_.counters;
+}
+
+void OdometryLoop::record_compute(LoopSnapshot& snap, TimeNs latency, TimeNs woke,
+                                  TimeNs done) noexcept {
   const TimeNs compute = done - woke;
   if (compute > stats_.compute_max) stats_.compute_max = compute;
   wakeup_hist_.record(latency);
@@ -151,9 +228,10 @@ void OdometryLoop::tick() noexcept {
     snap.stats.wakeup_latency = stats_.wakeup_latency;
     snap.stats.compute_time = stats_.compute_time;
   }
-  heartbeat_.store(stats_.ticks, std::memory_order_relaxed);
+  snap.stats.compute_max = stats_.compute_max;
+}
 
-  // Next deadline; after an overrun skip the missed periods instead of bursting to catch up.
+void OdometryLoop::schedule_next(LoopSnapshot& snap, TimeNs done) noexcept {
   deadline_ += period_;
   if (done >= deadline_) {
     const TimeNs behind = done - deadline_;
@@ -161,9 +239,7 @@ void OdometryLoop::tick() noexcept {
     deadline_ += skipped * period_;
     stats_.missed_deadlines += static_cast<std::uint64_t>(skipped);
   }
-  snap.stats.compute_max = stats_.compute_max;
   snap.stats.missed_deadlines = stats_.missed_deadlines;
-  published_.publish();
 }
 
 void OdometryLoop::run(TimeNs duration, const std::atomic<bool>& stop) noexcept {

@@ -57,6 +57,17 @@ void Odometry::update_fused(std::int64_t dn_left, std::int64_t dn_right, double 
             static_cast<double>(dn_right) * k_.metres_per_count_right(), dtheta, dt);
 }
 
+void Odometry::advance_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
+                             bool gyro_heading, double var_heading) noexcept {
+  const double s0 = sin_theta(), c0 = cos_theta();
+  update_fused(dn_left, dn_right, dt, dtheta);
+  if (gyro_heading) {
+    cov_.step_gyro_sc(s0, c0, d_left_, d_right_, dtheta, var_heading);
+  } else {
+    cov_.step_sc(s0, c0, d_left_, d_right_, k_.wheelbase());
+  }
+}
+
 void Odometry::integrate(double d_l, double d_r, double dth, double dt) noexcept {
   d_left_ = d_l;
   d_right_ = d_r;

@@ -116,6 +116,8 @@ void encode_status(std::uint32_t id, const StatusMsg& s, CanFrame& f) noexcept {
   put_raw(f, sig::encoder_flags, s.encoder_flags);
   put_raw(f, sig::calibration_state, s.calibration_state & 0x3u);
   put_raw(f, sig::stopping, s.stopping ? 1 : 0);
+  put_raw(f, sig::gyro_state, s.gyro_state & 0x3u);
+  put_raw(f, sig::gyro_events, s.gyro_events & 0x7u);
   put_raw(f, sig::set_pose_ack, s.set_pose_ack);
   put_count(f, sig::missed_deadlines, s.missed_deadlines);
   put_value(f, sig::uptime, std::floor(s.uptime));
@@ -179,6 +181,8 @@ bool decode_status(const CanFrame& f, StatusMsg& s) noexcept {
   s.encoder_flags = static_cast<std::uint8_t>(get_raw(f, sig::encoder_flags));
   s.calibration_state = static_cast<std::uint8_t>(get_raw(f, sig::calibration_state));
   s.stopping = get_raw(f, sig::stopping) != 0;
+  s.gyro_state = static_cast<std::uint8_t>(get_raw(f, sig::gyro_state));
+  s.gyro_events = static_cast<std::uint8_t>(get_raw(f, sig::gyro_events));
   s.set_pose_ack = static_cast<std::uint8_t>(get_raw(f, sig::set_pose_ack));
   s.missed_deadlines = static_cast<std::uint32_t>(get_raw(f, sig::missed_deadlines));
   s.uptime = get_value(f, sig::uptime);

@@ -10,11 +10,22 @@ SimRun::SimRun(SimRobot robot, const SimRunOptions& o)
 
 Result<std::unique_ptr<SimRun>> SimRun::create(const RobotGeometry& g, const Kinematics& believed,
                                                Scenario scenario, const SimRunOptions& o) {
+  if (o.gyro != nullptr) scenario.insert(scenario.begin(), Segment{o.gyro_lead_in, 0.0, 0.0});
   auto robot = SimRobot::create(g, std::move(scenario));
   if (!robot) return std::move(robot).error();
   std::unique_ptr<SimRun> run(new SimRun(std::move(robot).value(), o));
   if (o.perturbation != nullptr) run->robot_.set_travel_perturbation(o.perturbation);
-  auto loop = loop::OdometryLoop::create(o.loop, believed, run->encoder_, run->clock_);
+  loop::LoopConfig lc = o.loop;
+  if (o.gyro != nullptr) {
+    auto gyro = SimGyro::create(run->robot_, *o.gyro, o.gyro_seed);
+    if (!gyro) return std::move(gyro).error();
+    run->gyro_.emplace(std::move(gyro).value());
+    lc.gyrodometry.noise.rate_noise_density = o.gyro->noise_density;
+    // The model's delay plus half a sample period (its samples are interval means).
+    lc.gyrodometry.gyro_delay = o.gyro->delay + 0.5 / o.gyro->odr;
+  }
+  auto loop = loop::OdometryLoop::create(lc, believed, run->encoder_, run->clock_,
+                                         run->gyro_ ? &*run->gyro_ : nullptr);
   if (!loop) return std::move(loop).error();
   run->loop_ = std::move(loop).value();
   return run;

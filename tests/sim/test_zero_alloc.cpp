@@ -487,5 +487,48 @@ TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
   EXPECT_EQ(snap.encoder_counters.stale_events, 1u);
 }
 
+TEST(ZeroAlloc, GyroFusionTicksWithoutAllocating) {
+  // [gyro] backend = "sim" (consumer model) fused in the loop, both squares at 1 kHz. The wheel
+  // acceleration limit is set below what the squares' ramps need, so every start and stop of a
+  // leg opens a flagged interval and the gyro path (window correction, gyro heading, its
+  // covariance) runs inside the window, not just the comparison; a set-pose resets the fusion.
+  fw::Config cfg = fw::default_config();
+  cfg.loop.rate_hz = 1000.0;
+  cfg.sim.scenario = fw::SimScenario::kSquares;
+  cfg.gyro.backend = fw::GyroBackend::kSim;
+  cfg.gyro.max_wheel_accel = 0.05;
+  auto kin = Kinematics::create(cfg.robot);
+  ASSERT_TRUE(kin.ok());
+  auto rig = fw::Rig::create(cfg, *kin, /*virtual_time=*/true);
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  ASSERT_NE(rig->gyro(), nullptr);
+  loop::LoopConfig lc;
+  lc.rate_hz = cfg.loop.rate_hz;
+  lc.gyrodometry = rig->gyrodometry();
+  lc.calibration = calib::StoreStatus::kOk;  // scale estimation on as well
+  auto made = loop::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock(), rig->gyro());
+  ASSERT_TRUE(made.ok()) << made.error().message;
+  auto loop = std::move(made).value();
+  loop->start();
+  constexpr std::uint64_t kTicks = 120'000;
+  {
+    AllocWindow w;
+    for (std::uint64_t i = 0; i < kTicks; ++i) {
+      loop->tick();
+      if (i == 60'000) ASSERT_TRUE(loop->post(loop::SetPose{Pose2{}}));
+    }
+    w.disarm();
+    EXPECT_EQ(g_allocs.load(), 0u) << "heap allocations during " << kTicks << " gyro ticks";
+    EXPECT_EQ(g_frees.load(), 0u) << "heap deallocations during " << kTicks << " gyro ticks";
+  }
+  const loop::LoopGyroStatus& g = loop->snapshot().gyro;
+  EXPECT_TRUE(g.enabled);
+  EXPECT_TRUE(g.bias_valid);
+  EXPECT_GT(g.gyro.samples, kTicks - 10);  // a 1 kHz gyro read at 1 kHz
+  EXPECT_GT(g.fusion.accel_events, 0u);
+  EXPECT_GT(g.fusion.flagged_ticks, 0u);
+  EXPECT_EQ(loop->commands_applied(), 1u);
+}
+
 }  // namespace
 }  // namespace odo::test

@@ -225,6 +225,16 @@ TEST(CanStatus, RoundTripBitsAndSaturation) {
   EXPECT_EQ(d.set_pose_ack, 200);
   EXPECT_EQ(d.missed_deadlines, 65535u);
   EXPECT_DOUBLE_EQ(d.uptime, 3600.0);
+  // Gyro bits 11-12 (state) and 13-15 (events mod 8) of byte 1: 0x06 | 3 << 3 | 5 << 5 = 0xBE.
+  s.gyro_state = 3;
+  s.gyro_events = 13;  // modulo 8 on the wire: 5
+  encode_status(kId + 4, s, f);
+  EXPECT_EQ(f.data[1], 0xBE);
+  ASSERT_TRUE(decode_status(f, d));
+  EXPECT_EQ(d.gyro_state, 3);
+  EXPECT_EQ(d.gyro_events, 5);
+  EXPECT_EQ(d.calibration_state, 2);
+  EXPECT_TRUE(d.stopping);
   s.uptime = 1e12;
   encode_status(kId + 4, s, f);
   ASSERT_TRUE(decode_status(f, d));

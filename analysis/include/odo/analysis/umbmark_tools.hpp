@@ -56,6 +56,9 @@ struct UmbmarkSimOptions {
   bool bumps = false;  // add N + N extended-UMBmark runs to the first pass
   std::uint64_t seed = 1;
   calib::WheelbaseFormula formula = calib::WheelbaseFormula::kUmbmark629;
+  // --gyro: none | consumer | industrial: also drive the comparison with that simulated gyro
+  // fused by the loop (UmbmarkGyroComparison).
+  std::string gyro = "none";
 };
 
 // The floor and reference of --noise paper (README "UMBmark calibration" shows the resulting
@@ -82,7 +85,20 @@ struct UmbmarkSimPass {
   UmbmarkRunSet after;          // verification with result.composed
 };
 
+// UmbmarkGyroComparison (--gyro): the same squares (same seeds, so the same floor) driven with
+// odometry alone and with the gyro fused, every return error against the exact reference pose.
+// "uncal": the factors the first pass started from; "cal": the last pass's result.
+struct UmbmarkGyroComparison {
+  std::optional<double> eps_plain, eps_fused;  // eps_theta,nonsys, uncalibrated, bumps [rad]
+  double uncal_plain_bumps = 0.0;  // mean |(ex, ey)| on the bump course, uncalibrated, plain [m]
+  double cal_fused_bumps = 0.0;    // ... calibrated and fused [m]
+  double cal_plain_smooth = 0.0;   // mean |(ex, ey)| on the smooth course, calibrated, plain [m]
+  double cal_fused_smooth = 0.0;   // ... calibrated and fused [m]
+  std::uint64_t events = 0;        // flagged intervals started over all fused squares
+};
+
 struct UmbmarkSimResult {
+  std::optional<UmbmarkGyroComparison> gyro;  // with --gyro
   std::vector<UmbmarkSimPass> passes;
   std::vector<calib::UmbmarkRun> bump_runs;  // extended UMBmark runs of pass 1 (--bumps)
   double improvement = 0.0;                  // first before / last after E_max,syst

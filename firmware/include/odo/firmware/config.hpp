@@ -37,6 +37,10 @@ enum class CanEncoderProtocol : std::uint8_t { kOdrive, kGeneric };
 enum class ByteOrder : std::uint8_t { kLittle, kBig };
 enum class StoreBackend : std::uint8_t { kAuto, kFile, kNvmem, kMtd };
 enum class CanBusKind : std::uint8_t { kSim, kSocketCan, kNone };
+enum class GyroBackend : std::uint8_t { kNone, kSim, kIio };
+enum class GyroAxis : std::uint8_t { kX, kY, kZ };
+enum class GyroMode : std::uint8_t { kBuffered, kPolled };
+enum class GyroModelKind : std::uint8_t { kConsumer, kIndustrial };
 
 inline constexpr Choice<EncoderKind> kEncoderKinds[] = {{EncoderKind::kSim, "sim"},
                                                         {EncoderKind::kHctl1100, "hctl1100"},
@@ -63,6 +67,14 @@ inline constexpr Choice<StoreBackend> kStoreBackends[] = {{StoreBackend::kAuto, 
                                                           {StoreBackend::kMtd, "mtd"}};
 inline constexpr Choice<CanBusKind> kCanBusKinds[] = {
     {CanBusKind::kSim, "sim"}, {CanBusKind::kSocketCan, "socketcan"}, {CanBusKind::kNone, "none"}};
+inline constexpr Choice<GyroBackend> kGyroBackends[] = {
+    {GyroBackend::kNone, "none"}, {GyroBackend::kSim, "sim"}, {GyroBackend::kIio, "iio"}};
+inline constexpr Choice<GyroAxis> kGyroAxes[] = {
+    {GyroAxis::kX, "x"}, {GyroAxis::kY, "y"}, {GyroAxis::kZ, "z"}};
+inline constexpr Choice<GyroMode> kGyroModes[] = {{GyroMode::kBuffered, "buffered"},
+                                                  {GyroMode::kPolled, "polled"}};
+inline constexpr Choice<GyroModelKind> kGyroModelKinds[] = {
+    {GyroModelKind::kConsumer, "consumer"}, {GyroModelKind::kIndustrial, "industrial"}};
 
 // kChoiceTables: every choice table, found by its enum type (choices<E>()).
 inline constexpr std::tuple kChoiceTables{
@@ -75,7 +87,11 @@ inline constexpr std::tuple kChoiceTables{
     std::span<const Choice<CanEncoderProtocol>>(kCanEncoderProtocols),
     std::span<const Choice<ByteOrder>>(kByteOrders),
     std::span<const Choice<StoreBackend>>(kStoreBackends),
-    std::span<const Choice<CanBusKind>>(kCanBusKinds)};
+    std::span<const Choice<CanBusKind>>(kCanBusKinds),
+    std::span<const Choice<GyroBackend>>(kGyroBackends),
+    std::span<const Choice<GyroAxis>>(kGyroAxes),
+    std::span<const Choice<GyroMode>>(kGyroModes),
+    std::span<const Choice<GyroModelKind>>(kGyroModelKinds)};
 
 // choices: the table of enum E's choices.
 template <class E>
@@ -269,6 +285,35 @@ inline constexpr SelfCalRange<double> kSelfCalNumbers[] = {
     {"prior_sigma_factor", &SelfCalSection::prior_sigma_factor, 1e-4, 0.5, ""},
     {"prior_sigma_wheelbase", &SelfCalSection::prior_sigma_wheelbase, 1e-4, 1.0, "m"}};
 
+// [gyro]: a yaw-rate gyro and the gyrodometry fusion (README "Gyro"). backend = "iio": a MEMS
+// gyro through Linux IIO; "sim": a simulated gyro on the simulated robot (model's error terms).
+// Numbers default to NaN where "not set" means "the model's value" (see gyro_noise_model).
+struct GyroSection {
+  GyroBackend backend = GyroBackend::kNone;
+  std::string device;            // iio: device name, sysfs directory or /dev/iio:deviceN
+  GyroAxis axis = GyroAxis::kZ;  // iio: the chip axis along the robot's z
+  int sign = 1;                  // +1: that axis points up; -1: chip upside down
+  GyroMode mode = GyroMode::kBuffered;
+  double rate = 0.0;            // iio: sampling frequency to set [Hz]; 0 = leave it
+  std::string trigger;          // iio buffered: trigger to attach; "" = leave it
+  int buffer_length = 256;      // iio buffered: scans in the kernel buffer
+  double stale_timeout = 0.05;  // [s] no sample for this long: the gyro is stale
+  GyroModelKind model = GyroModelKind::kConsumer;  // sim: parameter set
+  std::int64_t seed = 1;                           // sim: noise seed
+  double noise_density = kNotSet;     // [rad/s/sqrt(Hz)] fusion noise model (sim: the model's)
+  double bias_instability = kNotSet;  // [rad/s]
+  double scale_tolerance = kNotSet;   // residual scale-factor error (fraction)
+  double delay = kNotSet;             // [s] the gyro's delay behind the encoders
+  double window = 0.1;                // [s] comparison window
+  double k_sigma = 5.0;
+  double max_wheel_speed = 2.0;   // [m/s]
+  double max_wheel_accel = 10.0;  // [m/s^2]
+  double still_time = 0.5;        // [s]
+  double bias_tau = 60.0;         // [s]
+  bool scale_estimation = true;   // estimate the scale factor on turns once calibrated
+  static constexpr double kNotSet = -1.0;
+};
+
 struct Config {
   std::string source = "<built-in>";  // file the config came from
   LoopSection loop;
@@ -287,6 +332,7 @@ struct Config {
   std::shared_ptr<const ros2::Config> ros2;
   ResumeSection resume;
   SelfCalSection selfcal;
+  GyroSection gyro;
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.

@@ -9,6 +9,7 @@
 #include "odo/firmware/config.hpp"
 #include "odo/hal/clock.hpp"
 #include "odo/hal/encoder.hpp"
+#include "odo/hal/gyro.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/kinematics.hpp"
@@ -34,6 +35,10 @@ class Rig {
   // truth: the simulated robot's ground truth beside each tick, to register on the loop
   // (simulation only; null otherwise).
   sim::TruthRecorder* truth() noexcept;
+  // gyro: the yaw-rate source of [gyro], null when backend = "none".
+  YawRateSource* gyro() noexcept;
+  // gyrodometry: the fusion parameters of [gyro] (tick and heading quantum set by the loop).
+  GyrodometryParams gyrodometry() const;
   // describe: one line saying what is wired, for the start-up report.
   const std::string& describe() const noexcept;
   // scenario_duration: length of the simulated motion [s], 0 when not simulated.
@@ -42,6 +47,8 @@ class Rig {
  private:
   struct Impl;
   explicit Rig(std::unique_ptr<Impl> impl);
+  // add_gyro: wires [gyro] on top of the encoders (rig.cpp).
+  static Status add_gyro(const Config& cfg, Impl& impl, bool virtual_time);
   std::unique_ptr<Impl> impl_;
 };
 

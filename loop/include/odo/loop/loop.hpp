@@ -1,6 +1,8 @@
 // OdometryLoop: the fixed-rate loop. One tick: sleep to an absolute deadline, apply the commands
-// posted since the last tick, read the encoders, take wrap-aware deltas, integrate the pose and
-// its covariance, update timing statistics, hand the snapshot to the (read-only) observers.
+// posted since the last tick, read the encoders (and the yaw-rate gyro, when there is one), take
+// wrap-aware deltas, fuse the gyro's heading over the intervals where it and odometry disagree
+// (gyrodometry), integrate the pose and its covariance, update timing statistics, hand the
+// snapshot to the (read-only) observers.
 // The same code runs against real drivers and against sim_hal; only the wiring differs.
 #pragma once
 
@@ -8,16 +10,19 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "odo/calibration/store.hpp"
 #include "odo/hal/clock.hpp"
 #include "odo/hal/encoder.hpp"
+#include "odo/hal/gyro.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/loop/command.hpp"
 #include "odo/loop/latency_histogram.hpp"
 #include "odo/loop/state_record.hpp"
 #include "odo/loop/triple_buffer.hpp"
 #include "odo/odometry/error_model.hpp"
+#include "odo/odometry/gyrodometry.hpp"
 #include "odo/odometry/kinematics.hpp"
 #include "odo/odometry/pose.hpp"
 
@@ -37,6 +42,19 @@ struct LoopStats {
   TimingSummary compute_time;
 };
 
+// The gyro and its fusion as of one tick (all zero when the loop runs without a gyro).
+struct LoopGyroStatus {
+  bool enabled = false;            // a yaw-rate source is wired
+  std::uint32_t gyro_flags = 0;    // GyroFlag bits of the last sample
+  std::uint32_t fusion_flags = 0;  // FusionFlag bits of the last tick
+  double rate_z = 0.0;             // last sample's mean rate [rad/s]
+  double bias = 0.0;               // the fusion's bias estimate [rad/s]
+  bool bias_valid = false;         // learnt at standstill (detection is on)
+  double scale = 1.0;              // the fusion's scale-factor estimate
+  FusionCounters fusion;           // bumps/slips detected, gyro-heading ticks, faults
+  GyroCounters gyro;               // the source's own counters
+};
+
 // What one tick produced; observers and the status thread see this.
 struct LoopSnapshot {
   std::uint64_t tick = 0;
@@ -54,6 +72,7 @@ struct LoopSnapshot {
   bool has_cov = false;
   // The calibration store's status of the kinematics in use (kUncalibrated: nominal values).
   calib::StoreStatus calibration_state = calib::StoreStatus::kUncalibrated;
+  LoopGyroStatus gyro;
 };
 
 // TickObserver: called on the loop thread after every tick with that tick's snapshot; reads it,
@@ -74,6 +93,11 @@ struct LoopConfig {
   ErrorModelParams error_model;  // Chong-Kleeman k_L, k_R for the pose covariance
   // The store's status of the kinematics the loop starts with (snapshot calibration_state).
   calib::StoreStatus calibration = calib::StoreStatus::kUncalibrated;
+  // Gyrodometry, used when create() is given a yaw-rate source; its tick and heading_quantum
+  // are set by create() from the loop rate and the kinematics.
+  GyrodometryParams gyrodometry;
+  // Estimate the gyro's scale factor from turns while the kinematics are calibrated.
+  bool gyro_scale_estimation = true;
 };
 
 class OdometryLoop {
@@ -81,10 +105,12 @@ class OdometryLoop {
   static constexpr std::size_t kMaxObservers = 8;
   static constexpr std::uint64_t kSummaryTicks = 256;  // power of two
 
-  // create: validates the rate and the encoder's counter width (heap-allocated once, at
-  // configure time: the loop holds atomics and is neither copied nor moved).
+  // create: validates the rate, the encoder's counter width and, with a gyro, the fusion's
+  // parameters (heap-allocated once, at configure time: the loop holds atomics and is neither
+  // copied nor moved). gyro: optional yaw-rate source, read every tick; null: odometry alone.
   static Result<std::unique_ptr<OdometryLoop>> create(const LoopConfig& cfg, const Kinematics& k,
-                                                      EncoderSource& encoder, Clock& clock);
+                                                      EncoderSource& encoder, Clock& clock,
+                                                      YawRateSource* gyro = nullptr);
 
   // add_observer: registers a per-tick observer (configure time only); false when full.
   bool add_observer(TickObserver* o) noexcept;
@@ -121,6 +147,8 @@ class OdometryLoop {
   }
 
   const Odometry& odometry() const noexcept { return odom_; }
+  // fusion: the gyrodometry fusion, null without a gyro (loop thread, or after run()).
+  const Gyrodometry* fusion() const noexcept { return fusion_ ? &*fusion_ : nullptr; }
   const LoopStats& stats() const noexcept { return stats_; }
   // Full histograms (loop thread, or after run() returned).
   const LatencyHistogram& wakeup_histogram() const noexcept { return wakeup_hist_; }
@@ -137,12 +165,39 @@ class OdometryLoop {
   OdometryLoop(TimeNs period, const LoopConfig& cfg, const Kinematics& k, EncoderSource& enc,
                Clock& clock);
 
+  // The steps of tick(), in order.
+  // wait_for_deadline: sleeps to the deadline; the wake-up time [ns].
+  TimeNs wait_for_deadline() noexcept;
+  // integrate: the encoder sample's motion since the previous good one (and the gyro's, fused).
+  void integrate(const EncoderSample& s) noexcept;
+  // integrate_fused: one interval of count deltas dl, dr over dt [s] with the gyro's reading.
+  void integrate_fused(std::int64_t dl, std::int64_t dr, double dt, const GyroSample& g) noexcept;
+  // record_wakeup: the wake-up latency [ns] into the statistics.
+  void record_wakeup(TimeNs latency) noexcept;
+  // fill_snapshot: this tick's snapshot in the back slot (every field that changes).
+  LoopSnapshot& fill_snapshot(const EncoderSample& s, TimeNs woke) noexcept;
+  // fill_gyro_status: the gyro and fusion part of the snapshot.
+  void fill_gyro_status(LoopGyroStatus& g) const noexcept;
+  // record_compute: the tick's compute time from `woke` to `done` [ns] into the statistics.
+  void record_compute(LoopSnapshot& snap, TimeNs latency, TimeNs woke, TimeNs done) noexcept;
+  // schedule_next: the next deadline; after an overrun the missed periods are skipped.
+  void schedule_next(LoopSnapshot& snap, TimeNs done) noexcept;
+  // scale_estimation_wanted: whether the fusion should estimate the gyro's scale now.
+  bool scale_estimation_wanted() const noexcept {
+    return gyro_scale_estimation_ && calibration_ == calib::StoreStatus::kOk;
+  }
+
   TimeNs period_;
   Odometry odom_;
   calib::StoreStatus calibration_;
   EncoderSource* enc_;
   Clock* clock_;
   int bits_;
+  YawRateSource* gyro_ = nullptr;
+  std::optional<Gyrodometry> fusion_;  // engaged when gyro_ is set
+  bool gyro_scale_estimation_ = true;
+  GyroSample last_gyro_;  // the gyro's last reading (for the snapshot)
+  std::uint32_t last_fusion_flags_ = 0;
   std::array<TickObserver*, kMaxObservers> observers_{};
   std::size_t n_observers_ = 0;
 

@@ -86,6 +86,10 @@ class PoseCovariance {
                double b) noexcept {
     propagate_arc(cov_, sin_theta0, cos_theta0, d_left, d_right, b, k_);
   }
+  // step_gyro_sc: a tick whose heading change dtheta [rad] came from the gyro, with heading
+  // variance var_heading [rad^2] (gyrodometry.hpp propagate_gyro_arc; defined there).
+  void step_gyro_sc(double sin_theta0, double cos_theta0, double d_left, double d_right,
+                    double dtheta, double var_heading) noexcept;
   void set_params(const ErrorModelParams& k) noexcept { k_ = k; }
   const ErrorModelParams& params() const noexcept { return k_; }
   const Cov3& cov() const noexcept { return cov_; }

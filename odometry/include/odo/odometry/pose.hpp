@@ -148,6 +148,11 @@ class Odometry {
   // (d_R - d_L) / b (the gyrodometry fusion's FusedTick::dtheta); bit-identical to update()
   // when dtheta is odometry's own increment.
   void update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta) noexcept;
+  // advance_fused: update_fused() and the covariance step of the same tick: the wheels' arc
+  // when gyro_heading is false (dtheta is then odometry's own), otherwise the gyro's heading
+  // noise var_heading [rad^2] instead of the wheels' differential noise (propagate_gyro_arc).
+  void advance_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
+                     bool gyro_heading, double var_heading) noexcept;
   // set_kinematics: swap in new calibration (e.g. after SIGHUP); the pose is kept.
   void set_kinematics(const Kinematics& k) noexcept { k_ = k; }
 

@@ -73,6 +73,8 @@ struct StatusMsg {
   std::uint8_t encoder_flags = 0;      // EncoderFlag bits 0..7
   std::uint8_t calibration_state = 0;  // 0 nominal, 1 calibrated, 2 corrupt store
   bool stopping = false;               // clean stop: the last status of this run
+  std::uint8_t gyro_state = 0;         // 0 no gyro, 1 fusing, 2 learning the bias, 3 gyro fault
+  std::uint8_t gyro_events = 0;        // bump/slip intervals detected, modulo 8
   std::uint8_t set_pose_ack = 0;       // set-pose commands applied, modulo 256
   std::uint32_t missed_deadlines = 0;  // saturates at 65535 on the wire
   double uptime = 0.0;                 // [s] loop time, 1 s resolution, saturates at 2^24-1

@@ -50,6 +50,8 @@ inline constexpr Signal rho_xy{"rho_xy", 48, 8, kRhoScale, true, -100, 100, ""};
 inline constexpr Signal encoder_flags{"encoder_flags", 0, 8, 1.0, false, 0, 255, ""};
 inline constexpr Signal calibration_state{"calibration_state", 8, 2, 1.0, false, 0, 2, ""};
 inline constexpr Signal stopping{"stopping", 10, 1, 1.0, false, 0, 1, ""};
+inline constexpr Signal gyro_state{"gyro_state", 11, 2, 1.0, false, 0, 3, ""};
+inline constexpr Signal gyro_events{"gyro_events", 13, 3, 1.0, false, 0, 7, ""};
 inline constexpr Signal set_pose_ack{"set_pose_ack", 16, 8, 1.0, false, 0, 255, ""};
 inline constexpr Signal missed_deadlines{"missed_deadlines", 24, 16, 1.0, false, 0, 65535, ""};
 inline constexpr Signal uptime{"uptime", 40, 24, 1.0, false, 0, 0xFFFFFF, "s"};
@@ -76,8 +78,9 @@ inline constexpr const Signal* kPoseX[] = {&x, &seq};
 inline constexpr const Signal* kPoseYTheta[] = {&y, &theta, &seq};
 inline constexpr const Signal* kVelocity[] = {&v, &w, &seq};
 inline constexpr const Signal* kUncertainty[] = {&sigma_x, &sigma_y, &sigma_theta, &rho_xy, &seq};
-inline constexpr const Signal* kStatus[] = {&encoder_flags, &calibration_state, &stopping,
-                                            &set_pose_ack,  &missed_deadlines,  &uptime};
+inline constexpr const Signal* kStatus[] = {
+    &encoder_flags, &calibration_state, &stopping,         &gyro_state,
+    &gyro_events,   &set_pose_ack,      &missed_deadlines, &uptime};
 inline constexpr const Signal* kTiming[] = {&wakeup_p99, &wakeup_max, &compute_max, &tx_dropped};
 inline constexpr const Signal* kSetPose[] = {&set_x, &set_y, &set_theta};
 inline constexpr const Signal* kFixPose[] = {&fix_x, &fix_y, &fix_seq};

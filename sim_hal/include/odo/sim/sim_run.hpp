@@ -5,12 +5,14 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "odo/hal/result.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/kinematics.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_encoder.hpp"
+#include "odo/sim/sim_gyro.hpp"
 #include "odo/sim/virtual_clock.hpp"
 
 namespace odo::sim {
@@ -20,6 +22,12 @@ struct SimRunOptions {
   std::int64_t counter_offset = 0;             // counter value at zero counts (start near the wrap)
   loop::LoopConfig loop;                       // rate, error model, calibration status
   TravelPerturbation* perturbation = nullptr;  // floor or wheel noise on the true travel
+  // gyro: a simulated gyro of this model fused by the loop (loop.gyrodometry, its noise model
+  // taken from the model); the robot first stands still for gyro_lead_in [s] so that the
+  // fusion learns the gyro's bias before it moves. Null: odometry alone.
+  const GyroModel* gyro = nullptr;
+  std::uint64_t gyro_seed = 1;
+  double gyro_lead_in = 1.0;
 };
 
 class SimRun {
@@ -38,6 +46,8 @@ class SimRun {
   SimRobot& robot() noexcept { return robot_; }
   SimEncoderSource& encoder() noexcept { return encoder_; }
   VirtualClock& clock() noexcept { return clock_; }
+  // gyro: the simulated gyro (fault injection), null without SimRunOptions::gyro.
+  SimGyro* gyro() noexcept { return gyro_ ? &*gyro_ : nullptr; }
   loop::OdometryLoop& loop() noexcept { return *loop_; }
 
  private:
@@ -45,6 +55,7 @@ class SimRun {
   VirtualClock clock_;
   SimRobot robot_;
   SimEncoderSource encoder_;
+  std::optional<SimGyro> gyro_;
   std::unique_ptr<loop::OdometryLoop> loop_;
 };
 

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "odo/hal/gyro.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/loop/triple_buffer.hpp"
 #include "odo/odometry/pose.hpp"
@@ -49,6 +50,27 @@ class EpochEncoder final : public EncoderSource {
   EncoderSource& inner_;
   TimeNs epoch_ = 0;
   bool started_ = false;
+
+ public:
+  // epoch: the real time of the robot's time zero [ns] (0 until the first read).
+  const TimeNs& epoch() const noexcept { return epoch_; }
+};
+
+// EpochGyro: a simulated gyro on the same real clock, with the robot's time zero at *epoch
+// (an EpochEncoder's epoch, or a backend's fixed one); stamps are returned in real time.
+class EpochGyro final : public YawRateSource {
+ public:
+  EpochGyro(YawRateSource& inner, const TimeNs& epoch) : inner_(inner), epoch_(epoch) {}
+  GyroSample read(TimeNs now) noexcept override {
+    GyroSample s = inner_.read(now - epoch_);
+    s.stamp += epoch_;
+    return s;
+  }
+  double full_scale() const noexcept override { return inner_.full_scale(); }
+
+ private:
+  YawRateSource& inner_;
+  const TimeNs& epoch_;
 };
 
 }  // namespace odo::sim

@@ -1,0 +1,139 @@
+// The gyrodometry fusion inside the firmware's loop (issue 16): the simulated robot, its
+// encoders and a simulated consumer gyro through sim::SimRun, the loop fusing every tick.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "odo/sim/floor.hpp"
+#include "odo/sim/sim_run.hpp"
+
+namespace odo::sim {
+namespace {
+
+// Straight 20 s at 0.2 m/s on a robot that is exactly what odometry believes, at 200 Hz.
+struct Leg {
+  RobotGeometry geo;  // 0.15 m wheels, 2048 x 16 counts, b = 0.34 m
+  Kinematics k = Kinematics::create(nominal_params(0.15, geo.wheelbase, geo)).value();
+  GyroModel model = consumer_gyro();
+  Scenario scenario() const {
+    const double w = 0.2 / 0.075;
+    return Scenario{{20.0, w, w}, {1.0, 0.0, 0.0}};
+  }
+  std::unique_ptr<SimRun> run(TravelPerturbation* floor, bool gyro) {
+    SimRunOptions o;
+    o.loop.rate_hz = 200.0;
+    o.perturbation = floor;
+    o.gyro = gyro ? &model : nullptr;
+    o.gyro_seed = 3;
+    // Both runs stand still first, so the gyro's lead-in does not shift the floor's bumps.
+    Scenario s = scenario();
+    if (!gyro) s.insert(s.begin(), Segment{o.gyro_lead_in, 0.0, 0.0});
+    return SimRun::create(geo, k, s, o).value();
+  }
+};
+
+UmbmarkFloor::Options bumps(int n) {
+  UmbmarkFloor::Options fo;
+  fo.bumps = n;
+  fo.bump_loss = bump_travel_loss(0.075, 0.010);  // 10 mm bumps: 3.514 mm of travel each
+  return fo;
+}
+
+TEST(LoopGyro, BumpsOnALegAreRejectedInTheLoop) {
+  // Ten 10 mm bumps under the left wheel turn odometry's heading by 10 * 3.514e-3 / 0.34 =
+  // 0.1034 rad (sim_gyro's SimGyrodometry test derives it); the loop with the gyro fused must be
+  // 10x better and count the ten bumps.
+  Leg leg;
+  UmbmarkFloor f1(bumps(10), 1), f2(bumps(10), 1);
+  auto plain = leg.run(&f1, false);
+  auto fused = leg.run(&f2, true);
+  plain->drive(0.0);
+  fused->drive(0.0);
+  const double e_plain = std::fabs(plain->error().theta);
+  const double e_fused = std::fabs(fused->error().theta);
+  EXPECT_NEAR(e_plain, 0.1034, 1e-3);
+  EXPECT_LT(e_fused, e_plain / 10.0);
+  const Gyrodometry* g = fused->loop().fusion();
+  ASSERT_NE(g, nullptr);
+  EXPECT_GE(g->counters().disagreements, 10u);
+  EXPECT_LE(g->counters().disagreements, 12u);
+  const loop::LoopGyroStatus& st = fused->loop().snapshot().gyro;
+  EXPECT_TRUE(st.enabled);
+  EXPECT_TRUE(st.bias_valid);
+  EXPECT_EQ(st.fusion.disagreements, g->counters().disagreements);
+  EXPECT_GT(st.fusion.flagged_ticks, 0u);
+  // The heading's variance grew over the flagged intervals from the gyro's noise: positive and
+  // finite (not the wheels' alone: set-pose below makes it zero again).
+  EXPECT_GT(fused->loop().odometry().covariance()[8], 0.0);
+  std::printf("loop, 10 bumps: odometry %.3e rad, fused %.3e rad, %llu events\n", e_plain, e_fused,
+              static_cast<unsigned long long>(g->counters().disagreements));
+}
+
+TEST(LoopGyro, SmoothLegIsOdometryBitForBit) {
+  // No bumps, no limits reached on a straight leg after the lead-in: nothing is flagged and the
+  // loop's pose is exactly odometry's.
+  Leg leg;
+  auto plain = leg.run(nullptr, false);
+  auto fused = leg.run(nullptr, true);
+  plain->drive(0.0);
+  fused->drive(0.0);
+  EXPECT_EQ(fused->loop().fusion()->counters().flagged_ticks, 0u);
+  EXPECT_EQ(fused->loop().odometry().pose().x, plain->loop().odometry().pose().x);
+  EXPECT_EQ(fused->loop().odometry().pose().y, plain->loop().odometry().pose().y);
+  EXPECT_EQ(fused->loop().odometry().pose().theta, plain->loop().odometry().pose().theta);
+  EXPECT_EQ(fused->loop().odometry().covariance(), plain->loop().odometry().covariance());
+}
+
+TEST(LoopGyro, FaultyGyroFallsBackToOdometry) {
+  // Fault-matrix rows: the gyro goes silent (stale), saturates, returns NaN, each during a bump
+  // run on smooth floor; the fusion flags the fault and the pose stays odometry's exactly.
+  for (int fault = 0; fault < 3; ++fault) {
+    Leg leg;
+    auto plain = leg.run(nullptr, false);
+    auto fused = leg.run(nullptr, true);
+    plain->drive(0.0);
+    SimGyro* g = fused->gyro();
+    ASSERT_NE(g, nullptr);
+    loop::OdometryLoop& lp = fused->loop();
+    lp.start();
+    for (int i = 0; i < 4200; ++i) {  // 21 s at 200 Hz
+      if (i == 1000) {
+        if (fault == 0) g->arm_silence(500'000'000);
+        if (fault == 1) g->arm_saturation(50);
+        if (fault == 2) g->arm_nan(20);
+      }
+      lp.tick();
+    }
+    const Gyrodometry* f = lp.fusion();
+    EXPECT_GE(f->counters().gyro_faults, 1u) << fault;
+    EXPECT_EQ(lp.snapshot().gyro.fusion.gyro_faults, f->counters().gyro_faults) << fault;
+    EXPECT_TRUE(std::isfinite(lp.odometry().pose().theta)) << fault;
+    EXPECT_NEAR(lp.odometry().pose().theta, plain->loop().odometry().pose().theta, 1e-12) << fault;
+    EXPECT_NEAR(lp.odometry().pose().x, plain->loop().odometry().pose().x, 1e-9) << fault;
+  }
+}
+
+TEST(LoopGyro, SetPoseMidLegKeepsTheFusionRight) {
+  // A set-pose (to zero) halfway along the bump leg: the fusion's window is reset with the pose,
+  // and the heading from there on is the true turn since the reset to within a tenth of what
+  // the bumps after it do to odometry alone (about half of 0.1034 rad).
+  Leg leg;
+  UmbmarkFloor f(bumps(10), 1);
+  auto fused = leg.run(&f, true);
+  loop::OdometryLoop& lp = fused->loop();
+  lp.start();
+  double truth_at_reset = 0.0;
+  for (int i = 0; i < 4400; ++i) {
+    if (i == 2200) {
+      ASSERT_TRUE(lp.post(loop::SetPose{Pose2{}}));
+      truth_at_reset = fused->robot().true_pose().theta;
+    }
+    lp.tick();
+  }
+  EXPECT_EQ(lp.commands_applied(), 1u);
+  const double turned = fused->robot().true_pose().theta - truth_at_reset;
+  EXPECT_LT(std::fabs(lp.odometry().pose().theta - turned), 0.1034 / 2.0 / 10.0);
+}
+
+}  // namespace
+}  // namespace odo::sim
