@@ -258,7 +258,7 @@ void run_simulate(const SimulateOpts& o, int& exit_code) {
   const double before = analysis::selfcal_e_max_syst({1.0, 1.0, analysis::kSelfCalBn}, !o.smooth);
   const double after = analysis::selfcal_e_max_syst(fin, !o.smooth);
   analysis::UmbmarkSimOptions uo;
-  uo.noise = o.smooth ? "none" : "paper";
+  uo.noise = o.smooth ? analysis::UmbmarkNoise::kNone : analysis::UmbmarkNoise::kPaper;
   uo.seed = o.seed;
   auto manual = analysis::run_umbmark_simulation(uo);
   const double e_manual =

@@ -302,7 +302,7 @@ bool record_options_ok(const RecordOpts& o) {
   if (!(o.wheelbase > 0.0 && o.wheelbase <= 20.0)) {
     m = range_message({"--wheelbase", o.wheelbase, 0.0, 20.0, "m"});
   } else if (o.runs < 1 || o.runs > 1000) {
-    m = range_message({"--runs", static_cast<double>(o.runs), 1, 1000, "", false, true});
+    m = range_message(integer_range("--runs", o.runs, 1, 1000));
   } else if (!protocol::valid_addressing(o.base_id, o.node)) {
     m = "--base-id / --node: not a valid node block (base id a multiple of 16, node 0..63)";
   }

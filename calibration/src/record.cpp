@@ -1,6 +1,5 @@
 #include "odo/calibration/record.hpp"
 
-
 #include <ctime>
 
 #include <bit>

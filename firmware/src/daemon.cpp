@@ -20,8 +20,8 @@
 #include "odo/firmware/config.hpp"
 #include "odo/firmware/realtime_setup.hpp"
 #include "odo/firmware/rig.hpp"
-#include "odo/firmware/state_persist.hpp"
 #include "odo/firmware/selfcal_estimator.hpp"
+#include "odo/firmware/state_persist.hpp"
 #include "odo/firmware/timing_report.hpp"
 #include "odo/firmware/watchdog.hpp"
 #include "odo/loop/loop.hpp"
@@ -280,8 +280,7 @@ int Daemon::configure() {
   }
   lc.gyrodometry = rig_->gyrodometry();
   lc.gyro_scale_estimation = cfg_->gyro.scale_estimation;
-  auto created =
-      loop::OdometryLoop::create(lc, *calibrated, *encoder, rig_->clock(), rig_->gyro());
+  auto created = loop::OdometryLoop::create(lc, *calibrated, *encoder, rig_->clock(), rig_->gyro());
   if (!created) return fail(cfg_->source + ": " + created.error().message);
   loop_ = std::move(created).value();
   if (sim::TruthRecorder* t = rig_->truth()) loop_->add_observer(t);
@@ -391,7 +390,8 @@ void Daemon::report() {
     j["resume"] = {
         {"resumed", why == loop::ResumeReason::kResumed},
         {"reason", std::string(loop::resume_reason_name(why))},
-        {"gap", why == loop::ResumeReason::kResumed ? to_seconds(loop_->resume_decision().gap) : 0.0}};
+        {"gap",
+         why == loop::ResumeReason::kResumed ? to_seconds(loop_->resume_decision().gap) : 0.0}};
   }
   if (selfcal_) j["selfcal"] = selfcal_json(selfcal_->estimator().counters());
   out_ << j.dump() << std::endl;

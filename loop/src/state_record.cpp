@@ -5,8 +5,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "odo/hal/bytes.hpp"
 #include "odo/calibration/record.hpp"
+#include "odo/hal/bytes.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
 

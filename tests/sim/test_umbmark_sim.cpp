@@ -167,13 +167,18 @@ TEST(UmbmarkSvg, PlotHasEveryRunAndCentreOfGravity) {
   o.passes = 2;
   const auto r = simulate(o);
   const std::string svg = analysis::umbmark_svg(r, "t & t");
-  std::size_t circles = 0, crosses = 0;
-  for (std::size_t p = svg.find("<circle"); p != std::string::npos; p = svg.find("<circle", p + 1))
-    ++circles;
-  for (std::size_t p = svg.find("<path"); p != std::string::npos; p = svg.find("<path", p + 1))
-    ++crosses;
-  EXPECT_EQ(circles, 3U * 4U);  // before + 2 verification sets, 2 + 2 runs each
-  EXPECT_EQ(crosses, 3U * 2U);  // a cw and a ccw c.g. per set
+  const auto count = [&svg](const std::string& what) {
+    std::size_t n = 0;
+    for (std::size_t p = svg.find(what); p != std::string::npos; p = svg.find(what, p + 1)) ++n;
+    return n;
+  };
+  // One marker per run, each with its set as tooltip (each pass has its own marker shape, so
+  // the runs are counted by their tooltips): before + 2 verification sets, 2 + 2 runs each.
+  EXPECT_EQ(count("<title>"), 3U * 4U);
+  EXPECT_EQ(count("<title>before</title>"), 4U);
+  EXPECT_EQ(count("<title>after pass 1</title>"), 4U);
+  EXPECT_EQ(count("<title>after pass 2</title>"), 4U);
+  EXPECT_EQ(count("<path"), 3U * 2U);  // a cw and a ccw c.g. cross per set
   EXPECT_NE(svg.find("t &amp; t"), std::string::npos);
 }
 

@@ -363,8 +363,10 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
       }
     }
     (*can)->send_final(loop->snapshot());  // the clean-stop frames: no allocation either
-    (*persister)->stop();                  // joins the writer after its last write
     w.disarm();
+    // Joins the state writer after its last write: shutdown, off the loop path (the exiting
+    // thread frees its own start-up state, as the log writer's does in close_log below).
+    (*persister)->stop();
     (*can)->close_log();  // joins the writer thread and closes the file: frees, off the loop path
     EXPECT_EQ(g_allocs.load(), 0u) << "heap allocations during " << kTicks << " ticks";
     EXPECT_EQ(g_frees.load(), 0u) << "heap deallocations during " << kTicks << " ticks";

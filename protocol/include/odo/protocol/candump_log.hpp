@@ -10,6 +10,7 @@
 #include "odo/hal/can_bus.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/protocol/can_protocol.hpp"
+#include "odo/protocol/signals.hpp"
 
 namespace odo::protocol {
 
@@ -43,7 +44,7 @@ struct DecodedFrame {
   int node = -1;
   Msg msg{};
   const char* message = "";  // PoseX, PoseYTheta, Velocity, Uncertainty, Status, Timing, SetPose
-  std::array<DecodedField, 6> fields{};
+  std::array<DecodedField, kMaxMessageSignals> fields{};
   std::size_t n_fields = 0;
 };
 

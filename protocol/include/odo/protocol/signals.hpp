@@ -108,6 +108,14 @@ inline constexpr MessageSpec kMessages[] = {
     {Msg::kFixSigma, "FixSigma", true, sig::kFixSigma},
 };
 
+// kMaxMessageSignals: the most signals any message has: the size of a decoded frame's fields,
+// derived from the table so that a message that gains a signal cannot overflow it.
+inline constexpr std::size_t kMaxMessageSignals = [] {
+  std::size_t n = 0;
+  for (const MessageSpec& m : kMessages) n = m.signals.size() > n ? m.signals.size() : n;
+  return n;
+}();
+
 // message_spec: the table entry of message m (every Msg has one).
 const MessageSpec& message_spec(Msg m) noexcept;
 
