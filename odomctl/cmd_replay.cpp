@@ -12,9 +12,7 @@ namespace {
 
 struct ReplayOpts {
   std::string ticks;
-  double wheel_diameter = 0, counts_per_rev = 0, gear_ratio = 1, wheelbase = 0;
-  double cl = 1, cr = 1;
-  int bits = 64;
+  KinematicsOpts kin;
   bool json = false;
   bool no_gyro = false;  // ignore a gyro_z column
 };
@@ -29,14 +27,7 @@ nlohmann::json gyro_json(const FusionCounters& c) {
 
 // run_replay: `odomctl ... replay` once its options are parsed; sets exit_code.
 void run_replay(const ReplayOpts& o, int& exit_code) {
-  KinematicParams p;
-  p.wheel_diameter = o.wheel_diameter;
-  p.counts_per_rev = o.counts_per_rev;
-  p.gear_ratio = o.gear_ratio;
-  p.wheelbase_nominal = p.wheelbase = o.wheelbase;
-  p.c_l = o.cl;
-  p.c_r = o.cr;
-  auto k = Kinematics::create(p);
+  auto k = make_kinematics(o.kin);
   if (!k) {
     std::cerr << "odomctl replay: " << k.error().message << "\n";
     exit_code = kExitBadInput;
@@ -50,7 +41,7 @@ void run_replay(const ReplayOpts& o, int& exit_code) {
   }
   analysis::ReplayGyro gyro;  // the loop's default fusion parameters (README "Gyro")
   gyro.use = !o.no_gyro;
-  auto r = analysis::replay_ticks(in, o.ticks, *k, o.bits, gyro);
+  auto r = analysis::replay_ticks(in, o.ticks, *k, o.kin.bits, gyro);
   if (!r) {
     std::cerr << "odomctl replay: " << r.error().message << "\n";
     exit_code = kExitBadInput;
@@ -87,15 +78,9 @@ void add_replay(CLI::App& app, int& exit_code) {
   c->add_option("--ticks", o->ticks,
                 "CSV file with header t,left,right[,gyro_z] (gyro_z [rad/s]: fused)")
       ->required();
-  c->add_option("--wheel-diameter", o->wheel_diameter, "nominal wheel diameter Dn [m]")->required();
-  c->add_option("--counts-per-rev", o->counts_per_rev,
-                "encoder counts per motor revolution after quadrature (Ce)")
-      ->required();
-  c->add_option("--gear-ratio", o->gear_ratio, "motor revolutions per wheel revolution (n)");
-  c->add_option("--wheelbase", o->wheelbase, "effective wheelbase b [m]")->required();
-  c->add_option("--cl", o->cl, "left wheel correction factor c_L");
-  c->add_option("--cr", o->cr, "right wheel correction factor c_R");
-  c->add_option("--counter-bits", o->bits, "counter width in bits, 16..64 (default 64)");
+  add_kinematics_options(*c, o->kin,
+                         {"effective wheelbase b [m]", "left wheel correction factor c_L",
+                          "right wheel correction factor c_R"});
   c->add_flag("--json", o->json, "print one JSON object");
   c->add_flag("--no-gyro", o->no_gyro, "ignore the gyro_z column (odometry alone)");
   c->callback([o, &exit_code] { run_replay(*o, exit_code); });

@@ -25,9 +25,7 @@ namespace {
 
 struct FitFixesOpts {
   std::string ticks, fixes;
-  double wheel_diameter = 0, counts_per_rev = 0, gear_ratio = 1, wheelbase = 0;
-  double cl = 1, cr = 1;
-  int bits = 64;
+  KinematicsOpts kin;
   calib::SelfCalConfig fit;
   bool json = false;
 };
@@ -35,14 +33,7 @@ struct FitFixesOpts {
 // fit_input: kinematics, segments and fixes; false (message printed) on bad input.
 bool fit_input(const FitFixesOpts& o, calib::FixTrack& track, calib::SelfCalConfig& c) {
   const char* cmd = "odomctl calib fit-fixes: ";
-  KinematicParams p;
-  p.wheel_diameter = o.wheel_diameter;
-  p.counts_per_rev = o.counts_per_rev;
-  p.gear_ratio = o.gear_ratio;
-  p.wheelbase_nominal = p.wheelbase = o.wheelbase;
-  p.c_l = o.cl;
-  p.c_r = o.cr;
-  auto k = Kinematics::create(p);
+  auto k = make_kinematics(o.kin);
   if (!k) {
     std::cerr << cmd << k.error().message << "\n";
     return false;
@@ -54,7 +45,7 @@ bool fit_input(const FitFixesOpts& o, calib::FixTrack& track, calib::SelfCalConf
       return false;
     }
   }
-  auto segs = analysis::read_count_segments(ticks, o.ticks, *k, o.bits);
+  auto segs = analysis::read_count_segments(ticks, o.ticks, *k, o.kin.bits);
   if (!segs) {
     std::cerr << cmd << segs.error().message << "\n";
     return false;
@@ -71,9 +62,10 @@ bool fit_input(const FitFixesOpts& o, calib::FixTrack& track, calib::SelfCalConf
   }
   track = std::move(t).value();
   c = o.fit;
-  p.c_l = p.c_r = 1.0;
-  c.metres_per_count = Kinematics::create(p)->metres_per_count();
-  c.in_use = {o.cl, o.cr, o.wheelbase};
+  KinematicsOpts nominal = o.kin;  // metres per count of the nominal wheel: factors 1
+  nominal.cl = nominal.cr = 1.0;
+  c.metres_per_count = make_kinematics(nominal)->metres_per_count();
+  c.in_use = {o.kin.cl, o.kin.cr, o.kin.wheelbase};
   if (auto s = calib::check_selfcal_config(c); !s) {
     std::cerr << cmd << s.error().message << "\n";
     return false;
@@ -334,15 +326,9 @@ void add_calib_fit_fixes(CLI::App& calib, int& exit_code) {
       "fit-fixes", "estimate c_L, c_R and b from a count log and absolute pose fixes");
   c->add_option("--ticks", o->ticks, "count log: CSV t,left,right[,gyro_z]")->required();
   c->add_option("--fixes", o->fixes, "fixes: CSV t,x,y,theta,sigma_xy,sigma_theta")->required();
-  c->add_option("--wheel-diameter", o->wheel_diameter, "nominal wheel diameter Dn [m]")->required();
-  c->add_option("--counts-per-rev", o->counts_per_rev,
-                "encoder counts per motor revolution after quadrature (Ce)")
-      ->required();
-  c->add_option("--gear-ratio", o->gear_ratio, "motor revolutions per wheel revolution (n)");
-  c->add_option("--wheelbase", o->wheelbase, "wheelbase b in use while recording [m]")->required();
-  c->add_option("--cl", o->cl, "c_L in use while recording");
-  c->add_option("--cr", o->cr, "c_R in use while recording");
-  c->add_option("--counter-bits", o->bits, "counter width in bits, 16..64 (default 64)");
+  add_kinematics_options(*c, o->kin,
+                         {"wheelbase b in use while recording [m]", "c_L in use while recording",
+                          "c_R in use while recording"});
   c->add_option("--k-left", o->fit.odometry_noise.k_left, "wheel noise k_L [m^(1/2)]")
       ->capture_default_str();
   c->add_option("--k-right", o->fit.odometry_noise.k_right, "wheel noise k_R [m^(1/2)]")

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "odo/hal/result.hpp"
+#include "odo/odometry/kinematics.hpp"
 
 namespace odo::ctl {
 
@@ -58,6 +59,28 @@ bool take_choice(Result<E> parsed, E& out, const char* cmd, int& exit_code) {
   exit_code = kExitBadInput;
   return false;
 }
+
+// KinematicsOpts: the robot's kinematics as the log commands take them (replay, calib
+// fit-fixes): nominal geometry, the factors in use and the counter width.
+struct KinematicsOpts {
+  double wheel_diameter = 0, counts_per_rev = 0, gear_ratio = 1, wheelbase = 0;  // m, -, -, m
+  double cl = 1, cr = 1;
+  int bits = 64;
+};
+
+// KinematicsHelp: the wording of --wheelbase, --cl and --cr, which differs by command.
+struct KinematicsHelp {
+  const char* wheelbase;
+  const char* cl;
+  const char* cr;
+};
+
+// add_kinematics_options: --wheel-diameter, --counts-per-rev, --gear-ratio, --wheelbase, --cl,
+// --cr and --counter-bits on `c`, stored in `k` (which must outlive the parse).
+void add_kinematics_options(CLI::App& c, KinematicsOpts& k, const KinematicsHelp& help);
+
+// make_kinematics: the Kinematics of `k`; the error names the field and its range.
+Result<Kinematics> make_kinematics(const KinematicsOpts& k);
 
 // add_replay: `odomctl replay` (integrate a log of raw counts).
 void add_replay(CLI::App& app, int& exit_code);
