@@ -18,11 +18,21 @@ fi
 # The host's apt sources (bookworm, -updates, -security), as a machine of the CI kind has them.
 cp /etc/apt/sources.list.d/debian.sources "$R/etc/apt/sources.list.d/" && rm -f "$R/etc/apt/sources.list"
 cp /etc/resolv.conf "$R/etc/resolv.conf"
+# The CI kind's own certificate authorities (its network's TLS egress proxy signs with them):
+# a fresh machine of the kind has them, a bare debootstrap does not (npm then fails with
+# SELF_SIGNED_CERT_IN_CHAIN), so they are copied in and installed the way the kind has them.
+if compgen -G "/usr/local/share/ca-certificates/*.crt" >/dev/null; then
+  mkdir -p "$R/usr/local/share/ca-certificates"
+  cp /usr/local/share/ca-certificates/*.crt "$R/usr/local/share/ca-certificates/"
+  chroot "$R" update-ca-certificates >/dev/null 2>&1 || { echo "fresh-ci: update-ca-certificates failed"; exit 1; }
+fi
 for m in proc sys dev dev/pts; do mountpoint -q "$R/$m" || mount --bind "/$m" "$R/$m"; done
 echo "fresh-ci: chroot ready in $(($(date +%s) - t0)) s"
 rm -rf "$R/root/repo" && git clone -q "$repo" "$R/root/repo"
 t1=$(date +%s)
+bundle=/etc/ssl/certs/ca-certificates.crt  # node and npm read the CAs from these, as on the kind
 chroot "$R" /usr/bin/env -i HOME=/root PATH=/usr/sbin:/usr/bin:/sbin:/bin CI=true LANG=C.UTF-8 \
+  NODE_EXTRA_CA_CERTS=$bundle SSL_CERT_FILE=$bundle \
   bash -c 'cd /root/repo && bash .ci/run' >"$R.log" 2>&1
 rc=$?
 echo "fresh-ci: .ci/run exit $rc after $(($(date +%s) - t1)) s; output in $R.log" | tee -a "$R.log"
