@@ -123,7 +123,7 @@ if [ "$install" = --install ]; then
     if [ -f "$unit" ]; then
       if command -v systemd-analyze >/dev/null; then
         check "systemd-analyze verify $unit" \
-          'systemd-analyze verify "$unit" >"$tmp/verify" 2>&1 || { cat "$tmp/verify"; false; }'
+          'systemd-analyze verify --man=no "$unit" >"$tmp/verify" 2>&1 || { cat "$tmp/verify"; false; }'
         [ -s "$tmp/verify" ] && { echo "systemd-analyze verify said:"; cat "$tmp/verify"; }
       else
         echo "SKIPPED: systemd-analyze verify: systemd-analyze is not installed"
