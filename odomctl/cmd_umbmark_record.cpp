@@ -1,6 +1,8 @@
 // odomctl umbmark record: the guided UMBmark session on a real robot. The odometry's poses come
-// from the daemon's CAN broadcast (a candump -L log being written), the person types only what
-// the tape gives; the return errors are computed here and saved after every run.
+// from the daemon's CAN broadcast (read from the bus, or from a candump -L log being written),
+// the person types only what the tape gives; the return errors are computed here and saved
+// after every run.
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <ctime>
@@ -13,12 +15,14 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "commands.hpp"
 #include "odo/analysis/calibration_json.hpp"
 #include "odo/analysis/umbmark_tools.hpp"
 #include "odo/calibration/umbmark_tape.hpp"
+#include "odo/firmware/can_listen.hpp"
 #include "odo/hal/field_range.hpp"
 #include "odo/protocol/candump_log.hpp"
 #include "umbmark_shared.hpp"
@@ -33,7 +37,7 @@ constexpr double kDeg = 180.0 / std::numbers::pi;
 constexpr const char* kCmd = "umbmark record";
 
 struct RecordOpts {
-  std::string csv, can_log, answers, out, store;
+  std::string csv, can, can_log, answers, out, store;
   int runs = 5, node = 1;
   std::uint32_t base_id = 0x400;
   double side = 4.0, wheelbase = 0.0, cl = 1.0, cr = 1.0;
@@ -41,32 +45,116 @@ struct RecordOpts {
   bool bumps = false;
 };
 
-// latest_pose: the newest PoseX + PoseYTheta pair (same seq) of `node` in a candump -L log.
-Result<Pose2> latest_pose(const std::string& path, std::uint32_t base_id, int node) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return make_error(Errc::kIo, path + ": cannot open (is candump -L running?)");
-  std::optional<Pose2> pose;
-  double x = 0.0;
-  int x_seq = -1;
-  for (std::string line; std::getline(in, line);) {
-    auto l = protocol::parse_candump_line(line);
+// PosePairer: joins a node's PoseX and PoseYTheta frames of the same sequence number into a
+// pose [m, m, rad]; every other frame is ignored.
+class PosePairer {
+ public:
+  PosePairer(std::uint32_t base_id, int node) : base_id_(base_id), node_(node) {}
+
+  // take: the pose completed by `f`, if it completes one.
+  std::optional<Pose2> take(const CanFrame& f) {
     int n = 0;
     protocol::Msg m{};
-    if (!l || !protocol::split_id(base_id, l->frame, n, m) || n != node) continue;
+    if (!protocol::split_id(base_id_, f, n, m) || n != node_) return std::nullopt;
     std::uint8_t seq = 0;
     double y = 0.0, th = 0.0;
-    if (m == protocol::Msg::kPoseX && protocol::decode_pose_x(l->frame, x, seq)) {
-      x_seq = seq;
-    } else if (m == protocol::Msg::kPoseYTheta &&
-               protocol::decode_pose_y_theta(l->frame, y, th, seq) && seq == x_seq) {
-      pose = Pose2{x, y, th};
+    if (m == protocol::Msg::kPoseX && protocol::decode_pose_x(f, x_, seq)) {
+      x_seq_ = seq;
+    } else if (m == protocol::Msg::kPoseYTheta && protocol::decode_pose_y_theta(f, y, th, seq) &&
+               seq == x_seq_) {
+      return Pose2{x_, y, th};
     }
+    return std::nullopt;
   }
-  if (!pose)
-    return make_error(Errc::kIo,
-                      path + ": no pose frames of node " + std::to_string(node) + " yet");
-  return *pose;
-}
+
+ private:
+  std::uint32_t base_id_;
+  int node_;
+  double x_ = 0.0;
+  int x_seq_ = -1;
+};
+
+// PoseFeed: where the daemon's current pose is read from.
+class PoseFeed {
+ public:
+  virtual ~PoseFeed() = default;
+  // latest: the daemon's newest pose [m, m, rad], or why there is none.
+  virtual Result<Pose2> latest() = 0;
+};
+
+// LogPoseFeed: the newest complete pose in a candump -L log that is being written.
+class LogPoseFeed final : public PoseFeed {
+ public:
+  LogPoseFeed(std::string path, std::uint32_t base_id, int node)
+      : path_(std::move(path)), base_id_(base_id), node_(node) {}
+
+  Result<Pose2> latest() override {
+    std::ifstream in(path_, std::ios::binary);
+    if (!in) return make_error(Errc::kIo, path_ + ": cannot open (is candump -L running?)");
+    PosePairer pairer(base_id_, node_);
+    std::optional<Pose2> pose;
+    for (std::string line; std::getline(in, line);) {
+      auto l = protocol::parse_candump_line(line);
+      if (!l) continue;
+      if (auto p = pairer.take(l->frame)) pose = p;
+    }
+    if (!pose)
+      return make_error(Errc::kIo,
+                        path_ + ": no pose frames of node " + std::to_string(node_) + " yet");
+    return *pose;
+  }
+
+ private:
+  std::string path_;
+  std::uint32_t base_id_;
+  int node_;
+};
+
+// BusPoseFeed: the next complete pose the daemon broadcasts on a SocketCAN interface.
+class BusPoseFeed final : public PoseFeed {
+ public:
+  static constexpr double kWait = 3.0;  // [s] for a pose pair: pose_hz >= 0.5 is enough
+
+  // open: the listener on `iface` for the node's two pose frames; errors name the interface.
+  static Result<std::unique_ptr<PoseFeed>> open(const std::string& iface, std::uint32_t base_id,
+                                                int node) {
+    const auto id = [&](protocol::Msg m) { return protocol::frame_id(base_id, node, m); };
+    auto bus =
+        fw::open_can_listener(iface, {id(protocol::Msg::kPoseX), id(protocol::Msg::kPoseYTheta)});
+    if (!bus) return std::move(bus).error();
+    return std::unique_ptr<PoseFeed>(
+        new BusPoseFeed(iface, std::move(bus).value(), PosePairer(base_id, node), node));
+  }
+
+  Result<Pose2> latest() override {
+    // What waits in the socket was queued while the person measured: old, and once the queue
+    // is full the kernel drops the newest frames. Empty it, then take the next complete pair.
+    CanFrame f{};
+    while (bus_->receive(f)) {
+    }
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(kWait);
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (!bus_->receive(f)) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        continue;
+      }
+      if (auto p = pairer_.take(f)) return *p;
+    }
+    std::ostringstream m;
+    m << iface_ << ": no pose frames of node " << node_ << " within " << kWait
+      << " s (is odometryd broadcasting on " << iface_ << "?)";
+    return make_error(Errc::kIo, m.str());
+  }
+
+ private:
+  BusPoseFeed(std::string iface, std::unique_ptr<CanBus> bus, PosePairer pairer, int node)
+      : iface_(std::move(iface)), bus_(std::move(bus)), pairer_(pairer), node_(node) {}
+
+  std::string iface_;
+  std::unique_ptr<CanBus> bus_;
+  PosePairer pairer_;
+  int node_;
+};
 
 // Prompter: asks on stdout and reads one line from the terminal or from --answers (then echoed,
 // so that a transcript reads like a session). A bad answer is asked again on a terminal and
@@ -116,6 +204,9 @@ class Prompter {
     }
   }
 
+  // scripted: the answers come from --answers, not from a person.
+  bool scripted() const { return !source_.empty(); }
+
  private:
   std::istream& in_;
   std::string source_;  // the answers file, empty on a terminal
@@ -149,14 +240,19 @@ void print_pose(const char* when, const Pose2& p) {
 }
 
 // read_pose: asks for Enter, then reads the daemon's pose; on a terminal a missing pose is
-// asked for again.
-bool read_pose(Prompter& in, const RecordOpts& o, const std::string& prompt, Pose2& out) {
+// asked for again, in a script it ends the session (the runs so far stay saved).
+bool read_pose(Prompter& in, PoseFeed& feed, const std::string& prompt, Pose2& out) {
   for (;;) {
     if (!in.line(prompt)) return false;
-    auto p = latest_pose(o.can_log, o.base_id, o.node);
+    auto p = feed.latest();
     if (p) {
       out = *p;
       return true;
+    }
+    // A script cannot wait for the daemon: the next answer is not an Enter for this pose.
+    if (in.scripted()) {
+      std::cerr << "odomctl " << kCmd << ": " << p.error().message << "\n";
+      return false;
     }
     std::cout << "  " << p.error().message << "; press Enter to try again.\n";
   }
@@ -177,7 +273,8 @@ bool tape(Prompter& in, const RecordOpts& o, const char* when, calib::TapeReadin
 }
 
 // record_run: one run of the plan, from the start mark to the computed return error.
-bool record_run(Prompter& in, const RecordOpts& o, Direction d, bool bumps, UmbmarkRun& run) {
+bool record_run(Prompter& in, PoseFeed& feed, const RecordOpts& o, Direction d, bool bumps,
+                UmbmarkRun& run) {
   const char* dir = d == Direction::kCw ? "cw" : "ccw";
   std::cout << "  Put the robot on the start mark, heading along the first leg"
             << (bumps ? (d == Direction::kCw ? "; ten ~10 mm cables under the right wheel's "
@@ -190,11 +287,11 @@ bool record_run(Prompter& in, const RecordOpts& o, Direction d, bool bumps, Umbm
   Pose2 p0, p1;
   std::optional<double> heading;
   if (!tape(in, o, "start", t0) ||
-      !read_pose(in, o, "  press Enter to read the odometry's start pose: ", p0))
+      !read_pose(in, feed, "  press Enter to read the odometry's start pose: ", p0))
     return false;
   print_pose("start", p0);
   if (!read_pose(
-          in, o,
+          in, feed,
           std::string("  drive the ") + dir + " square now; press Enter when it has " + "stopped: ",
           p1))
     return false;
@@ -305,6 +402,8 @@ bool record_options_ok(const RecordOpts& o) {
     m = range_message(integer_range("--runs", o.runs, 1, 1000));
   } else if (!protocol::valid_addressing(o.base_id, o.node)) {
     m = "--base-id / --node: not a valid node block (base id a multiple of 16, node 0..63)";
+  } else if (o.can.empty() == o.can_log.empty()) {
+    m = "the poses: one of --can IFACE (the bus) or --can-log FILE (a candump -L log) is needed";
   }
   if (!m.empty()) {
     std::cerr << "odomctl " << kCmd << ": " << m << "\n";
@@ -313,11 +412,25 @@ bool record_options_ok(const RecordOpts& o) {
   return output_paths_ok({o.csv, o.out, o.store}, kCmd);
 }
 
+// open_feed: the pose source the options name; an interface that cannot be opened is said
+// before the first question.
+std::unique_ptr<PoseFeed> open_feed(const RecordOpts& o) {
+  if (o.can.empty()) return std::make_unique<LogPoseFeed>(o.can_log, o.base_id, o.node);
+  auto f = BusPoseFeed::open(o.can, o.base_id, o.node);
+  if (!f) {
+    std::cerr << "odomctl " << kCmd << ": --can " << o.can << ": " << f.error().message << "\n";
+    return nullptr;
+  }
+  return std::move(f).value();
+}
+
 // run_record: `odomctl umbmark record` once its options are parsed; sets exit_code.
 void run_record(const RecordOpts& o, int& exit_code) {
   exit_code = kExitBadInput;
   std::vector<UmbmarkRun> runs;
   if (!record_options_ok(o) || !load_runs(o, runs)) return;
+  const std::unique_ptr<PoseFeed> feed = open_feed(o);
+  if (!feed) return;
   std::ifstream answers;
   if (!o.answers.empty()) {
     answers.open(o.answers, std::ios::binary);
@@ -338,7 +451,7 @@ void run_record(const RecordOpts& o, int& exit_code) {
                                                : "ccw (counter-clockwise, turning left)")
               << (p[i].second ? ", with bumps" : "") << "\n";
     UmbmarkRun run;
-    if (!record_run(in, o, p[i].first, p[i].second, run)) {
+    if (!record_run(in, *feed, o, p[i].first, p[i].second, run)) {
       std::cerr << "odomctl " << kCmd << ": stopped; " << runs.size() << " runs saved in " << o.csv
                 << ": the same command resumes\n";
       return;
@@ -359,10 +472,11 @@ void add_record(CLI::App& umbmark, int& exit_code) {
       "record", "guided UMBmark runs on a real robot: poses from the daemon, tape from you");
   c->add_option("--csv", o->csv, "the runs CSV, saved after every run (a session resumes)")
       ->required();
+  c->add_option("--can", o->can,
+                "read the daemon's pose from its broadcast on this SocketCAN interface (can0)");
   c->add_option("--can-log", o->can_log,
-                "candump -L log of the daemon's CAN broadcast being written "
-                "(candump -L can0 >FILE, or odometryd --can-log FILE)")
-      ->required();
+                "or from a candump -L log of that broadcast being written "
+                "(candump -L can0 >FILE, or odometryd --can-log FILE)");
   c->add_option("--wheelbase", o->wheelbase, "wheelbase the robot uses during the runs [m]")
       ->required();
   c->add_option("--current-cl", o->cl, "c_l the robot uses during the runs (default 1)");

@@ -1,0 +1,298 @@
+// Kernel tier (VM harness): `odomctl umbmark record --can IFACE` reads the daemon's pose from a
+// real SocketCAN interface (vcan), issue 20.
+//  - Bus against log: a broadcaster in this test sends PoseX + PoseYTheta frames of node 1 every
+//    5 ms, and changes the pose before each "press Enter" answer of a scripted session (the next
+//    answer is written only once the session has printed the pose it read). The same session
+//    with --can-log, its log rewritten with the same poses at the same moments, must write the
+//    same runs CSV byte for byte: the bus path reads what the log path reads.
+//  - The running daemon: odometryd on vcan with the simulated robot standing still, its pose set
+//    with `cansend`; the session prints that pose as its start and end pose.
+//  - No broadcast: a scripted session stops with one line naming the interface and the wait.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <linux/can.h>
+#include <net/if.h>
+#include <signal.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "kernel_env.hpp"
+#include "odo/protocol/can_protocol.hpp"
+#include "odo/protocol/candump_log.hpp"
+
+namespace odo::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr std::uint32_t kBase = 0x400;
+constexpr int kNode = 1;
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+pid_t spawn(const std::string& cmd) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    setpgid(0, 0);
+    execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+int wait_exit(pid_t pid) {
+  int status = 0;
+  if (waitpid(pid, &status, 0) != pid) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+
+// pose_frames: the node's PoseX and PoseYTheta frames of pose p with sequence number seq.
+std::pair<CanFrame, CanFrame> pose_frames(const protocol::PoseMsg& p) {
+  std::pair<CanFrame, CanFrame> f;
+  protocol::encode_pose_x(protocol::frame_id(kBase, kNode, protocol::Msg::kPoseX), p, f.first);
+  protocol::encode_pose_y_theta(protocol::frame_id(kBase, kNode, protocol::Msg::kPoseYTheta), p,
+                                f.second);
+  return f;
+}
+
+// Broadcaster: sends the current pose's two frames every 5 ms on a raw socket; set() returns
+// only when no frame of the previous pose can still be sent.
+class Broadcaster {
+ public:
+  explicit Broadcaster(const std::string& ifc) {
+    fd_ = socket(PF_CAN, SOCK_RAW, CAN_RAW);
+    ifreq ifr{};
+    std::strncpy(ifr.ifr_name, ifc.c_str(), IFNAMSIZ - 1);
+    ioctl(fd_, SIOCGIFINDEX, &ifr);
+    sockaddr_can a{};
+    a.can_family = AF_CAN;
+    a.can_ifindex = ifr.ifr_ifindex;
+    ok_ = fd_ >= 0 && bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+    thread_ = std::thread([this] { run(); });
+  }
+  ~Broadcaster() {
+    stop_ = true;
+    thread_.join();
+    close(fd_);
+  }
+  bool ok() const { return ok_; }
+  void set(const protocol::PoseMsg& p) {
+    std::lock_guard<std::mutex> l(m_);
+    pose_ = p;
+  }
+
+ private:
+  void send(const CanFrame& f) {
+    can_frame k{};
+    k.can_id = f.id;
+    k.can_dlc = f.len;
+    std::memcpy(k.data, f.data.data(), f.len);
+    (void)!write(fd_, &k, sizeof k);
+  }
+  void run() {
+    while (!stop_) {
+      {
+        std::lock_guard<std::mutex> l(m_);
+        pose_.seq = static_cast<std::uint8_t>(pose_.seq + 1);
+        const auto [fx, fy] = pose_frames(pose_);
+        send(fx);
+        send(fy);
+      }
+      std::this_thread::sleep_for(5ms);
+    }
+  }
+  int fd_ = -1;
+  bool ok_ = false;
+  std::atomic<bool> stop_{false};
+  std::mutex m_;
+  protocol::PoseMsg pose_{};
+  std::thread thread_;
+};
+
+// write_log: a candump -L log holding one pose pair, replaced whole (rename).
+void write_log(const std::string& path, const protocol::PoseMsg& p) {
+  const auto [fx, fy] = pose_frames(p);
+  char a[128], b[128];
+  const std::size_t na =
+      protocol::format_candump_line(a, sizeof a, 1'700'000'000'000'000'000, "vcanu0", fx);
+  const std::size_t nb =
+      protocol::format_candump_line(b, sizeof b, 1'700'000'000'005'000'000, "vcanu0", fy);
+  {
+    std::ofstream f(path + ".tmp", std::ios::binary);
+    f.write(a, static_cast<std::streamsize>(na));
+    f.write(b, static_cast<std::streamsize>(nb));
+  }
+  std::rename((path + ".tmp").c_str(), path.c_str());
+}
+
+// The poses the odometry "reports" at the four Enters of a --runs 1 session (cw then ccw, start
+// and end each), and the tape answers (mm) around them.
+const std::vector<protocol::PoseMsg> kPoses = {{0.1000, -0.0500, 0.0100, 0},
+                                               {0.1312, -0.0077, 0.0433, 0},
+                                               {-0.2000, 0.0300, -0.0200, 0},
+                                               {-0.1745, 0.0621, 0.0180, 0}};
+const char* const kTape[2][5] = {{"1000", "800", "1012", "795", "1.5"},
+                                 {"1000", "800", "990", "808", "-2.0"}};
+
+// drive_session: answers a running `umbmark record --runs 1` through the FIFO; before each Enter
+// it calls set_pose(k), and it waits for the session to print the pose it read before going on.
+// Returns false when the session did not get that far within 20 s.
+template <class SetPose>
+bool drive_session(const std::string& fifo, const std::string& out, SetPose set_pose) {
+  // Non-blocking open: a session that failed before opening its answers must not hang the test.
+  int fd = -1;
+  for (int i = 0; i < 200 && fd < 0; ++i, std::this_thread::sleep_for(50ms))
+    fd = open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+  if (fd < 0) return false;
+  fcntl(fd, F_SETFL, 0);
+  struct Closer {
+    int fd;
+    ~Closer() { close(fd); }
+  } closer{fd};
+  int k = 0;
+  auto say = [&](const std::string& line) {
+    (void)!write(fd, (line + "\n").data(), line.size() + 1);
+  };
+  auto enter = [&](const char* when, std::size_t n) {
+    set_pose(k++);
+    std::this_thread::sleep_for(50ms);  // frames of the pose before are delivered by now
+    say("");
+    for (int i = 0; i < 400; ++i, std::this_thread::sleep_for(50ms))
+      if (count(slurp(out), std::string("odometry at ") + when) >= n) return true;
+    return false;
+  };
+  for (std::size_t run = 0; run < 2; ++run) {
+    say(kTape[run][0]);
+    say(kTape[run][1]);
+    if (!enter("start", run + 1) || !enter("end", run + 1)) return false;
+    say(kTape[run][2]);
+    say(kTape[run][3]);
+    say(kTape[run][4]);
+  }
+  return true;
+}
+
+std::string record_cmd(const std::string& dir, const std::string& tag, const std::string& feed) {
+  return std::string("exec ") + ODOMCTL_PATH + " umbmark record --runs 1 --wheelbase 0.5 --csv " +
+         dir + "/" + tag + ".csv --answers " + dir + "/" + tag + ".fifo " + feed + " > " + dir +
+         "/" + tag + ".out 2> " + dir + "/" + tag + ".err";
+}
+
+void vcan_up(const std::string& ifc) {
+  run("ip link del " + ifc + " 2>/dev/null");
+  ASSERT_EQ(run("ip link add " + ifc + " type vcan && ip link set " + ifc + " up"), 0);
+}
+
+TEST(UmbmarkRecordLive, BusSessionWritesTheSameCsvAsTheLogSession) {
+  ODO_REQUIRE_VM();
+  const std::string ifc = "vcanu0", dir = "/tmp/odo_umb_live";
+  vcan_up(ifc);
+  run("rm -rf " + dir + " && mkdir -p " + dir);
+  for (const char* tag : {"bus", "log"})
+    ASSERT_EQ(mkfifo((dir + "/" + tag + ".fifo").c_str(), 0600), 0);
+
+  Broadcaster b(ifc);
+  ASSERT_TRUE(b.ok());
+  b.set(kPoses[0]);
+  const pid_t bus = spawn(record_cmd(dir, "bus", "--can " + ifc));
+  EXPECT_TRUE(drive_session(dir + "/bus.fifo", dir + "/bus.out",
+                            [&](int k) { b.set(kPoses[static_cast<std::size_t>(k)]); }))
+      << slurp(dir + "/bus.out") << slurp(dir + "/bus.err");
+  EXPECT_EQ(wait_exit(bus), 0) << slurp(dir + "/bus.err");
+
+  write_log(dir + "/capture.log", kPoses[0]);
+  const pid_t log = spawn(record_cmd(dir, "log", "--can-log " + dir + "/capture.log"));
+  EXPECT_TRUE(drive_session(
+      dir + "/log.fifo", dir + "/log.out",
+      [&](int k) { write_log(dir + "/capture.log", kPoses[static_cast<std::size_t>(k)]); }))
+      << slurp(dir + "/log.out") << slurp(dir + "/log.err");
+  EXPECT_EQ(wait_exit(log), 0) << slurp(dir + "/log.err");
+
+  const std::string csv = slurp(dir + "/bus.csv");
+  std::printf("runs CSV read from %s:\n%s", ifc.c_str(), csv.c_str());
+  EXPECT_EQ(count(csv, "\n"), 3u);  // header + 2 runs
+  EXPECT_EQ(csv, slurp(dir + "/log.csv"));
+  // The bus session saw each pose it was given (the table's 4 decimals survive the 0.1 mm and
+  // 1e-4 rad resolution of the frames).
+  const std::string out = slurp(dir + "/bus.out");
+  EXPECT_NE(out.find("odometry at start: x 0.1000 m, y -0.0500 m"), std::string::npos) << out;
+  EXPECT_NE(out.find("odometry at end: x -0.1745 m, y 0.0621 m"), std::string::npos) << out;
+}
+
+TEST(UmbmarkRecordLive, ReadsTheRunningDaemonsPoseAndSaysWhenThereIsNone) {
+  ODO_REQUIRE_VM();
+  const std::string ifc = "vcanu1", dir = "/tmp/odo_umb_daemon";
+  vcan_up(ifc);
+  run("rm -rf " + dir + " && mkdir -p " + dir);
+  {
+    std::ofstream cfg(dir + "/odometryd.toml");
+    cfg << "[loop]\nrate_hz = 100\nstatus_period = 0\n[sim]\nscenario = \"idle\"\n"
+        << "[calibration]\nstore = \"\"\n[realtime]\npriority = 0\nlock_memory = false\n"
+        << "[can]\nbus = \"socketcan\"\ninterface = \"" << ifc << "\"\nnode_id = 1\n";
+    std::ofstream ans(dir + "/answers.txt");
+    for (const auto& run : kTape)
+      ans << run[0] << "\n"
+          << run[1] << "\n\n\n"
+          << run[2] << "\n"
+          << run[3] << "\n"
+          << run[4] << "\n";
+  }
+  const std::string rec = std::string(ODOMCTL_PATH) +
+                          " umbmark record --runs 1 --wheelbase 0.5 --can " + ifc + " --answers " +
+                          dir + "/answers.txt --csv " + dir;
+  // Nobody broadcasts yet: the scripted session stops at the first pose, naming the wait.
+  EXPECT_EQ(run(rec + "/none.csv > " + dir + "/none.out 2> " + dir + "/none.err"), 1);
+  const std::string none = slurp(dir + "/none.err");
+  EXPECT_NE(none.find(ifc + ": no pose frames of node 1 within 3 s"), std::string::npos) << none;
+  EXPECT_EQ(access((dir + "/none.csv").c_str(), F_OK), -1);  // no run, nothing written
+
+  const pid_t daemon = spawn(std::string("exec ") + ODOMETRYD_PATH + " --config " + dir +
+                             "/odometryd.toml --duration 30 > /dev/null 2> " + dir + "/d.err");
+  std::this_thread::sleep_for(1500ms);
+  // Set pose x = 1.234 m, y = -0.567 m, theta = 0.1234 rad: raw 1234 = 0x0004D2, -567 =
+  // 0xFFFDC9, 1234 = 0x04D2, little-endian; id 0x400 + 16 * 1 + 8.
+  ASSERT_EQ(run("cansend " + ifc + " 418#D20400C9FDFFD204"), 0);
+  std::this_thread::sleep_for(300ms);
+  const int rc = run(rec + "/daemon.csv > " + dir + "/daemon.out 2> " + dir + "/daemon.err");
+  kill(-daemon, SIGTERM);
+  wait_exit(daemon);
+  EXPECT_EQ(rc, 0) << slurp(dir + "/daemon.err") << slurp(dir + "/d.err");
+  const std::string out = slurp(dir + "/daemon.out");
+  // The robot stands still: every pose read is the one set, 0.1234 rad = 7.070 deg.
+  EXPECT_EQ(count(out, "x 1.2340 m, y -0.5670 m, theta 7.070 deg"), 4u) << out;
+  // An interface that does not exist is one line before the first question (exit 2).
+  EXPECT_EQ(run(std::string(ODOMCTL_PATH) + " umbmark record --wheelbase 0.5 --can vcannope" +
+                " --csv " + dir + "/x.csv < /dev/null > " + dir + "/x.out 2> " + dir + "/x.err"),
+            2);
+  const std::string x = slurp(dir + "/x.err");
+  EXPECT_EQ(count(x, "\n"), 1u) << x;
+  EXPECT_NE(x.find("--can vcannope"), std::string::npos) << x;
+  EXPECT_EQ(slurp(dir + "/x.out"), "");
+}
+
+}  // namespace
+}  // namespace odo::test
