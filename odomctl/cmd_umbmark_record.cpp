@@ -23,6 +23,7 @@
 #include "odo/analysis/umbmark_tools.hpp"
 #include "odo/calibration/umbmark_tape.hpp"
 #include "odo/firmware/can_listen.hpp"
+#include "odo/firmware/config.hpp"
 #include "odo/hal/field_range.hpp"
 #include "odo/protocol/candump_log.hpp"
 #include "umbmark_shared.hpp"
@@ -37,12 +38,13 @@ constexpr double kDeg = 180.0 / std::numbers::pi;
 constexpr const char* kCmd = "umbmark record";
 
 struct RecordOpts {
-  std::string csv, can, can_log, answers, out, store;
+  std::string csv, can, can_log, answers, out, store, config;
   int runs = 5, node = 1;
   std::uint32_t base_id = 0x400;
   double side = 4.0, wheelbase = 0.0, cl = 1.0, cr = 1.0;
   calib::SideWall wall = calib::SideWall::kLeft;
   bool bumps = false;
+  bool node_given = false, base_id_given = false;  // on the command line: not from --config
 };
 
 // PosePairer: joins a node's PoseX and PoseYTheta frames of the same sequence number into a
@@ -393,6 +395,29 @@ bool finish(Prompter& in, const RecordOpts& o, const std::vector<UmbmarkRun>& ru
   return save_factors(o.store, *rec, kCmd);
 }
 
+// apply_daemon_config: the daemon's [can] interface, node and base id from --config, where the
+// command line does not name them. False (said on stderr) for a config that broadcasts no pose.
+bool apply_daemon_config(RecordOpts& o) {
+  if (o.config.empty()) return true;
+  auto c = fw::load_config(o.config);
+  std::string m;
+  if (!c) {
+    m = c.error().message;
+  } else if (c->can.bus != fw::CanBusKind::kSocketCan) {
+    m = o.config + ": [can] bus is not \"socketcan\": the daemon broadcasts on no CAN interface";
+  } else if (!(c->can.pose_hz > 0.0)) {
+    m = o.config + ": [can] pose_hz = 0: the daemon broadcasts no pose";
+  }
+  if (!m.empty()) {
+    std::cerr << "odomctl " << kCmd << ": " << m << "\n";
+    return false;
+  }
+  if (o.can.empty() && o.can_log.empty()) o.can = c->can.interface;
+  if (!o.node_given) o.node = c->can.node_id;
+  if (!o.base_id_given) o.base_id = static_cast<std::uint32_t>(c->can.base_id);
+  return true;
+}
+
 // record_options_ok: values and output paths before the first question.
 bool record_options_ok(const RecordOpts& o) {
   std::string m;
@@ -403,7 +428,8 @@ bool record_options_ok(const RecordOpts& o) {
   } else if (!protocol::valid_addressing(o.base_id, o.node)) {
     m = "--base-id / --node: not a valid node block (base id a multiple of 16, node 0..63)";
   } else if (o.can.empty() == o.can_log.empty()) {
-    m = "the poses: one of --can IFACE (the bus) or --can-log FILE (a candump -L log) is needed";
+    m = "the poses: one of --can IFACE (the bus), --can-log FILE (a candump -L log) or --config "
+        "FILE (the daemon's interface) is needed";
   }
   if (!m.empty()) {
     std::cerr << "odomctl " << kCmd << ": " << m << "\n";
@@ -425,10 +451,10 @@ std::unique_ptr<PoseFeed> open_feed(const RecordOpts& o) {
 }
 
 // run_record: `odomctl umbmark record` once its options are parsed; sets exit_code.
-void run_record(const RecordOpts& o, int& exit_code) {
+void run_record(RecordOpts o, int& exit_code) {
   exit_code = kExitBadInput;
   std::vector<UmbmarkRun> runs;
-  if (!record_options_ok(o) || !load_runs(o, runs)) return;
+  if (!apply_daemon_config(o) || !record_options_ok(o) || !load_runs(o, runs)) return;
   const std::unique_ptr<PoseFeed> feed = open_feed(o);
   if (!feed) return;
   std::ifstream answers;
@@ -487,12 +513,21 @@ void add_record(CLI::App& umbmark, int& exit_code) {
   c->add_option("--side-wall", o->wall, "the side wall at the start mark: left (default), right")
       ->transform(CLI::CheckedTransformer(std::map<std::string, calib::SideWall>{
           {"left", calib::SideWall::kLeft}, {"right", calib::SideWall::kRight}}));
-  c->add_option("--node", o->node, "node id of the daemon on the bus (default 1)");
-  c->add_option("--base-id", o->base_id, "base id of the protocol (default 0x400)");
+  c->add_option("--config", o->config,
+                "the daemon's config: its [can] interface, node_id and base_id are the defaults "
+                "of --can, --node and --base-id");
+  CLI::Option* node =
+      c->add_option("--node", o->node, "node id of the daemon on the bus (default 1)");
+  CLI::Option* base =
+      c->add_option("--base-id", o->base_id, "base id of the protocol (default 0x400)");
   c->add_option("--answers", o->answers, "read the answers from FILE (scripts, tests)");
   c->add_option("--out", o->out, "write the result as JSON (what `calib import` reads)");
   c->add_option("--store", o->store, "offer to import the result into this calibration store");
-  c->callback([o, &exit_code] { run_record(*o, exit_code); });
+  c->callback([o, node, base, &exit_code] {
+    o->node_given = node->count() > 0;
+    o->base_id_given = base->count() > 0;
+    run_record(*o, exit_code);
+  });
 }
 
 }  // namespace odo::ctl

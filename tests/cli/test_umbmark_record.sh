@@ -146,6 +146,17 @@ run "$ODOMCTL" umbmark record --csv "$tmp/no/dir/r.csv" --can-log "$tmp/still.lo
   --answers "$tmp/one.txt" >"$tmp/out" 2>"$tmp/err"
 [ $? = 2 ] && [ "$(wc -l <"$tmp/err")" = 1 ] && [ ! -s "$tmp/out" ]
 check "record --csv unwritable: exit 2 before the first question: $(cat "$tmp/err")" $?
+# Where the poses come from: one source is needed; --config takes the daemon's [can] interface,
+# and a daemon config that broadcasts on no interface is said before the first question.
+run "$ODOMCTL" umbmark record --csv "$tmp/r3.csv" --wheelbase 0.34 --answers "$tmp/one.txt" \
+  >"$tmp/out" 2>"$tmp/err"
+[ $? = 2 ] && [ "$(wc -l <"$tmp/err")" = 1 ] && grep -q "one of --can IFACE" "$tmp/err" && [ ! -s "$tmp/out" ]
+check "record without a pose source: exit 2, one line: $(cat "$tmp/err")" $?
+run "$ODOMCTL" umbmark record --csv "$tmp/r3.csv" --config "$tmp/idle.toml" --wheelbase 0.34 \
+  --answers "$tmp/one.txt" >"$tmp/out" 2>"$tmp/err"
+[ $? = 2 ] && [ "$(wc -l <"$tmp/err")" = 1 ] && grep -q 'idle.toml: \[can\] bus is not "socketcan"' "$tmp/err" &&
+  [ ! -e "$tmp/r3.csv" ]
+check "record --config of a daemon on the simulated bus: exit 2: $(cat "$tmp/err")" $?
 
 echo "cli_umbmark_record: $pass passed, $fail failed"
 [ $fail = 0 ]

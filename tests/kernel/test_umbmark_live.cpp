@@ -6,7 +6,8 @@
 //    with --can-log, its log rewritten with the same poses at the same moments, must write the
 //    same runs CSV byte for byte: the bus path reads what the log path reads.
 //  - The running daemon: odometryd on vcan with the simulated robot standing still, its pose set
-//    with `cansend`; the session prints that pose as its start and end pose.
+//    with `cansend`; a session that takes the interface from the daemon's config (--config)
+//    prints that pose as its start and end pose.
 //  - No broadcast: a scripted session stops with one line naming the interface and the wait.
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -277,7 +278,11 @@ TEST(UmbmarkRecordLive, ReadsTheRunningDaemonsPoseAndSaysWhenThereIsNone) {
   // 0xFFFDC9, 1234 = 0x04D2, little-endian; id 0x400 + 16 * 1 + 8.
   ASSERT_EQ(run("cansend " + ifc + " 418#D20400C9FDFFD204"), 0);
   std::this_thread::sleep_for(300ms);
-  const int rc = run(rec + "/daemon.csv > " + dir + "/daemon.out 2> " + dir + "/daemon.err");
+  // This session finds the interface and node in the daemon's own config.
+  const std::string rec_cfg = std::string(ODOMCTL_PATH) +
+                              " umbmark record --runs 1 --wheelbase 0.5 --config " + dir +
+                              "/odometryd.toml --answers " + dir + "/answers.txt --csv " + dir;
+  const int rc = run(rec_cfg + "/daemon.csv > " + dir + "/daemon.out 2> " + dir + "/daemon.err");
   kill(-daemon, SIGTERM);
   wait_exit(daemon);
   EXPECT_EQ(rc, 0) << slurp(dir + "/daemon.err") << slurp(dir + "/d.err");
