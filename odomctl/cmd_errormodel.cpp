@@ -85,6 +85,48 @@ void run_validate_twist(const ValidateOpts& o, int& exit_code) {
   exit_code = kExitOk;
 }
 
+// write_validate_files: --plot and --csv of a pose Monte Carlo; false (said) when one failed.
+bool write_validate_files(const ValidateOpts& o, const analysis::McResult& r) {
+  if (!o.plot.empty()) {
+    std::ostringstream title;
+    title << "Chong-Kleeman error model, " << r.runs
+          << " runs: " << analysis::path_description(o.mc.path) << "; k_L = " << o.mc.k.k_left
+          << ", k_R = " << o.mc.k.k_right << " m^(1/2), b = " << o.mc.wheelbase << " m";
+    if (!write_output_file(
+            o.plot,
+            analysis::error_ellipse_svg(r.errors, r.predicted, r.sample, r.mean, title.str()),
+            "errormodel validate"))
+      return false;
+  }
+  if (o.csv.empty()) return true;
+  std::ostringstream text;
+  analysis::write_run_errors(text, r.errors);
+  return write_output_file(o.csv, text.str(), "errormodel validate");
+}
+
+// print_validate: the predicted and sample covariances on stdout (a table, or --json).
+void print_validate(const ValidateOpts& o, const analysis::McResult& r) {
+  if (o.json) {
+    nlohmann::json j{{"runs", r.runs},
+                     {"path", std::string(analysis::name_of(o.mc.path))},
+                     {"wheelbase", o.mc.wheelbase},
+                     {"k_left", o.mc.k.k_left},
+                     {"k_right", o.mc.k.k_right},
+                     {"seed", o.mc.seed},
+                     {"predicted", nested(r.predicted)},
+                     {"sample", nested(r.sample)},
+                     {"mean", r.mean},
+                     {"rel_error_diag", r.rel_error},
+                     {"max_rel_error_diag", r.max_rel_error_diag}};
+    std::cout << j.dump() << "\n";
+    return;
+  }
+  print_table(std::cout, r.predicted, r.sample);
+  std::cout << "mean error          " << r.mean[0] << " m, " << r.mean[1] << " m, " << r.mean[2]
+            << " rad\n"
+            << "max |pred - sample| / sample over the variances: " << r.max_rel_error_diag << "\n";
+}
+
 // run_validate: `odomctl ... validate` once its options are parsed; sets exit_code.
 void run_validate(const ValidateOpts& o, int& exit_code) {
   if (auto s = analysis::check_mc_options(o.mc); !s) {
@@ -112,47 +154,11 @@ void run_validate(const ValidateOpts& o, int& exit_code) {
     return;
   }
   std::cerr << "errormodel validate: " << r->runs << " runs driven\n";
-  if (!o.plot.empty()) {
-    std::ostringstream title;
-    title << "Chong-Kleeman error model, " << r->runs
-          << " runs: " << analysis::path_description(o.mc.path) << "; k_L = " << o.mc.k.k_left
-          << ", k_R = " << o.mc.k.k_right << " m^(1/2), b = " << o.mc.wheelbase << " m";
-    if (!write_output_file(
-            o.plot,
-            analysis::error_ellipse_svg(r->errors, r->predicted, r->sample, r->mean, title.str()),
-            "errormodel validate")) {
-      exit_code = kExitFailed;
-      return;
-    }
+  if (!write_validate_files(o, *r)) {
+    exit_code = kExitFailed;
+    return;
   }
-  if (!o.csv.empty()) {
-    std::ostringstream text;
-    analysis::write_run_errors(text, r->errors);
-    if (!write_output_file(o.csv, text.str(), "errormodel validate")) {
-      exit_code = kExitFailed;
-      return;
-    }
-  }
-  if (o.json) {
-    nlohmann::json j{{"runs", r->runs},
-                     {"path", std::string(analysis::name_of(o.mc.path))},
-                     {"wheelbase", o.mc.wheelbase},
-                     {"k_left", o.mc.k.k_left},
-                     {"k_right", o.mc.k.k_right},
-                     {"seed", o.mc.seed},
-                     {"predicted", nested(r->predicted)},
-                     {"sample", nested(r->sample)},
-                     {"mean", r->mean},
-                     {"rel_error_diag", r->rel_error},
-                     {"max_rel_error_diag", r->max_rel_error_diag}};
-    std::cout << j.dump() << "\n";
-  } else {
-    print_table(std::cout, r->predicted, r->sample);
-    std::cout << "mean error          " << r->mean[0] << " m, " << r->mean[1] << " m, "
-              << r->mean[2] << " rad\n"
-              << "max |pred - sample| / sample over the variances: " << r->max_rel_error_diag
-              << "\n";
-  }
+  print_validate(o, *r);
   exit_code = kExitOk;
 }
 

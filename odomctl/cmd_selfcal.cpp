@@ -176,6 +176,40 @@ struct SimOutcome {
   int corrupted = 0;
 };
 
+// selfcal_setup: the estimator as the daemon would run it for these options.
+fw::SelfCalSetup selfcal_setup(const SimulateOpts& o, const Kinematics& believed) {
+  fw::SelfCalSetup setup;
+  setup.cfg.enabled = true;
+  setup.cfg.min_fixes = o.min_fixes > 0 ? o.min_fixes : o.excursions + 1;
+  setup.cfg.max_fixes = std::max(setup.cfg.min_fixes, 41);
+  setup.cfg.fit_every = o.fit_every;
+  setup.nominal = setup.in_use = believed.params();
+  setup.ripe_delay = from_seconds(0.04);
+  return setup;
+}
+
+// make_fix: a fix of the true pose at `now` with the options' noise; when `may_corrupt`, with
+// probability --outliers a wrong landmark match 0.5-5 m off (counted in `corrupted`).
+calib::PoseFix make_fix(const SimulateOpts& o, const Pose2& truth, TimeNs now, bool may_corrupt,
+                        std::mt19937_64& rng, int& corrupted) {
+  std::normal_distribution<double> n01;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double sth = o.sigma_theta * std::numbers::pi / 180.0;
+  calib::PoseFix f{now,
+                   truth.x + o.sigma_xy * n01(rng),
+                   truth.y + o.sigma_xy * n01(rng),
+                   wrap_angle(truth.theta + sth * n01(rng)),
+                   o.sigma_xy,
+                   sth};
+  if (may_corrupt && u(rng) < o.outliers) {
+    const double r = 0.5 + 4.5 * u(rng), a = 2 * std::numbers::pi * u(rng);
+    f.x += r * std::cos(a);
+    f.y += r * std::sin(a);
+    ++corrupted;
+  }
+  return f;
+}
+
 // simulate_drive: the daemon's loop, recorder and estimator on the simulated LabMate.
 SimOutcome simulate_drive(const SimulateOpts& o, const SimDrive& d, std::mt19937_64& rng) {
   const Kinematics believed = analysis::selfcal_kinematics({1.0, 1.0, analysis::kSelfCalBn});
@@ -191,18 +225,8 @@ SimOutcome simulate_drive(const SimulateOpts& o, const SimDrive& d, std::mt19937
   auto lp = loop::OdometryLoop::create(loop::LoopConfig{}, believed, rec, clock).value();
   sim::SimNvStorage medium(sim::SimMedium::kEeprom, 1024, 0, 16);
   auto store = *calib::CalibrationStore::create(medium);
-  fw::SelfCalSetup setup;
-  setup.cfg.enabled = true;
-  setup.cfg.min_fixes = o.min_fixes > 0 ? o.min_fixes : o.excursions + 1;
-  setup.cfg.max_fixes = std::max(setup.cfg.min_fixes, 41);
-  setup.cfg.fit_every = o.fit_every;
-  setup.nominal = setup.in_use = believed.params();
-  setup.ripe_delay = from_seconds(0.04);
   std::ostringstream log;
-  fw::SelfCalEstimator est(setup, &store, lp->commands(), segments, rec, log);
-  std::normal_distribution<double> n01;
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  const double sth = o.sigma_theta * std::numbers::pi / 180.0;
+  fw::SelfCalEstimator est(selfcal_setup(o, believed), &store, lp->commands(), segments, rec, log);
   std::vector<calib::PoseFix> waiting;
   SimOutcome out;
   std::size_t next = 0;
@@ -212,20 +236,7 @@ SimOutcome simulate_drive(const SimulateOpts& o, const SimDrive& d, std::mt19937
     lp->tick();
     const TimeNs now = lp->snapshot().stamp;
     if (next < d.fix_times.size() && now >= d.fix_times[next]) {
-      const Pose2& p = robot.true_pose();
-      calib::PoseFix f{now,
-                       p.x + o.sigma_xy * n01(rng),
-                       p.y + o.sigma_xy * n01(rng),
-                       wrap_angle(p.theta + sth * n01(rng)),
-                       o.sigma_xy,
-                       sth};
-      if (next > 0 && u(rng) < o.outliers) {  // a wrong landmark match
-        const double r = 0.5 + 4.5 * u(rng), a = 2 * std::numbers::pi * u(rng);
-        f.x += r * std::cos(a);
-        f.y += r * std::sin(a);
-        ++out.corrupted;
-      }
-      waiting.push_back(f);
+      waiting.push_back(make_fix(o, robot.true_pose(), now, next > 0, rng, out.corrupted));
       ++next;
     }
     if (!waiting.empty() && now >= waiting.front().t + from_seconds(o.late)) {

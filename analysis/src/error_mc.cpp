@@ -92,10 +92,7 @@ Result<McResult> run_error_monte_carlo(const McOptions& o,
   // Two periods of standstill after the path so that the last reading sees the robot stopped.
   const double standstill = 2.0 / o.rate_hz;
   sim::WheelNoise noise(o.k.k_left, o.k.k_right, 0);
-  sim::SimRunOptions so;
-  so.loop.rate_hz = o.rate_hz;
-  so.loop.error_model = o.k;
-  so.perturbation = &noise;
+  const sim::SimRunOptions so = mc_run_options(o, noise);
 
   McResult r;
   r.runs = o.runs;

@@ -4,6 +4,7 @@
 #include "odo/analysis/error_model_tools.hpp"
 #include "odo/odometry/kinematics.hpp"
 #include "odo/sim/robot.hpp"
+#include "odo/sim/sim_run.hpp"
 
 namespace odo::analysis {
 
@@ -29,6 +30,15 @@ inline Result<McRobot> mc_robot(const McOptions& o) {
   g.counts_per_rev = p.counts_per_rev;
   g.gear_ratio = p.gear_ratio;
   return McRobot{*k, g};
+}
+
+// mc_run_options: the loop of options o (rate, error model) with the runs' wheel noise.
+inline sim::SimRunOptions mc_run_options(const McOptions& o, sim::TravelPerturbation& noise) {
+  sim::SimRunOptions so;
+  so.loop.rate_hz = o.rate_hz;
+  so.loop.error_model = o.k;
+  so.perturbation = &noise;
+  return so;
 }
 
 }  // namespace odo::analysis

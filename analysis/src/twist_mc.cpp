@@ -57,10 +57,7 @@ Result<TwistMcResult> run_twist_monte_carlo(const McOptions& o) {
   const sim::Scenario path{{2.0 * kTwistWarmUp, (o.speed - 0.5 * o.wheelbase * omega) / rw,
                             (o.speed + 0.5 * o.wheelbase * omega) / rw}};
   sim::WheelNoise noise(o.k.k_left, o.k.k_right, 0);
-  sim::SimRunOptions so;
-  so.loop.rate_hz = o.rate_hz;
-  so.loop.error_model = o.k;
-  so.perturbation = &noise;
+  const sim::SimRunOptions so = mc_run_options(o, noise);
 
   TwistMcResult r;
   r.runs = o.runs;

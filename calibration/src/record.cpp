@@ -122,6 +122,28 @@ Result<std::vector<std::uint8_t>> encode_record(const CalibrationRecord& r) {
   return b;
 }
 
+namespace {
+
+// decode_fit: the fit provenance of a record whose flags say it has one (version >= 2).
+Result<FixFitProvenance> decode_fit(std::span<const std::uint8_t> bytes, std::uint16_t version,
+                                    std::uint16_t length) {
+  if (version < kRecordVersionFit || length < kRecordV2Bytes)
+    return corrupt("fit fields flagged in a record of version " + std::to_string(version) +
+                   " and length " + std::to_string(length) +
+                   " (needs >= 2 and >= " + std::to_string(kRecordV2Bytes) + ")");
+  FixFitProvenance f;
+  f.fixes_used = get<std::uint32_t>(bytes, 104);
+  f.fixes_rejected = get<std::uint32_t>(bytes, 108);
+  double* fv[] = {&f.residual, &f.sigma_c_l, &f.sigma_c_r, &f.sigma_wheelbase};
+  for (std::size_t i = 0; i < 4; ++i) {
+    *fv[i] = get<double>(bytes, 112 + 8 * i);
+    if (!std::isfinite(*fv[i])) return corrupt("a stored fit value is not finite");
+  }
+  return f;
+}
+
+}  // namespace
+
 Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
   if (bytes.size() < kRecordV1Bytes) return corrupt("shorter than a version-1 record");
   const auto magic = get<std::uint32_t>(bytes, 0);
@@ -167,19 +189,9 @@ Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
   const auto* m = reinterpret_cast<const char*>(bytes.data() + 88);
   r.method.assign(m, strnlen(m, kMethodBytes - 1));
   if (flags & kFlagFit) {
-    if (version < kRecordVersionFit || length < kRecordV2Bytes)
-      return corrupt("fit fields flagged in a record of version " + std::to_string(version) +
-                     " and length " + std::to_string(length) +
-                     " (needs >= 2 and >= " + std::to_string(kRecordV2Bytes) + ")");
-    FixFitProvenance f;
-    f.fixes_used = get<std::uint32_t>(bytes, 104);
-    f.fixes_rejected = get<std::uint32_t>(bytes, 108);
-    double* fv[] = {&f.residual, &f.sigma_c_l, &f.sigma_c_r, &f.sigma_wheelbase};
-    for (std::size_t i = 0; i < 4; ++i) {
-      *fv[i] = get<double>(bytes, 112 + 8 * i);
-      if (!std::isfinite(*fv[i])) return corrupt("a stored fit value is not finite");
-    }
-    r.fit = f;
+    auto f = decode_fit(bytes, version, length);
+    if (!f) return std::move(f).error();
+    r.fit = *f;
   }
   return r;
 }

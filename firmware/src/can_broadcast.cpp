@@ -26,40 +26,6 @@ std::uint8_t gyro_state(const loop::LoopGyroStatus& g) noexcept {
 
 }  // namespace
 
-// ---- CanFrameRing ----
-
-CanFrameRing::CanFrameRing(std::size_t capacity_pow2) {
-  std::size_t n = 1;
-  while (n < capacity_pow2) n <<= 1;
-  buf_.resize(n);
-  mask_ = n - 1;
-}
-
-bool CanFrameRing::push(const CanFrame& f) noexcept {
-  const std::uint64_t h = head_.load(std::memory_order_relaxed);
-  if (h - tail_.load(std::memory_order_acquire) > mask_) {
-    dropped_.fetch_add(1, std::memory_order_relaxed);
-    return false;
-  }
-  buf_[h & mask_] = f;
-  head_.store(h + 1, std::memory_order_release);
-  return true;
-}
-
-void CanFrameRing::push_wait(const CanFrame& f) noexcept {
-  while (head_.load(std::memory_order_relaxed) - tail_.load(std::memory_order_acquire) > mask_)
-    std::this_thread::yield();
-  push(f);
-}
-
-bool CanFrameRing::pop(CanFrame& out) noexcept {
-  const std::uint64_t t = tail_.load(std::memory_order_relaxed);
-  if (t == head_.load(std::memory_order_acquire)) return false;
-  out = buf_[t & mask_];
-  tail_.store(t + 1, std::memory_order_release);
-  return true;
-}
-
 // ---- candump -L log ----
 
 CanLogWriter::~CanLogWriter() {
@@ -301,6 +267,42 @@ void CanBroadcaster::send_final(const loop::LoopSnapshot& s) noexcept {
 
 // ---- CanLink ----
 
+namespace {
+
+// open_socket_bus: the daemon's SocketCAN socket; it receives only the commands addressed to
+// this node (set-pose when enabled, the absolute fixes, dropped unless [selfcal] is enabled).
+Result<std::unique_ptr<drivers::SocketCanBus>> open_socket_bus(const CanSection& s) {
+  drivers::SocketCanOptions so;
+  so.interface = s.interface;
+  so.reopen_period = s.reopen_period;
+  const auto id = [&](protocol::Msg m) {
+    return protocol::frame_id(static_cast<std::uint32_t>(s.base_id), s.node_id, m);
+  };
+  if (s.set_pose)
+    so.filters.push_back(drivers::CanFilter{id(protocol::Msg::kSetPose), 0x7FF, false});
+  for (const protocol::Msg m : {protocol::Msg::kFixPose, protocol::Msg::kFixSigma})
+    so.filters.push_back(drivers::CanFilter{id(m), 0x7FF, false});
+  return drivers::SocketCanBus::open(so);
+}
+
+// broadcast_options: [can] as the broadcaster takes it (rates as loop-tick divisors).
+CanBroadcastOptions broadcast_options(const CanSection& s, double loop_hz, bool virtual_time) {
+  CanBroadcastOptions o;
+  o.base_id = static_cast<std::uint32_t>(s.base_id);
+  o.node_id = s.node_id;
+  o.set_pose = s.set_pose;
+  o.lossless_log = virtual_time;
+  auto div = [&](double hz) {
+    const std::int64_t d = protocol::divisor_for(loop_hz, hz);
+    return d > 0 ? static_cast<std::uint32_t>(d) : 0u;
+  };
+  o.div = CanDivisors{div(s.pose_hz), div(s.velocity_hz), div(s.uncertainty_hz), div(s.status_hz),
+                      div(s.timing_hz)};
+  return o;
+}
+
+}  // namespace
+
 CanLink::~CanLink() {
   if (log_) log_->stop();
 }
@@ -316,19 +318,7 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
   }
   std::string iface;
   if (s.bus == CanBusKind::kSocketCan) {
-    drivers::SocketCanOptions so;
-    so.interface = s.interface;
-    so.reopen_period = s.reopen_period;
-    if (s.set_pose)
-      so.filters.push_back(
-          drivers::CanFilter{protocol::frame_id(static_cast<std::uint32_t>(s.base_id), s.node_id,
-                                                protocol::Msg::kSetPose),
-                             0x7FF, false});
-    // Absolute fixes for self-calibration (dropped unless [selfcal] is enabled).
-    for (const protocol::Msg m : {protocol::Msg::kFixPose, protocol::Msg::kFixSigma})
-      so.filters.push_back(drivers::CanFilter{
-          protocol::frame_id(static_cast<std::uint32_t>(s.base_id), s.node_id, m), 0x7FF, false});
-    auto bus = drivers::SocketCanBus::open(so);
+    auto bus = open_socket_bus(s);
     if (!bus) return std::move(bus).error();
     link->bus_ = std::move(bus).value();
     iface = s.interface;
@@ -344,17 +334,7 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
     if (!w) return std::move(w).error();
     link->log_ = std::move(w).value();
   }
-  CanBroadcastOptions o;
-  o.base_id = static_cast<std::uint32_t>(s.base_id);
-  o.node_id = s.node_id;
-  o.set_pose = s.set_pose;
-  o.lossless_log = virtual_time;
-  auto div = [&](double hz) {
-    const std::int64_t d = protocol::divisor_for(loop_hz, hz);
-    return d > 0 ? static_cast<std::uint32_t>(d) : 0u;
-  };
-  o.div = CanDivisors{div(s.pose_hz), div(s.velocity_hz), div(s.uncertainty_hz), div(s.status_hz),
-                      div(s.timing_hz)};
+  const CanBroadcastOptions o = broadcast_options(s, loop_hz, virtual_time);
   link->bc_ = std::make_unique<CanBroadcaster>(o, *link->bus_, &loop.commands(),
                                                link->log_ ? &link->log_->ring() : nullptr);
   if (!loop.add_observer(link->bc_.get()))

@@ -248,29 +248,24 @@ void read_selfcal(TableReader t, SelfCalSection& s) {
 // The numeric keys of [gyro] and their ranges: the one table the reader takes them from.
 struct GyroRange {
   const char* key;
+  double GyroSection::*member;
   double lo, hi;
   const char* unit;
 };
 constexpr GyroRange kGyroRanges[] = {
-    {"rate", 0.0, 100000.0, "Hz"},
-    {"stale_timeout", 0.001, 10.0, "s"},
-    {"noise_density", 0.0, 0.1, "rad/s/sqrt(Hz)"},
-    {"bias_instability", 0.0, 0.1, "rad/s"},
-    {"scale_tolerance", 0.0, 0.5, ""},
-    {"delay", 0.0, 1.0, "s"},
-    {"window", 0.01, 10.0, "s"},
-    {"k_sigma", 1.0, 20.0, ""},
-    {"max_wheel_speed", 0.01, 100.0, "m/s"},
-    {"max_wheel_accel", 0.01, 1000.0, "m/s^2"},
-    {"still_time", 0.01, 60.0, "s"},
-    {"bias_tau", 0.01, 86400.0, "s"},
+    {"rate", &GyroSection::rate, 0.0, 100000.0, "Hz"},
+    {"stale_timeout", &GyroSection::stale_timeout, 0.001, 10.0, "s"},
+    {"noise_density", &GyroSection::noise_density, 0.0, 0.1, "rad/s/sqrt(Hz)"},
+    {"bias_instability", &GyroSection::bias_instability, 0.0, 0.1, "rad/s"},
+    {"scale_tolerance", &GyroSection::scale_tolerance, 0.0, 0.5, ""},
+    {"delay", &GyroSection::delay, 0.0, 1.0, "s"},
+    {"window", &GyroSection::window, 0.01, 10.0, "s"},
+    {"k_sigma", &GyroSection::k_sigma, 1.0, 20.0, ""},
+    {"max_wheel_speed", &GyroSection::max_wheel_speed, 0.01, 100.0, "m/s"},
+    {"max_wheel_accel", &GyroSection::max_wheel_accel, 0.01, 1000.0, "m/s^2"},
+    {"still_time", &GyroSection::still_time, 0.01, 60.0, "s"},
+    {"bias_tau", &GyroSection::bias_tau, 0.01, 86400.0, "s"},
 };
-
-double gyro_number(TableReader& t, std::string_view key, double def) {
-  for (const GyroRange& r : kGyroRanges)
-    if (key == r.key) return t.number(key, def, r.lo, r.hi, r.unit);
-  return def;  // not reached: every key passed here is in the table
-}
 
 void read_gyro(TableReader t, GyroSection& s) {
   s.backend = t.choice("backend", s.backend);
@@ -282,22 +277,12 @@ void read_gyro(TableReader t, GyroSection& s) {
              "= 0 must be +1 (the chip axis points up, along the robot's z) or -1 "
              "(mounted upside down)");
   s.mode = t.choice("mode", s.mode);
-  s.rate = gyro_number(t, "rate", s.rate);
   s.trigger = t.string("trigger", s.trigger);
   s.buffer_length = static_cast<int>(t.integer("buffer_length", s.buffer_length, 2, 65536));
-  s.stale_timeout = gyro_number(t, "stale_timeout", s.stale_timeout);
   s.model = t.choice("model", s.model);
   s.seed = t.integer("seed", s.seed, 0, INT64_MAX);
-  s.noise_density = gyro_number(t, "noise_density", s.noise_density);
-  s.bias_instability = gyro_number(t, "bias_instability", s.bias_instability);
-  s.scale_tolerance = gyro_number(t, "scale_tolerance", s.scale_tolerance);
-  s.delay = gyro_number(t, "delay", s.delay);
-  s.window = gyro_number(t, "window", s.window);
-  s.k_sigma = gyro_number(t, "k_sigma", s.k_sigma);
-  s.max_wheel_speed = gyro_number(t, "max_wheel_speed", s.max_wheel_speed);
-  s.max_wheel_accel = gyro_number(t, "max_wheel_accel", s.max_wheel_accel);
-  s.still_time = gyro_number(t, "still_time", s.still_time);
-  s.bias_tau = gyro_number(t, "bias_tau", s.bias_tau);
+  for (const GyroRange& r : kGyroRanges)
+    s.*r.member = t.number(r.key, s.*r.member, r.lo, r.hi, r.unit);
   if (s.bias_tau < s.still_time)
     t.reject("bias_tau", "= " + std::to_string(s.bias_tau) + " s must be at least still_time (" +
                              std::to_string(s.still_time) + " s)");

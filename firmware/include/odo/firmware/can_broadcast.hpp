@@ -19,6 +19,7 @@
 #include "odo/loop/command.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/loop/recording_encoder.hpp"
+#include "odo/loop/spsc_ring.hpp"
 #include "odo/protocol/can_protocol.hpp"
 #include "odo/protocol/candump_log.hpp"
 
@@ -28,27 +29,10 @@ class SimCanPort;
 
 namespace odo::fw {
 
-// CanFrameRing: single-producer (loop thread) single-consumer (log thread) ring of frames,
-// allocated once; a full ring drops the frame and counts it.
-class CanFrameRing {
- public:
-  explicit CanFrameRing(std::size_t capacity_pow2 = 4096);
-  // push: loop thread; false (and counted) when full.
-  bool push(const CanFrame& f) noexcept;
-  // push_wait: loop thread in virtual time only (no deadlines to keep): waits for space, so a
-  // run faster than real time loses no frame from the log.
-  void push_wait(const CanFrame& f) noexcept;
-  // pop: consumer thread; false when empty.
-  bool pop(CanFrame& out) noexcept;
-  std::uint64_t dropped() const noexcept { return dropped_.load(std::memory_order_relaxed); }
-
- private:
-  std::vector<CanFrame> buf_;
-  std::size_t mask_;
-  std::atomic<std::uint64_t> head_{0};  // next write (producer)
-  std::atomic<std::uint64_t> tail_{0};  // next read (consumer)
-  std::atomic<std::uint64_t> dropped_{0};
-};
+// CanFrameRing: the loop thread's frames to the log thread, allocated once; a full ring drops
+// the frame and counts it.
+using CanFrameRing = loop::SpscRing<CanFrame>;
+inline constexpr std::size_t kCanLogRingFrames = 4096;  // 24 s of the default broadcast
 
 // CanLogWriter: drains a CanFrameRing into a candump -L file from its own thread (every 20 ms),
 // so the loop never does file I/O. Frame stamps are loop time [ns]; the wall-clock time of loop
@@ -71,7 +55,7 @@ class CanLogWriter {
   std::FILE* file_;
   std::vector<char> buffer_;  // stdio buffer, allocated at open: fwrite never allocates
   std::string iface_;
-  CanFrameRing ring_;
+  CanFrameRing ring_{kCanLogRingFrames};
   std::int64_t epoch_ns_ = 0;
   std::atomic<bool> stop_{false};
   std::thread thread_;

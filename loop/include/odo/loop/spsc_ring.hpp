@@ -1,12 +1,13 @@
 // SpscRing: a bounded single-producer single-consumer ring of trivially copyable values,
 // allocated once at configure time; push and pop never allocate, lock or wait. A full ring
 // drops the value and counts it. Carries the self-calibration record (count segments, fixes)
-// from the loop thread to the estimator thread.
+// from the loop thread to the estimator thread, and the CAN frames to the candump log writer.
 #pragma once
 
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -37,6 +38,13 @@ class SpscRing {
     buf_[h & mask_] = v;
     head_.store(h + 1, std::memory_order_release);
     return true;
+  }
+  // push_wait: producer thread in virtual time only (no deadlines to keep): waits for space, so
+  // a run faster than real time loses no value.
+  void push_wait(const T& v) noexcept {
+    while (head_.load(std::memory_order_relaxed) - tail_.load(std::memory_order_acquire) > mask_)
+      std::this_thread::yield();
+    push(v);
   }
   // pop: consumer thread; false when empty.
   bool pop(T& out) noexcept {
