@@ -146,6 +146,28 @@ run "$ODOMCTL" umbmark record --csv "$tmp/no/dir/r.csv" --can-log "$tmp/still.lo
   --answers "$tmp/one.txt" >"$tmp/out" 2>"$tmp/err"
 [ $? = 2 ] && [ "$(wc -l <"$tmp/err")" = 1 ] && [ ! -s "$tmp/out" ]
 check "record --csv unwritable: exit 2 before the first question: $(cat "$tmp/err")" $?
+# --bumps: the extended-UMBmark runs follow the plain ones and need the heading. With the robot
+# standing still, etheta is the typed heading: plain cw 1.0, ccw -0.5 deg; bumps cw 3.0, ccw -2.0
+# deg, so eps_theta,nonsys = |3.0 - 1.0| + |-2.0 - (-0.5)| = 3.5 deg = 0.0610865 rad.
+printf '500\n300\n\n\n500\n300\n%s\n' 1.0 -0.5 3.0 -2.0 >"$tmp/bumps.txt"
+run "$ODOMCTL" umbmark record --csv "$tmp/rb.csv" --can-log "$tmp/still.log" --wheelbase 0.34 \
+  --runs 1 --bumps --answers "$tmp/bumps.txt" --out "$tmp/rb.json" >"$tmp/sb" 2>"$tmp/eb"
+rc=$?
+[ $rc = 0 ] && grep -q "^Run 3 of 4: cw (clockwise, turning right), with bumps" "$tmp/sb" &&
+  [ "$(cut -d, -f5 "$tmp/rb.csv" | tr '\n' ' ')" = "bumps 0 0 1 1 " ] &&
+  python3 -c "import json,sys; e=json.load(open(sys.argv[1]))['eps_theta_nonsys']; sys.exit(abs(e-0.0610865)>1e-6)" "$tmp/rb.json"
+check "record --bumps: 2 + 2 runs, eps_theta,nonsys 3.5 deg: rc $rc $(grep eps_theta "$tmp/sb")" $?
+# A bump run without the heading: the scripted answer is refused with file:line, the plain runs
+# stay saved.
+printf '500\n300\n\n\n500\n300\n%s\n' 1.0 -0.5 >"$tmp/nohead.txt"
+printf '500\n300\n\n\n500\n300\n\n' >>"$tmp/nohead.txt"
+run "$ODOMCTL" umbmark record --csv "$tmp/rn.csv" --can-log "$tmp/still.log" --wheelbase 0.34 \
+  --runs 1 --bumps --answers "$tmp/nohead.txt" >/dev/null 2>"$tmp/en"
+rc=$?
+[ $rc = 1 ] && grep -q "nohead.txt:21: '' is not a number in \[-180, 180\]" "$tmp/en" &&
+  [ "$(wc -l <"$tmp/rn.csv")" = 3 ]
+check "record --bumps: a bump run needs the heading (file:line): $(head -1 "$tmp/en")" $?
+
 # Where the poses come from: one source is needed; --config takes the daemon's [can] interface,
 # and a daemon config that broadcasts on no interface is said before the first question.
 run "$ODOMCTL" umbmark record --csv "$tmp/r3.csv" --wheelbase 0.34 --answers "$tmp/one.txt" \
