@@ -77,7 +77,9 @@ TEST(Threads, DaemonRealTimeWithStatusThreadStopsOnFlag) {
   std::ostringstream out, err;
   int rc = -1;
   std::thread daemon([&] { rc = fw::run_daemon(o, stop, out, err); });
-  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  // 2 s of wall time: under qemu-user beside another test, the daemon's start-up (config, store,
+  // threads) took most of an earlier 0.7 s and the loop ran only 25-32 ticks (armhf, 2026-11-24).
+  std::this_thread::sleep_for(std::chrono::seconds(2));
   stop = true;
   daemon.join();
   ASSERT_EQ(rc, 0) << err.str();
