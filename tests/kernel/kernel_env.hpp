@@ -4,7 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 namespace odo::test {
@@ -13,6 +18,26 @@ namespace odo::test {
 inline bool in_vm() {
   const char* v = std::getenv("ODO_IN_VM");
   return v != nullptr && std::string(v) == "1";
+}
+
+// slurp: the whole content of a file ("" when it cannot be read).
+inline std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// spawn: runs `cmd` through sh in the background, in a process group of its own (kill(-pid, ...)
+// stops it with its children); returns its pid.
+inline pid_t spawn(const std::string& cmd) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    setpgid(0, 0);
+    execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
 }
 
 // run: a shell command in the guest; returns its exit status.
