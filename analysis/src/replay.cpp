@@ -43,7 +43,8 @@ class Fuser {
     in.wheelbase = k_.wheelbase();
     in.gyro.rate_z = gyro_z;
     in.gyro.samples = 1;
-    odom_.update_fused(dl, dr, dt, fusion_->step(in).dtheta);
+    const FusedTick f = fusion_->step(in);
+    odom_.update_fused(dl, dr, dt, f.dtheta, f.ds);
     return Ok{};
   }
   void finish(ReplayResult& r) const {

@@ -259,6 +259,7 @@ constexpr GyroRange kGyroRanges[] = {
     {"bias_instability", &GyroSection::bias_instability, 0.0, 0.1, "rad/s"},
     {"scale_tolerance", &GyroSection::scale_tolerance, 0.0, 0.5, ""},
     {"delay", &GyroSection::delay, 0.0, 1.0, "s"},
+    {"delay_tolerance", &GyroSection::delay_tolerance, 0.0, 1.0, "s"},
     {"window", &GyroSection::window, 0.01, 10.0, "s"},
     {"k_sigma", &GyroSection::k_sigma, 1.0, 20.0, ""},
     {"max_wheel_speed", &GyroSection::max_wheel_speed, 0.01, 100.0, "m/s"},

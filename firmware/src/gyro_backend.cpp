@@ -55,15 +55,19 @@ GyrodometryParams gyrodometry_params(const GyroSection& g) {
   if (g.backend == GyroBackend::kSim) {
     const sim::GyroModel m = sim_model(g);
     // The model's bias random walk K moves the bias by K sqrt(100 s) in 100 s: its instability
-    // as the data sheet states it (sim_gyro.hpp); its delay plus half a sample period.
+    // as the data sheet states it (sim_gyro.hpp). Its delay as it is: a sample covers the period
+    // before its time and is available `delay` later, and a tick's rate is the mean of the
+    // samples that became available in it, so the mean lags the tick by `delay` (on average;
+    // exactly when the samples are aligned with the ticks, as in the simulator).
     p.noise.rate_noise_density = m.noise_density;
     p.noise.bias_instability = m.bias_walk * 10.0;
-    p.gyro_delay = m.delay + 0.5 / m.odr;
+    p.gyro_delay = m.delay;
   }
   p.noise.rate_noise_density = or_model(g.noise_density, p.noise.rate_noise_density);
   p.noise.bias_instability = or_model(g.bias_instability, p.noise.bias_instability);
   p.noise.scale_tolerance = or_model(g.scale_tolerance, p.noise.scale_tolerance);
   p.gyro_delay = or_model(g.delay, p.gyro_delay);
+  p.delay_tolerance = g.delay_tolerance;
   p.window = g.window;
   p.k_sigma = g.k_sigma;
   p.max_wheel_speed = g.max_wheel_speed;

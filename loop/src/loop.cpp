@@ -24,6 +24,9 @@ Result<std::unique_ptr<OdometryLoop>> OdometryLoop::create(const LoopConfig& cfg
   std::optional<Gyrodometry> fusion;
   if (gyro != nullptr) {
     GyrodometryParams p = cfg.gyrodometry;
+    // Odometry's own noise is the one the covariance uses: the fusion's threshold and the pose's
+    // uncertainty read the same k_L, k_R.
+    p.odometry_noise = cfg.error_model;
     p.tick = to_seconds(period);
     // One count on each wheel: the resolution of odometry's heading over any window.
     p.heading_quantum = (k.metres_per_count_left() + k.metres_per_count_right()) / k.wheelbase();
@@ -169,7 +172,7 @@ void OdometryLoop::integrate_fused(std::int64_t dl, std::int64_t dr, double dt,
   in.gyro = g;
   const FusedTick f = fusion_->step(in);
   last_fusion_flags_ = f.flags;
-  odom_.advance_fused(dl, dr, dt, f.dtheta, (f.flags & kFusionGyroUsed) != 0, f.var_heading);
+  odom_.advance_fused(dl, dr, dt, f.dtheta, f.ds, (f.flags & kFusionGyroUsed) != 0, f.var_heading);
 }
 
 void OdometryLoop::record_wakeup(TimeNs latency) noexcept {

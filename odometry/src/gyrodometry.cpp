@@ -50,6 +50,7 @@ Status check_gyrodometry(const GyrodometryParams& p) {
       {"window", p.window, 2.0 * p.tick, std::max(10.0, 2.0 * p.tick), false},
       {"k_sigma", p.k_sigma, 1.0, 20.0, false},
       {"gyro_delay", p.gyro_delay, 0.0, 1.0, false},
+      {"delay_tolerance", p.delay_tolerance, 0.0, 1.0, false},
       {"heading_quantum", p.heading_quantum, 0.0, 0.1, false},
       {"max_wheel_speed", p.max_wheel_speed, 0.0, 100.0, true},
       {"max_wheel_accel", p.max_wheel_accel, 0.0, 1000.0, true},
@@ -62,9 +63,10 @@ Status check_gyrodometry(const GyrodometryParams& p) {
   for (const Bound& b : table) {
     if (auto s = check_bound(b); !s) return s;
   }
-  if (p.window / p.tick > 100000.0)
-    return make_error(Errc::kInvalidArgument,
-                      "gyrodometry window / tick must not exceed 100000 ticks");
+  if (p.window / p.tick > 100000.0 || p.gyro_delay / p.tick > 100000.0)
+    return make_error(
+        Errc::kInvalidArgument,
+        "gyrodometry window / tick and gyro_delay / tick must not exceed 100000 ticks");
   return Ok{};
 }
 
@@ -75,13 +77,22 @@ Result<Gyrodometry> Gyrodometry::create(const GyrodometryParams& p) {
 
 Gyrodometry::Gyrodometry(const GyrodometryParams& p) : p_(p) {
   // An even number of ticks, so the window splits into two equal halves for accelerations.
-  const auto half = static_cast<std::size_t>(std::max(1.0, std::round(0.5 * p.window / p.tick)));
-  half_ = half;
-  ring_.assign(2 * half, Entry{});
-  const double t_w = static_cast<double>(ring_.size()) * p.tick;
+  half_ = static_cast<std::size_t>(std::max(1.0, std::round(0.5 * p.window / p.tick)));
+  n_ = 2 * half_;
+  // d = m tick - g tick. The 1e-9 keeps a delay of whole ticks (2 ms at 1 kHz: 1.9999999999999998
+  // ticks in doubles) from becoming m = 3, g = 0.9999999999999998.
+  const double ticks = p.gyro_delay / p.tick;
+  m_ = static_cast<std::size_t>(std::ceil(ticks - 1e-9));
+  g_ = std::max(0.0, static_cast<double>(m_) - ticks);
+  // The window, the two ticks beyond its old edge (J_old there), and odometry m ticks back.
+  ring_.assign(std::max(n_ + 2, m_ + 1), Entry{});
+  const double t_w = static_cast<double>(n_) * p.tick;
   noise_term_ = p.k_sigma * p.noise.rate_noise_density * std::sqrt(t_w);
+  gyro_var_ = p.noise.rate_noise_density * p.noise.rate_noise_density * t_w;
+  k2_left_ = p.odometry_noise.k_left * p.odometry_noise.k_left;
+  k2_right_ = p.odometry_noise.k_right * p.odometry_noise.k_right;
+  delay_per_tick_ = p.delay_tolerance / p.tick;
   const double t_h = static_cast<double>(half_) * p.tick;
-  inv_t_h_ = 1.0 / t_h;
   v_max_tick_ = p.max_wheel_speed * p.tick;
   dv_max_ = p.max_wheel_accel * t_h * t_h;  // in metres of half-window travel
   update_b_res();
@@ -92,7 +103,7 @@ void Gyrodometry::update_b_res() noexcept {
   b_res_ = p_.noise.bias_instability +
            p_.noise.rate_noise_density / std::sqrt(std::max(bias_time_, p_.still_time));
   // The part of T that does not change from tick to tick while moving.
-  const double t_w = static_cast<double>(ring_.size()) * p_.tick;
+  const double t_w = static_cast<double>(n_) * p_.tick;
   base_threshold_ = p_.heading_quantum + noise_term_ + b_res_ * t_w;
 }
 
@@ -103,35 +114,55 @@ void Gyrodometry::reset() noexcept {
   resum();
   in_interval_ = false;
   interval_ticks_ = 0;
+  hold_ = 0;
   still_for_ = 0.0;
 }
 
-Gyrodometry::Entry& Gyrodometry::at(std::size_t age) noexcept {
+std::size_t Gyrodometry::index(std::size_t age) const noexcept {
   // age < ring size: one conditional wrap instead of a division.
-  return ring_[head_ >= age ? head_ - age : head_ + ring_.size() - age];
+  return head_ >= age ? head_ - age : head_ + ring_.size() - age;
 }
 
 double Gyrodometry::threshold() const noexcept {
-  // Change of the rate of turn across the window: the halves' mean rates differ by half of it
-  // on a steady ramp.
-  const double turn_new = sum_new_r_ - sum_new_l_, turn_old = sum_old_r_ - sum_old_l_;
-  const double d_omega =
-      filled_ == ring_.size() ? 2.0 * std::fabs(turn_new - turn_old) * inv_t_h_ / wheelbase_ : 0.0;
-  return base_threshold_ + p_.noise.scale_tolerance * std::fabs(sum_odo_) + p_.gyro_delay * d_omega;
+  // The two sensors' random errors are independent: their variances add (sum_var_ is never
+  // negative in exact arithmetic; the running sum's rounding could make it -1e-20).
+  const double random = p_.k_sigma * std::sqrt(gyro_var_ + std::max(0.0, sum_var_)) - noise_term_;
+  return base_threshold_ + random + p_.noise.scale_tolerance * std::fabs(sum_odo_) + edge_bounds();
+}
+
+double Gyrodometry::edge_bounds() const noexcept {
+  // Before the ring is full the edges' neighbours are missing; step() compares only full rings.
+  if (filled_ < ring_.size()) return 0.0;
+  const Entry &g0 = at(0), &g1 = at(1);
+  const Entry &gn1 = at(n_ - 1), &gn = at(n_), &gn2 = at(n_ + 1);
+  double e = delay_per_tick_ * std::fabs(g0.gyro - gn.gyro);
+  if (g_ == 0.0) return e;  // both points are tick boundaries: nothing is interpolated
+  const double p = 1.0 - g_;
+  e += p * std::fabs(g0.gyro - g1.gyro);  // the newest edge: only the older neighbour exists
+  // The old edge: the tighter of the two bounds; a neighbour without a usable increment (its
+  // stored 0 is no rate) leaves the other one.
+  const double by_old = gn2.gyro_ok ? p * std::fabs(gn.gyro - gn2.gyro) : HUGE_VAL;
+  const double by_new = g_ * std::fabs(gn1.gyro - gn.gyro);
+  return e + std::min(by_old, by_new);
+}
+
+void Gyrodometry::add_to_window(const Entry& e, double sign) noexcept {
+  sum_odo_ += sign * e.odo_cmp;
+  sum_var_ += sign * e.var_cmp;
+  if (e.err_ok)
+    sum_err_ += sign * e.err;
+  else
+    bad_ = sign > 0.0 ? bad_ + 1 : bad_ - 1;
 }
 
 void Gyrodometry::resum() noexcept {
   // Re-add the window from the ring so that the running sums' rounding cannot accumulate.
-  sum_err_ = sum_odo_ = 0.0;
+  sum_err_ = sum_odo_ = sum_var_ = 0.0;
   sum_new_l_ = sum_new_r_ = sum_old_l_ = sum_old_r_ = 0.0;
   bad_ = 0;
-  for (std::size_t age = 0; age < filled_; ++age) {
+  for (std::size_t age = 0; age < std::min(filled_, n_); ++age) {
     const Entry& e = at(age);
-    sum_odo_ += e.odo;
-    if (e.gyro_ok)
-      sum_err_ += e.gyro - e.odo;
-    else
-      ++bad_;
+    add_to_window(e, 1.0);
     if (age < half_) {
       sum_new_l_ += e.d_left;
       sum_new_r_ += e.d_right;
@@ -142,36 +173,41 @@ void Gyrodometry::resum() noexcept {
   }
 }
 
+void Gyrodometry::align(Entry& e) noexcept {
+  // The newest entry is in the ring (age 0): its aligned gyro increment and odometry's of m ticks
+  // ago (see the top of gyrodometry.hpp). Comparable only when everything it reads is there.
+  const Entry& prev = at(1);
+  const bool have = filled_ > std::max<std::size_t>(m_, 1);
+  e.odo_cmp = have ? at(m_).odo : 0.0;
+  e.var_cmp = have ? at(m_).var : 0.0;
+  e.err_ok = have && e.gyro_ok && (g_ == 0.0 || prev.gyro_ok);
+  e.err = e.err_ok ? (1.0 - g_) * e.gyro + g_ * prev.gyro - e.odo_cmp : 0.0;
+}
+
 void Gyrodometry::push(const Entry& e) noexcept {
-  const std::size_t n = ring_.size();
-  const std::size_t next = head_ + 1 == n ? 0 : head_ + 1;
-  if (filled_ == n) {  // the oldest entry (older half) leaves the window
-    const Entry& old = ring_[next];
-    sum_odo_ -= old.odo;
-    if (old.gyro_ok)
-      sum_err_ -= old.gyro - old.odo;
-    else
-      --bad_;
-    sum_old_l_ -= old.d_left;
-    sum_old_r_ -= old.d_right;
-  }
-  if (filled_ >= half_) {  // the entry of age half_ - 1 moves from the newer to the older half
-    const Entry& mid = at(half_ - 1);
+  const std::size_t size = ring_.size();
+  const std::size_t next = head_ + 1 == size ? 0 : head_ + 1;
+  ring_[next] = e;
+  head_ = next;
+  if (filled_ < size) ++filled_;
+  Entry& fresh = ring_[head_];
+  align(fresh);
+  add_to_window(fresh, 1.0);
+  sum_new_l_ += fresh.d_left;
+  sum_new_r_ += fresh.d_right;
+  if (filled_ > half_) {  // the entry now of age half_ moves from the newer to the older half
+    const Entry& mid = at(half_);
     sum_new_l_ -= mid.d_left;
     sum_new_r_ -= mid.d_right;
     sum_old_l_ += mid.d_left;
     sum_old_r_ += mid.d_right;
   }
-  ring_[next] = e;
-  head_ = next;
-  if (filled_ < n) ++filled_;
-  sum_odo_ += e.odo;
-  if (e.gyro_ok)
-    sum_err_ += e.gyro - e.odo;
-  else
-    ++bad_;
-  sum_new_l_ += e.d_left;
-  sum_new_r_ += e.d_right;
+  if (filled_ > n_) {  // the entry now of age n leaves the window (older half)
+    const Entry& old = at(n_);
+    add_to_window(old, -1.0);
+    sum_old_l_ -= old.d_left;
+    sum_old_r_ -= old.d_right;
+  }
   // Re-sum every kResumWraps passes of the ring: the running sums' rounding stays far below a
   // count (1e-16 relative per addition, a few thousand additions), at 1/16 of the cost.
   if (head_ == 0 && ++wraps_ % kResumWraps == 0) resum();
@@ -229,14 +265,38 @@ double Gyrodometry::begin_interval() noexcept {
   // Replace every tick of the window that odometry still supplies: the disturbance began at most
   // a window ago, and detection waited for it to grow beyond the threshold.
   double correction = 0.0;
-  for (std::size_t age = 0; age < filled_; ++age) {
+  for (std::size_t age = 0; age < std::min(filled_, n_); ++age) {
     Entry& e = at(age);
-    if (e.replaced || !e.gyro_ok) continue;
-    correction += e.gyro - e.odo;
+    if (e.replaced || !e.err_ok) continue;
+    correction += e.err;
     e.replaced = true;
     ++interval_ticks_;
   }
   return correction;
+}
+
+Gyrodometry::Entry Gyrodometry::entry(const FusionInput& in, double odo, bool usable,
+                                      double dt) const noexcept {
+  Entry e;
+  e.odo = odo;
+  e.d_left = in.d_left;
+  e.d_right = in.d_right;
+  // Chong-Kleeman: wheel variances k^2 |d|; the heading difference divides by b twice.
+  e.var = (k2_left_ * std::fabs(in.d_left) + k2_right_ * std::fabs(in.d_right)) /
+          (in.wheelbase * in.wheelbase);
+  e.gyro_ok = usable;
+  e.raw = usable ? (in.gyro.rate_z - bias_) * dt : 0.0;
+  e.gyro = scale_ * e.raw;
+  return e;
+}
+
+std::uint32_t Gyrodometry::disagree_flag() const noexcept {
+  // Only full rings are compared (edge_bounds needs the ticks beyond the window's old edge);
+  // T >= base_threshold_: most ticks are decided without the window-dependent terms.
+  const double abs_err = std::fabs(sum_err_);
+  const bool flag =
+      bad_ == 0 && filled_ == ring_.size() && abs_err > base_threshold_ && abs_err > threshold();
+  return flag ? kFusionDisagree : 0u;
 }
 
 FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
@@ -260,24 +320,22 @@ FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
   update_bias(in, rate_ok, still, dt);
   const bool usable = rate_ok && bias_valid();
   if (!bias_valid()) out.flags |= kFusionNoBias;
-  Entry e;
-  e.odo = odo;
-  e.d_left = in.d_left;
-  e.d_right = in.d_right;
-  e.gyro_ok = usable;
-  const double raw = usable ? (in.gyro.rate_z - bias_) * dt : 0.0;
-  e.gyro = scale_ * raw;
-  push(e);
+  push(entry(in, odo, usable, dt));
   if (!usable) {
     in_interval_ = false;  // a faulty gyro ends any flagged interval: odometry from here on
+    hold_ = 0;
     return out;
   }
-  if (scale_estimation_ && !in_interval_) update_scale(odo, raw, dt);
-  std::uint32_t why = limit_flags();
-  // T >= base_threshold_: most ticks are decided without the window-dependent terms.
-  const double abs_err = std::fabs(sum_err_);
-  if (bad_ == 0 && abs_err > base_threshold_ && abs_err > threshold()) why |= kFusionDisagree;
-  if (why == 0) {
+  const Entry& fresh = ring_[head_];
+  if (scale_estimation_ && !in_interval_ && fresh.err_ok)
+    update_scale(fresh.odo_cmp, (1.0 - g_) * fresh.raw + g_ * at(1).raw, dt);
+  const std::uint32_t limits = limit_flags();
+  const std::uint32_t why = limits | disagree_flag();
+  // A tick beyond the kinematic limits is odometry's age 0, but the gyro replaces odometry m
+  // ticks late: the interval lasts at least until that tick has been replaced.
+  const bool hold = in_interval_ && hold_ > 0;
+  hold_ = limits != 0 ? m_ : (hold_ > 0 ? hold_ - 1 : 0);
+  if (why == 0 && !hold) {
     in_interval_ = false;
     return out;
   }
@@ -285,7 +343,7 @@ FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
   if (!in_interval_) {
     open_interval(why, odo, dt, out);
   } else {
-    continue_interval(e.gyro, dt, out);
+    continue_interval(odo, fresh.err, dt, out);
   }
   return out;
 }
@@ -297,7 +355,12 @@ void Gyrodometry::open_interval(std::uint32_t why, double odo, double dt, FusedT
   counters_.disagreements += (why & kFusionDisagree) != 0 ? 1 : 0;
   counters_.speed_events += (why & kFusionSpeedLimit) != 0 ? 1 : 0;
   counters_.accel_events += (why & kFusionAccelLimit) != 0 ? 1 : 0;
-  out.dtheta = odo + begin_interval();
+  const double c = begin_interval();
+  out.dtheta = odo + c;
+  interval_c_ = interval_ds_ = 0.0;
+  interval_l_ = sum_new_l_ + sum_old_l_;
+  interval_r_ = sum_new_r_ + sum_old_r_;
+  out.ds = travel_step(c);
   // m ticks of gyro at once: white noise N^2 m dt, the bias error's (b_res m dt)^2.
   const double n2 = p_.noise.rate_noise_density * p_.noise.rate_noise_density;
   const double t = static_cast<double>(interval_ticks_) * dt;
@@ -305,15 +368,36 @@ void Gyrodometry::open_interval(std::uint32_t why, double odo, double dt, FusedT
   counters_.flagged_ticks += interval_ticks_;
 }
 
-void Gyrodometry::continue_interval(double gyro, double dt, FusedTick& out) noexcept {
+void Gyrodometry::continue_interval(double odo, double err, double dt, FusedTick& out) noexcept {
   ring_[head_].replaced = true;
-  out.dtheta = gyro;
+  out.dtheta = odo + err;
+  interval_l_ += ring_[head_].d_left;
+  interval_r_ += ring_[head_].d_right;
+  out.ds = travel_step(err);
   // Tick k of an interval: the bias part (b_res k dt)^2 grows by b_res^2 dt^2 (2k + 1).
   const double n2 = p_.noise.rate_noise_density * p_.noise.rate_noise_density;
   const double k = static_cast<double>(interval_ticks_);
   out.var_heading = n2 * dt + b_res_ * b_res_ * dt * dt * (2.0 * k + 1.0);
   ++interval_ticks_;
   ++counters_.flagged_ticks;
+}
+
+double Gyrodometry::travel_step(double c) noexcept {
+  // Attributed on the interval's whole correction, not tick by tick: a tick's noise would pick a
+  // wheel by its sign and always shorten the travel. The interval's wheel travels tell which
+  // wheel could have over-counted by b |c| (see the top of gyrodometry.hpp): the excess must
+  // point the way that wheel moved and not exceed its travel.
+  interval_c_ += c;
+  const double e_l = wheelbase_ * interval_c_, e_r = -e_l;
+  const bool left =
+      e_l != 0.0 && (e_l > 0.0) == (interval_l_ > 0.0) && std::fabs(e_l) <= std::fabs(interval_l_);
+  const bool right =
+      e_r != 0.0 && (e_r > 0.0) == (interval_r_ > 0.0) && std::fabs(e_r) <= std::fabs(interval_r_);
+  // Neither, or both (a turn on the spot): no way to choose, no travel correction.
+  const double total = left == right ? 0.0 : -0.5 * (left ? e_l : e_r);
+  const double step = total - interval_ds_;
+  interval_ds_ = total;
+  return step;
 }
 
 void propagate_gyro_arc(Cov3& cov, double sin_theta0, double cos_theta0, double ds, double dtheta,

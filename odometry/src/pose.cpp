@@ -48,19 +48,19 @@ void PoseIntegrator::step_arc(double ds, double dth) noexcept {
 void Odometry::update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
   const double d_l = static_cast<double>(dn_left) * k_.metres_per_count_left();  // Eq. 6.35
   const double d_r = static_cast<double>(dn_right) * k_.metres_per_count_right();
-  integrate(d_l, d_r, (d_r - d_l) / k_.wheelbase(), dt);
+  integrate(d_l, d_r, (d_r - d_l) / k_.wheelbase(), 0.0, dt);
 }
 
-void Odometry::update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt,
-                            double dtheta) noexcept {
+void Odometry::update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
+                            double ds_correction) noexcept {
   integrate(static_cast<double>(dn_left) * k_.metres_per_count_left(),
-            static_cast<double>(dn_right) * k_.metres_per_count_right(), dtheta, dt);
+            static_cast<double>(dn_right) * k_.metres_per_count_right(), dtheta, ds_correction, dt);
 }
 
 void Odometry::advance_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
-                             bool gyro_heading, double var_heading) noexcept {
+                             double ds_correction, bool gyro_heading, double var_heading) noexcept {
   const double s0 = sin_theta(), c0 = cos_theta();
-  update_fused(dn_left, dn_right, dt, dtheta);
+  update_fused(dn_left, dn_right, dt, dtheta, ds_correction);
   if (gyro_heading) {
     cov_.step_gyro_sc(s0, c0, d_left_, d_right_, dtheta, var_heading);
   } else {
@@ -68,10 +68,12 @@ void Odometry::advance_fused(std::int64_t dn_left, std::int64_t dn_right, double
   }
 }
 
-void Odometry::integrate(double d_l, double d_r, double dth, double dt) noexcept {
+void Odometry::integrate(double d_l, double d_r, double dth, double ds_correction,
+                         double dt) noexcept {
   d_left_ = d_l;
   d_right_ = d_r;
-  const double ds = 0.5 * (d_l + d_r);
+  // Adding 0.0 keeps update()'s value (x + 0.0 == x, except -0.0 -> +0.0, which moves nothing).
+  const double ds = 0.5 * (d_l + d_r) + ds_correction;
   integ_.step_arc(ds, dth);
   distance_ += std::fabs(ds);
   if (dt > 0.0) {

@@ -21,8 +21,8 @@ Result<std::unique_ptr<SimRun>> SimRun::create(const RobotGeometry& g, const Kin
     if (!gyro) return std::move(gyro).error();
     run->gyro_.emplace(std::move(gyro).value());
     lc.gyrodometry.noise.rate_noise_density = o.gyro->noise_density;
-    // The model's delay plus half a sample period (its samples are interval means).
-    lc.gyrodometry.gyro_delay = o.gyro->delay + 0.5 / o.gyro->odr;
+    // The model's delay as it is (see gyrodometry_params in firmware/src/gyro_backend.cpp).
+    lc.gyrodometry.gyro_delay = o.gyro->delay;
   }
   auto loop = loop::OdometryLoop::create(lc, believed, run->encoder_, run->clock_,
                                          run->gyro_ ? &*run->gyro_ : nullptr);

@@ -351,9 +351,11 @@ TEST(SimGyrodometry, AtMostOneFalseAlarmPerHour) {
 TEST(SimGyrodometry, SlipsAreDetected) {
   // 100 slips on a straight run at 0.2 m/s, one every 4 s: a random wheel turning 5-20 % faster
   // than the ground moves it for 0.1-2 s. The weakest, 5 % for 0.1 s, turns odometry's heading by
-  // 0.05 * 0.2 m/s * 0.1 s / 0.34 m = 2.9e-3 rad, above both thresholds (5.1e-4 geared,
-  // 1.8e-3 direct drive). A slip is detected when an interval starts between its start and
-  // 0.15 s after its end (window + delay); any other interval is a false alarm.
+  // 0.05 * 0.2 m/s * 0.1 s / 0.34 m = 2.9e-3 rad: above the geared threshold at 0.2 m/s (1.6e-3
+  // with odometry's own noise, gyrodometry.hpp) and level with the direct drive's (2.9e-3), so
+  // the weakest slips are the ones the direct drive can miss; a slip of 0.15 s or 7.5 % is
+  // already 1.5x its threshold. A slip is detected when an interval starts between its start
+  // and 0.15 s after its end (window + delay); any other interval is a false alarm.
   for (const double gear : {16.0, 1.0}) {
     RobotGeometry geo;
     geo.gear_ratio = gear;

@@ -118,7 +118,8 @@ TEST(Replay, GyroColumnIsFusedExactlyAsTheLoopRule) {
     in.wheelbase = k.wheelbase();
     in.gyro.rate_z = 0.01;
     in.gyro.samples = 1;
-    odom.update_fused(dl, dr, in.dt, fusion.step(in).dtheta);
+    const FusedTick f = fusion.step(in);
+    odom.update_fused(dl, dr, in.dt, f.dtheta, f.ds);
   }
   std::istringstream log(bump_log(true));
   auto fused = analysis::replay_ticks(log, "gyro.csv", k, 64, analysis::ReplayGyro{});

@@ -32,6 +32,8 @@ GyrodometryParams params(double q) {
   p.k_sigma = 5.0;
   p.heading_quantum = q;
   p.still_time = 0.5;
+  p.gyro_delay = 0.0;             // these tests' gyro is not delayed (DelayedGyro* below is)
+  p.odometry_noise = {0.0, 0.0};  // nor is odometry noisy (OdometryNoise* below is)
   return p;
 }
 
@@ -150,9 +152,12 @@ TEST(Gyrodometry, BumpReplacedOverTheWholeInterval) {
   // is 3.8235e-4, so the window crosses T = 5.0646e-4 on the bump's second tick; the correction
   // then replaces both ticks, the interval runs until the window holds at most one bump tick,
   // and every bump tick ends up with the gyro's increment 0: the fused heading stays 0.
+  // The correction, 7.647059e-3 rad, is b c = 2.6e-3 m of one wheel's travel; only the left
+  // wheel, moving forward, can have over-counted it (the right would have to be 2.6 mm short), so
+  // the centre travel loses half of it: -1.3e-3 m, the bump's 20 * 0.13 mm / 2.
   auto g = Gyrodometry::create(params(kQLabMate)).value();
   learn_bias(g, 0.01);
-  double fused = 0.0, odo = 0.0, var = 0.0;
+  double fused = 0.0, odo = 0.0, var = 0.0, ds = 0.0;
   int used = 0, starts = 0;
   for (int i = 0; i < 200; ++i) {
     const bool bump = i >= 50 && i < 70;
@@ -160,12 +165,14 @@ TEST(Gyrodometry, BumpReplacedOverTheWholeInterval) {
     fused += t.dtheta;
     odo += t.dtheta_odo;
     var += t.var_heading;
+    ds += t.ds;
     used += (t.flags & kFusionGyroUsed) != 0;
     starts += (t.flags & kFusionEventStart) != 0;
     if (i == 51) EXPECT_TRUE(t.flags & kFusionEventStart);
   }
   EXPECT_NEAR(odo, -7.647059e-3, 1e-9);
   EXPECT_NEAR(fused, 0.0, 1e-15);
+  EXPECT_NEAR(ds, -1.3e-3, 1e-15);
   EXPECT_EQ(starts, 1);
   EXPECT_EQ(g.counters().disagreements, 1u);
   // Interval: from tick 51 while the window holds 2+ bump ticks (2 * 3.8235e-4 > T), i.e. up to
@@ -280,6 +287,130 @@ TEST(Gyrodometry, ScaleFactorFromTurns) {
   EXPECT_EQ(g.counters().disagreements, 0u);
 }
 
+// A gyro whose samples lag the motion by 2 ms, read at 100 Hz: m = ceil(0.2) = 1 tick, g = 0.8.
+// The robot turns on the spot at w = 0.5 rad/s from tick 1 to tick 300 (the rate steps at tick
+// boundaries), exact odometry. Gyro tick j (ending at 10 j ms) covers the motion of
+// [10 j - 12, 10 j - 2] ms: tick 1 sees 8 ms of turning, 0.8 w dt; ticks 2..300 see w dt; tick 301
+// sees 2 ms, 0.2 w dt. The aligned increment compared with odometry's tick j - 1 is
+// 0.2 gyro_j + 0.8 gyro_j-1.
+//   tick 1: E = 0.2 * 0.8 w dt - odo_0 = 0.16 w dt = 8e-4 rad (w dt = 5e-3): the interpolation
+//           point (2 ms into gyro tick 1) is the step itself, p = 1 - g = 0.2, s = 0.2:
+//           error p (1 - s) w dt. The bound e_new = p J_old = 0.2 * |0.8 w dt - 0| is the same
+//           8e-4, and the delay term adds delta_d / tick |gyro_0 - gyro_n| = 0.05 * 0.8 w dt =
+//           2e-4: T - T_still = 1e-3 (the scale term is 0: odometry's compared tick, tick 0, is
+//           still).
+//   tick 2: err = 0.2 w dt + 0.8 * 0.8 w dt - w dt = -0.16 w dt: E = 0 (the sum telescopes).
+// Every window is within its threshold; the old comparison of the same ticks (no re-timing) sees
+// 0.8 w dt - w dt = -1e-3 against T = T_still + 2.5e-4 and flags the turn's start.
+GyrodometryParams delayed_params(double delay) {
+  GyrodometryParams p = params(kQLabMate);
+  p.tick = 0.01;
+  p.gyro_delay = delay;
+  p.delay_tolerance = 0.0005;
+  return p;
+}
+
+FusionInput input_at(double dt, double d_left, double d_right, double rate) {
+  FusionInput in = input(d_left, d_right, rate);
+  in.dt = dt;
+  return in;
+}
+
+TEST(Gyrodometry, DelayedGyroTurnIsNeverFlagged) {
+  const double w = 0.5, dt = 0.01, d = w * kB / 2.0 * dt, bias = 0.01;
+  auto g = Gyrodometry::create(delayed_params(0.002)).value();
+  EXPECT_EQ(g.delay_ticks(), 1u);
+  EXPECT_NEAR(g.gyro_weight(), 0.8, 1e-12);
+  for (int i = 0; i < 101; ++i) g.step(input_at(dt, 0.0, 0.0, bias));  // 0.5 s still + 0.51 s
+  ASSERT_TRUE(g.bias_valid());
+  for (int i = 0; i < 20; ++i) g.step(input_at(dt, 0.0, 0.0, bias));
+  const double t_still = g.threshold();
+  double fused = 0.0, odo = 0.0;
+  for (int j = 1; j <= 400; ++j) {
+    const bool turning = j <= 300;
+    const double seen = j == 1 ? 0.8 : (j <= 300 ? 1.0 : (j == 301 ? 0.2 : 0.0));
+    const FusedTick t =
+        g.step(input_at(dt, turning ? -d : 0.0, turning ? d : 0.0, seen * w + bias));
+    ASSERT_EQ(t.flags & kFusionGyroUsed, 0u) << "tick " << j;
+    fused += t.dtheta;
+    odo += t.dtheta_odo;
+    if (j == 1) {
+      EXPECT_NEAR(g.disagreement(), 8e-4, 1e-15);
+      EXPECT_NEAR(g.threshold() - t_still, 1e-3, 1e-15);
+    }
+    if (j == 2) EXPECT_NEAR(g.disagreement(), 0.0, 1e-15);
+  }
+  EXPECT_EQ(fused, odo);
+  EXPECT_EQ(g.counters().disagreements, 0u);
+
+  // The same gyro, taken as undelayed: the turn's start is a disagreement.
+  auto u = Gyrodometry::create(delayed_params(0.0)).value();
+  for (int i = 0; i < 121; ++i) u.step(input_at(dt, 0.0, 0.0, bias));
+  for (int j = 1; j <= 5; ++j) {
+    const double seen = j == 1 ? 0.8 : 1.0;
+    u.step(input_at(dt, -d, d, seen * w + bias));
+  }
+  EXPECT_EQ(u.counters().disagreements, 1u);
+}
+
+TEST(Gyrodometry, KinematicLimitTickIsReplacedOnceTheGyroCatchesUp) {
+  // 200 Hz, delay 2 ms: m = 1, g = 0.6. One tick with the left wheel at 2.4 m/s (limit 2 m/s),
+  // gyro exact (0 rate): on that tick the gyro's view of it is not there yet (its err compares
+  // odometry's previous tick, 0), so it integrates odometry's -0.011/0.34 = -0.032353 rad; the
+  // interval holds one more tick, whose err = 0 - (-0.032353) puts it back: the two ticks sum
+  // to the gyro's 0.
+  GyrodometryParams p = params(kQLabMate);
+  p.gyro_delay = 0.002;
+  auto g = Gyrodometry::create(p).value();
+  learn_bias(g, 0.0);
+  for (int i = 0; i < 40; ++i) g.step(input(0.001, 0.001, 0.0));
+  const FusedTick spike = g.step(input(0.012, 0.001, 0.0));
+  EXPECT_TRUE(spike.flags & kFusionSpeedLimit);
+  EXPECT_NEAR(spike.dtheta, -0.011 / kB, 1e-15);
+  const FusedTick next = g.step(input(0.001, 0.001, 0.0));
+  EXPECT_TRUE(next.flags & kFusionGyroUsed);
+  EXPECT_NEAR(spike.dtheta + next.dtheta, 0.0, 1e-15);
+  EXPECT_EQ(g.counters().speed_events, 1u);
+}
+
+// Odometry's own noise (Chong-Kleeman k_L = 4.0e-4, k_R = 5.8e-4 m^(1/2), the error model's
+// defaults) enters the threshold: a floor's small bumps are odometry noise, not events. Straight
+// at 1 mm a tick on both wheels, 20-tick window: odometry's heading variance over the window is
+// (k_L^2 + k_R^2) 0.02 m / b^2 = (1.6e-7 + 3.364e-7) 0.02 / 0.1156 = 8.588235e-8 rad^2, the gyro's
+// N^2 T_w = 5.970501e-9; 5 sqrt(9.185285e-8) = 1.515362e-3, so
+//   T = q + B_res T_w + 1.515362e-3 = 8.459453e-5 + 3.518492e-5 + 1.515362e-3 = 1.635141e-3 rad.
+// A 0.4 mm loss under one wheel (1.176e-3 rad) stays below it; the bump of
+// BumpReplacedOverTheWholeInterval (3.8235e-4 rad a tick) is flagged once 5 of its ticks are in
+// the window (1.912e-3 > T = 1.66e-3; 4 ticks give 1.529e-3).
+TEST(Gyrodometry, OdometryNoiseRaisesTheThreshold) {
+  GyrodometryParams p = params(kQLabMate);
+  p.odometry_noise = {4.0e-4, 5.8e-4};
+  auto g = Gyrodometry::create(p).value();
+  learn_bias(g, 0.0);
+  for (int i = 0; i < 40; ++i) g.step(input(0.001, 0.001, 0.0));
+  EXPECT_NEAR(g.threshold(), 1.635141e-3, 1e-9);
+  g.step(input(0.0006, 0.001, 0.0));  // the small bump: odometry turns by 1.176e-3 rad
+  for (int i = 0; i < 40; ++i) g.step(input(0.001, 0.001, 0.0));
+  EXPECT_EQ(g.counters().disagreements, 0u);
+  double fused = 0.0;
+  int first = -1;
+  for (int i = 0; i < 100; ++i) {
+    const bool bump = i >= 50 && i < 70;
+    const FusedTick t = g.step(input(bump ? 0.00113 : 0.001, 0.001, 0.0));
+    fused += t.dtheta;
+    if (first < 0 && (t.flags & kFusionEventStart)) first = i;
+  }
+  EXPECT_EQ(first, 54);
+  EXPECT_EQ(g.counters().disagreements, 1u);
+  EXPECT_NEAR(fused, 0.0, 1e-15);
+  // Without odometry's noise the small bump alone is an event (1.176e-3 > 5.06e-4).
+  auto h = Gyrodometry::create(params(kQLabMate)).value();
+  learn_bias(h, 0.0);
+  for (int i = 0; i < 40; ++i) h.step(input(0.001, 0.001, 0.0));
+  h.step(input(0.0006, 0.001, 0.0));
+  EXPECT_EQ(h.counters().disagreements, 1u);
+}
+
 TEST(Gyrodometry, RejectsBadParameters) {
   GyrodometryParams p = params(kQLabMate);
   p.window = std::numeric_limits<double>::quiet_NaN();
@@ -309,7 +440,7 @@ TEST(Gyrodometry, FusedUpdateIsOdometryWhenNothingIsFlagged) {
     in.gyro.flags = kGyroStale;  // odometry only
     const FusedTick t = g.step(in);
     plain.update(dl, dr, kTick);
-    fused.update_fused(dl, dr, kTick, t.dtheta);
+    fused.update_fused(dl, dr, kTick, t.dtheta, t.ds);
   }
   EXPECT_EQ(plain.pose().x, fused.pose().x);
   EXPECT_EQ(plain.pose().y, fused.pose().y);
@@ -317,7 +448,7 @@ TEST(Gyrodometry, FusedUpdateIsOdometryWhenNothingIsFlagged) {
   EXPECT_EQ(plain.angular_velocity(), fused.angular_velocity());
   // Another heading: straight counts, 1e-3 rad per tick from elsewhere: 100 ticks turn 0.1 rad.
   Odometry turn(k);
-  for (int i = 0; i < 100; ++i) turn.update_fused(70, 70, kTick, 1e-3);
+  for (int i = 0; i < 100; ++i) turn.update_fused(70, 70, kTick, 1e-3, 0.0);
   EXPECT_NEAR(turn.pose().theta, 0.1, 1e-15);
   EXPECT_NEAR(turn.angular_velocity(), 0.2, 1e-15);
 }

@@ -303,7 +303,8 @@ struct GyroSection {
   double noise_density = kNotSet;     // [rad/s/sqrt(Hz)] fusion noise model (sim: the model's)
   double bias_instability = kNotSet;  // [rad/s]
   double scale_tolerance = kNotSet;   // residual scale-factor error (fraction)
-  double delay = kNotSet;             // [s] the gyro's delay behind the encoders
+  double delay = kNotSet;             // [s] lag of the gyro's samples behind the motion
+  double delay_tolerance = 0.0005;    // [s] how far `delay` may be off
   double window = 0.1;                // [s] comparison window
   double k_sigma = 5.0;
   double max_wheel_speed = 2.0;   // [m/s]

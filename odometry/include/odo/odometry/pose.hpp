@@ -145,14 +145,16 @@ class Odometry {
     distance_ = distance;
   }
   // update_fused: the same with the heading changing by dtheta [rad] instead of
-  // (d_R - d_L) / b (the gyrodometry fusion's FusedTick::dtheta); bit-identical to update()
-  // when dtheta is odometry's own increment.
-  void update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta) noexcept;
+  // (d_R - d_L) / b and the centre travel by ds_correction [m] more than the wheels' mean (the
+  // gyrodometry fusion's FusedTick::dtheta and ::ds); bit-identical to update() when dtheta is
+  // odometry's own increment and ds_correction is 0.
+  void update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
+                    double ds_correction) noexcept;
   // advance_fused: update_fused() and the covariance step of the same tick: the wheels' arc
   // when gyro_heading is false (dtheta is then odometry's own), otherwise the gyro's heading
   // noise var_heading [rad^2] instead of the wheels' differential noise (propagate_gyro_arc).
   void advance_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
-                     bool gyro_heading, double var_heading) noexcept;
+                     double ds_correction, bool gyro_heading, double var_heading) noexcept;
   // set_kinematics: swap in new calibration (e.g. after SIGHUP); the pose is kept.
   void set_kinematics(const Kinematics& k) noexcept { k_ = k; }
 
@@ -170,7 +172,7 @@ class Odometry {
 
  private:
   // integrate: one tick of wheel travels d_l, d_r [m] and heading change dth [rad].
-  void integrate(double d_l, double d_r, double dth, double dt) noexcept;
+  void integrate(double d_l, double d_r, double dth, double ds_correction, double dt) noexcept;
   Kinematics k_;
   PoseCovariance cov_;
   PoseIntegrator integ_;
