@@ -15,12 +15,24 @@ for opt in --store --plot --csv; do
   check "simulate $opt unwritable: exit 2, one line before any square: rc $rc $(cat "$tmp/err")" $?
 done
 mkdir "$tmp/ro" && chmod 555 "$tmp/ro"
-if [ -w "$tmp/ro" ]; then
-  echo "SKIP: read-only directory case (running as root: every directory is writable)"
+# Root may write into a mode-555 directory (CI runs as root): there the directory is made
+# read-only by a read-only bind mount in a private mount namespace, which binds root too.
+skipped=""
+ro_run() {
+  if [ ! -w "$tmp/ro" ]; then
+    run "$@"
+  else
+    unshare -m sh -c 'mount --bind "$1" "$1" && mount -o remount,bind,ro "$1" && shift &&
+      exec "$@"' sh "$tmp/ro" ${CROSS_EMULATOR:-} "$@"
+  fi
+}
+if [ -w "$tmp/ro" ] && ! unshare -m sh -c "mount --bind '$tmp/ro' '$tmp/ro'" 2>"$tmp/err"; then
+  skipped="read-only directory case: root, and no private mount namespace ($(cat "$tmp/err"))"
 else
-  run "$ODOMCTL" errormodel validate --runs 10 --plot "$tmp/ro/p.svg" >/dev/null 2>"$tmp/err"
+  ro_run "$ODOMCTL" errormodel validate --runs 10 --plot "$tmp/ro/p.svg" >/dev/null 2>"$tmp/err"
   rc=$?
-  [ $rc = 2 ] && [ "$(wc -l <"$tmp/err")" = 1 ] && grep -q "ro/p.svg: cannot create" "$tmp/err"
+  [ $rc = 2 ] && [ "$(wc -l <"$tmp/err")" = 1 ] && grep -q "ro/p.svg: cannot create" "$tmp/err" &&
+    [ ! -e "$tmp/ro/p.svg" ]
   check "errormodel validate --plot in a read-only directory: exit 2, $(cat "$tmp/err")" $?
 fi
 
@@ -181,4 +193,8 @@ run "$ODOMCTL" umbmark record --csv "$tmp/r3.csv" --config "$tmp/idle.toml" --wh
 check "record --config of a daemon on the simulated bus: exit 2: $(cat "$tmp/err")" $?
 
 echo "cli_umbmark_record: $pass passed, $fail failed"
-[ $fail = 0 ]
+[ $fail = 0 ] || exit 1
+if [ -n "$skipped" ]; then
+  echo "SKIP: $skipped"
+  exit 77
+fi
