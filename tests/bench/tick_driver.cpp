@@ -1,7 +1,10 @@
 // tick_driver: runs N loop ticks for instruction counting with callgrind
-// (tools/callgrind_tick.sh). Usage: tick_driver sim|counting N [all]
+// (tools/callgrind_tick.sh). Usage: tick_driver sim|counting|gyro N [all]
 //   sim       the simulated robot on a long arc (as BM_LoopTick)
 //   counting  a counter-register encoder (as BM_LoopTickFirmwareOnly)
+//   gyro      sim with the consumer gyro (1 kHz samples) and the fusion in the loop; the robot
+//             stands still for the first second, so the bias is learnt and every later tick
+//             compares its window (the fusion's full path, no interval)
 // The CAN broadcaster is attached as in odometryd with the simulated bus: default rates at
 // 1 kHz (pose and velocity every 20th tick, uncertainty and status every 100th, timing every
 // 1000th), the wire drained every tick; `all` sends every message on every tick (worst case).
@@ -16,12 +19,14 @@
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_can_bus.hpp"
 #include "odo/sim/sim_encoder.hpp"
+#include "odo/sim/sim_gyro.hpp"
 #include "odo/sim/virtual_clock.hpp"
 
 int main(int argc, char** argv) {
   if (argc < 3 || argc > 4 || (argc == 4 && std::strcmp(argv[3], "all") != 0) ||
-      (std::strcmp(argv[1], "sim") != 0 && std::strcmp(argv[1], "counting") != 0)) {
-    std::fprintf(stderr, "usage: tick_driver sim|counting N [all]\n");
+      (std::strcmp(argv[1], "sim") != 0 && std::strcmp(argv[1], "counting") != 0 &&
+       std::strcmp(argv[1], "gyro") != 0)) {
+    std::fprintf(stderr, "usage: tick_driver sim|counting|gyro N [all]\n");
     return 2;
   }
   const long n = std::atol(argv[2]);
@@ -30,13 +35,24 @@ int main(int argc, char** argv) {
     return 2;
   }
   const auto k = *odo::Kinematics::create({0.15, 2048, 16, 0.34, 0.34, 1.0, 1.0});
-  auto robot = *odo::sim::SimRobot::create(odo::sim::RobotGeometry{}, {{1e7, 3.0, 3.3}});
+  const bool with_gyro = argv[1][0] == 'g';
+  odo::sim::Scenario path{{1e7, 3.0, 3.3}};
+  if (with_gyro) path.insert(path.begin(), {1.0, 0.0, 0.0});
+  auto robot = *odo::sim::SimRobot::create(odo::sim::RobotGeometry{}, path);
   odo::sim::SimEncoderSource sim_enc(robot, 32);
   odo::bench::CountingEncoder count_enc(52, 57);
-  odo::EncoderSource& enc = argv[1][0] == 's' ? static_cast<odo::EncoderSource&>(sim_enc)
+  odo::EncoderSource& enc = argv[1][0] != 'c' ? static_cast<odo::EncoderSource&>(sim_enc)
                                               : static_cast<odo::EncoderSource&>(count_enc);
   odo::sim::VirtualClock clock;
-  auto loop = odo::loop::OdometryLoop::create(odo::loop::LoopConfig{1000.0}, k, enc, clock).value();
+  const odo::sim::GyroModel model = odo::sim::consumer_gyro();
+  auto gyro = *odo::sim::SimGyro::create(robot, model, 1);
+  odo::loop::LoopConfig cfg{1000.0};
+  // As odometryd sets them for [gyro] backend = "sim" (firmware/src/gyro_backend.cpp).
+  cfg.gyrodometry.noise.rate_noise_density = model.noise_density;
+  cfg.gyrodometry.noise.bias_instability = model.bias_walk * 10.0;
+  cfg.gyrodometry.gyro_delay = model.delay;
+  auto loop =
+      odo::loop::OdometryLoop::create(cfg, k, enc, clock, with_gyro ? &gyro : nullptr).value();
   odo::sim::SimCanPort port;
   odo::fw::CanBroadcastOptions co;
   co.div = argc == 4 ? odo::fw::CanDivisors{1, 1, 1, 1, 1}
@@ -47,8 +63,10 @@ int main(int argc, char** argv) {
   loop->start();
   for (long i = 0; i < n; ++i) loop->tick();
   const odo::Pose2& p = loop->odometry().pose();
-  std::printf("ticks=%llu x=%.6f y=%.6f theta=%.6f can_sent=%llu\n",
+  const odo::Gyrodometry* f = loop->fusion();
+  std::printf("ticks=%llu x=%.6f y=%.6f theta=%.6f can_sent=%llu fusion_events=%llu\n",
               static_cast<unsigned long long>(loop->stats().ticks), p.x, p.y, p.theta,
-              static_cast<unsigned long long>(can.counters().sent));
+              static_cast<unsigned long long>(can.counters().sent),
+              static_cast<unsigned long long>(f ? f->counters().disagreements : 0));
   return 0;
 }
