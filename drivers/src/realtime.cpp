@@ -40,7 +40,7 @@ RealtimeItem set_fifo(int prio) {
     it.outcome = RtOutcome::kNotPermitted;
     it.detail = "not permitted (" + errno_text(e) +
                 "; needs CAP_SYS_NICE or RLIMIT_RTPRIO >= " + std::to_string(prio) + ", limit is " +
-                rlimit_text(RLIMIT_RTPRIO) + "); the loop runs with normal scheduling";
+                rlimit_text(RLIMIT_RTPRIO) + "); the thread runs with normal scheduling";
   } else {
     it.outcome = RtOutcome::kFailed;
     it.detail = errno_text(e);

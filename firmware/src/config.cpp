@@ -200,7 +200,7 @@ void read_can(TableReader t, CanSection& s, double loop_hz) {
 }
 
 // ---- [ros2] (ROS 2 output; ranges and name rules are the ros2 library's) ----
-void read_ros2(TableReader t, ros2::Config& c, double loop_hz) {
+void read_ros2(TableReader t, ros2::Config& c, double loop_hz, int loop_priority) {
   c.enabled = t.boolean("enabled", c.enabled);
   c.domain_id =
       static_cast<std::uint32_t>(t.integer("domain_id", c.domain_id, 0, ros2::kDomainIdMax));
@@ -212,8 +212,13 @@ void read_ros2(TableReader t, ros2::Config& c, double loop_hz) {
   c.interfaces = t.strings("interfaces", c.interfaces);
   c.peers = t.strings("peers", c.peers);
   c.multicast = t.boolean("multicast", c.multicast);
+  c.priority = static_cast<int>(t.integer("priority", c.priority, 0, ros2::kPriorityMax));
   if (!t.ok()) return;
   if (auto p = ros2::check(c, loop_hz)) t.reject(p->key, p->what);
+  if (c.priority > 0 && loop_priority > 0 && c.priority >= loop_priority)
+    t.reject("priority", "= " + std::to_string(c.priority) + " must be below realtime.priority (" +
+                             std::to_string(loop_priority) +
+                             "): the publish thread must never preempt the loop");
   if (c.enabled && !ros2::kBuiltWithDds)
     t.reject("enabled",
              "= true, but this odometryd was built without the ROS 2 output (-DODO_ROS2=OFF, no "
@@ -350,7 +355,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_error_model(root.sub("error_model"), c.error_model);
   read_can(root.sub("can"), c.can, c.loop.rate_hz);
   ros2::Config ros2_cfg;
-  read_ros2(root.sub("ros2"), ros2_cfg, c.loop.rate_hz);
+  read_ros2(root.sub("ros2"), ros2_cfg, c.loop.rate_hz, c.realtime.priority);
   c.ros2 = std::make_shared<const ros2::Config>(std::move(ros2_cfg));
   read_resume(root.sub("resume"), c.resume, c.loop.rate_hz);
   read_selfcal(root.sub("selfcal"), c.selfcal);

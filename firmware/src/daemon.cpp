@@ -337,7 +337,8 @@ int Daemon::run(std::atomic<bool>& stop) {
   // The DDS thread, like the status thread, starts before the real-time set-up (normal
   // scheduling); it only reads the loop's snapshots.
   if (ros2_) {
-    if (auto started = ros2_->start(); !started) return fail(started.error().message, 1);
+    auto started = ros2_->start(o_.virtual_time, cfg_->realtime.required, log_);
+    if (!started) return fail(started.error().message, 1);
   }
   // The loop runs on this thread: real-time set-up after the status thread started, so that
   // thread keeps normal scheduling.

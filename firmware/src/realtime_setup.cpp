@@ -3,6 +3,7 @@
 #include <ostream>
 
 #include "odo/drivers/realtime.hpp"
+#include "realtime_report.hpp"
 
 namespace odo::fw {
 
@@ -18,28 +19,31 @@ bool setup_realtime(const RealtimeSection& cfg, bool virtual_time, std::ostream&
   r.cpu = cfg.cpu;
   r.prefault_stack = static_cast<std::size_t>(cfg.prefault_stack);
   bool ok = true;
-  for (const drivers::RealtimeItem& it : drivers::apply_realtime(r)) {
-    log << "odometryd: realtime: " << it.what << ": ";
-    switch (it.outcome) {
-      case drivers::RtOutcome::kApplied:
-        log << "applied\n";
-        break;
-      case drivers::RtOutcome::kOff:
-        log << it.detail << "\n";
-        break;
-      case drivers::RtOutcome::kNotPermitted:
-      case drivers::RtOutcome::kFailed:
-        log << "NOT APPLIED: " << it.detail << (cfg.required ? "" : "; continuing") << "\n";
-        if (cfg.required) {
-          err << "odometryd: realtime: " << it.what << " could not be applied and [realtime] "
-              << "required = true: refusing to start (" << it.detail << ")\n";
-          ok = false;
-        }
-        break;
-    }
-  }
+  for (const drivers::RealtimeItem& it : drivers::apply_realtime(r))
+    ok = report_realtime("realtime", it, cfg.required, log, err) && ok;
   log.flush();
   return ok;
+}
+
+bool report_realtime(std::string_view who, const drivers::RealtimeItem& it, bool required,
+                     std::ostream& log, std::ostream& err) {
+  log << "odometryd: " << who << ": " << it.what << ": ";
+  switch (it.outcome) {
+    case drivers::RtOutcome::kApplied:
+      log << "applied\n";
+      return true;
+    case drivers::RtOutcome::kOff:
+      log << it.detail << "\n";
+      return true;
+    case drivers::RtOutcome::kNotPermitted:
+    case drivers::RtOutcome::kFailed:
+      break;
+  }
+  log << "NOT APPLIED: " << it.detail << (required ? "" : "; continuing") << "\n";
+  if (!required) return true;
+  err << "odometryd: " << who << ": " << it.what << " could not be applied and [realtime] "
+      << "required = true: refusing to start (" << it.detail << ")\n";
+  return false;
 }
 
 }  // namespace odo::fw

@@ -1,8 +1,11 @@
 #include "ros2_output.hpp"
 
+#include <future>
 #include <sstream>
 
+#include "odo/drivers/realtime.hpp"
 #include "odo/ros2/config.hpp"
+#include "realtime_report.hpp"
 
 namespace odo::fw {
 
@@ -24,6 +27,7 @@ Result<std::unique_ptr<Ros2Output>> Ros2Output::create(const ros2::Config* c, do
       [self](const ros2::SetPose& p) { self->post(p); });
   if (!bridge) return std::move(bridge).error();
   out->bridge_ = std::move(bridge).value();
+  out->priority_ = c->priority;
   if (!loop.add_observer(self)) {
     return make_error(Errc::kBusy, "ros2: the loop has no free observer slot");
   }
@@ -69,8 +73,27 @@ void Ros2Output::post(const ros2::SetPose& p) {
   }
 }
 
-Status Ros2Output::start() {
-  return bridge_->start();
+Status Ros2Output::start(bool virtual_time, bool required, std::ostream& log) {
+  // Virtual time runs as fast as possible: no thread of it may hog a CPU at real-time priority.
+  const int prio = virtual_time ? 0 : priority_;
+  std::promise<drivers::RealtimeItem> applied;
+  std::future<drivers::RealtimeItem> item = applied.get_future();
+  auto started = bridge_->start([prio, &applied] {
+    drivers::RealtimeRequest r;
+    r.fifo_priority = prio;
+    applied.set_value(drivers::apply_realtime(r).front());
+  });
+  if (!started) return started;
+  // The thread reports before it publishes anything: the report is in order with the others.
+  drivers::RealtimeItem it = item.get();
+  if (prio == 0) it.detail = "off ([ros2] priority = 0): normal time-sharing scheduling";
+  std::ostringstream err;  // report_realtime's own line; the daemon prints the error below
+  if (report_realtime("ros2 publish thread", it, required, log, err)) return Ok{};
+  bridge_->stop();
+  return make_error(Errc::kUnsupported, "ros2 publish thread: " + it.what +
+                                            " could not be applied and [realtime] required = "
+                                            "true: refusing to start (" +
+                                            it.detail + ")");
 }
 
 void Ros2Output::stop() {

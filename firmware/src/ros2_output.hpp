@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <iosfwd>
 #include <memory>
 #include <string>
 
@@ -35,9 +36,11 @@ class Ros2Output final : public loop::TickObserver {
 
   // on_tick: loop thread; converts the snapshot and publishes it to the bridge's buffer.
   void on_tick(const loop::LoopSnapshot& snap) noexcept override;
-  // start: the bridge's thread (before the loop runs); stop: joins it, after the loop ran (the
-  // newest sample, the final pose, is published before the thread ends).
-  Status start();
+  // start: the bridge's thread (before the loop runs), at [ros2] priority unless virtual_time;
+  // that part is reported on log like the loop's [realtime] parts, and refused (error) when it
+  // fails and `required`. stop: joins the thread, after the loop ran (the newest sample, the
+  // final pose, is published before the thread ends).
+  Status start(bool virtual_time, bool required, std::ostream& log);
   void stop();
   // describe: one line for the start-up report.
   std::string describe() const;
@@ -52,6 +55,7 @@ class Ros2Output final : public loop::TickObserver {
   void post(const ros2::SetPose& p);
 
   double b_;
+  int priority_ = 0;  // [ros2] priority of the publish thread
   ErrorModelParams k_;
   loop::OdometryLoop& loop_;
   loop::TripleBuffer<ros2::OdomSample> samples_;

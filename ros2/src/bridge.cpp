@@ -244,13 +244,16 @@ Result<std::unique_ptr<Bridge>> Bridge::create(const Config& c, double loop_rate
   return std::unique_ptr<Bridge>(new Bridge(std::move(impl)));
 }
 
-Status Bridge::start() {
+Status Bridge::start(std::function<void()> thread_setup) {
   if (impl_->thread.joinable()) return make_error(Errc::kBusy, "ros2: bridge already running");
   {
     std::lock_guard g(impl_->m);
     impl_->stopping = false;
   }
-  impl_->thread = std::thread([this] { impl_->run(); });
+  impl_->thread = std::thread([this, setup = std::move(thread_setup)] {
+    if (setup) setup();
+    impl_->run();
+  });
   return Ok{};
 }
 

@@ -15,7 +15,7 @@ Result<std::unique_ptr<Bridge>> Bridge::create(const Config&, double, SampleSour
                     "ros2: this build has no ROS 2 output (configured with -DODO_ROS2=OFF)");
 }
 
-Status Bridge::start() {
+Status Bridge::start(std::function<void()>) {
   return make_error(Errc::kUnsupported, "ros2: no ROS 2 output in this build");
 }
 

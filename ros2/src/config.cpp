@@ -78,6 +78,12 @@ std::string rate_problem(double rate_hz, double loop_rate_hz) {
   return m.str();
 }
 
+std::string priority_problem(int priority) {
+  if (priority >= 0 && priority <= kPriorityMax) return "";
+  return "= " + std::to_string(priority) + " is outside [0, " + std::to_string(kPriorityMax) +
+         "] (0: normal scheduling)";
+}
+
 std::string interfaces_problem(const std::vector<std::string>& interfaces) {
   for (const auto& i : interfaces) {
     if (i.empty() || i.size() > 15 || !address_text(i)) {
@@ -130,7 +136,8 @@ std::optional<ConfigProblem> check(const Config& c, double loop_rate_hz) {
                          : ""},
       {"rate_hz", rate_problem(c.rate_hz, loop_rate_hz)},
       {"interfaces", interfaces_problem(c.interfaces)},
-      {"peers", peers_problem(c)}};
+      {"peers", peers_problem(c)},
+      {"priority", priority_problem(c.priority)}};
   for (const auto& [key, what] : checks) {
     if (!what.empty()) return ConfigProblem{std::string(key), what};
   }

@@ -158,5 +158,34 @@ TEST_F(Ros2Daemon, CyclonePeerReceivesTheFinalPoseAndSetsThePose) {
   check();
 }
 
+// [ros2] priority: the publish thread asks for SCHED_FIFO at that priority and the start-up
+// report says what happened: applied as root (CI), "not permitted" otherwise (an ordinary user
+// without CAP_SYS_NICE); off by default. Real time, not virtual: virtual time never asks.
+TEST_F(Ros2Daemon, PublishThreadPriorityIsAppliedAndReported) {
+  for (const int prio : {0, 20}) {
+    const std::string cfg = dir_ + "/prio.toml";
+    std::ofstream(cfg) << "[loop]\nrate_hz = 100\n"
+                       << "[realtime]\npriority = 0\nlock_memory = false\nprefault_stack = 0\n"
+                       << "[calibration]\nstore = \"\"\n[can]\nbus = \"none\"\n"
+                       << "[ros2]\nenabled = true\ndomain_id = " << domain(2)
+                       << "\ninterfaces = [\"lo\"]\nmulticast = false\npeers = [\"127.0.0.1\"]\n"
+                       << "priority = " << prio << "\n";
+    const PeerRun d = run_peer(std::string(ODO_EMULATOR_PREFIX) + ODOMETRYD + " --config " + cfg +
+                               " --duration 0.3 2>&1");
+    ASSERT_EQ(d.status, 0);
+    std::string line;
+    for (const auto& l : d.lines)
+      if (l.rfind("odometryd: ros2 publish thread: ", 0) == 0) line = l;
+    const std::string head = "odometryd: ros2 publish thread: SCHED_FIFO";
+    if (prio == 0) {
+      EXPECT_EQ(line, head + ": off ([ros2] priority = 0): normal time-sharing scheduling");
+    } else if (geteuid() == 0) {
+      EXPECT_EQ(line, head + " priority 20: applied");
+    } else {
+      EXPECT_EQ(line.rfind(head + " priority 20: NOT APPLIED: not permitted", 0), 0u) << line;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace odo::ros2

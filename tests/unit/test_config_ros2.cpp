@@ -34,7 +34,7 @@ TEST(ConfigRos2, EveryKeyIsRead) {
       "[loop]\nrate_hz = 200\n[ros2]\ndomain_id = 232\nnamespace = \"/robot1\"\n"
       "odom_frame = \"odom1\"\nbase_frame = \"base_footprint\"\nrate_hz = 200\n"
       "publish_tf = false\ninterfaces = [\"eth0\", \"lo\"]\npeers = [\"192.168.1.20\"]\n"
-      "multicast = false\n",
+      "multicast = false\npriority = 40\n",
       "all.toml");
   ASSERT_TRUE(c.ok()) << c.error().message;
   const ros2::Config& r = *c->ros2;
@@ -47,6 +47,7 @@ TEST(ConfigRos2, EveryKeyIsRead) {
   EXPECT_EQ(r.interfaces, (std::vector<std::string>{"eth0", "lo"}));
   EXPECT_EQ(r.peers, (std::vector<std::string>{"192.168.1.20"}));
   EXPECT_FALSE(r.multicast);
+  EXPECT_EQ(r.priority, 40);
 }
 
 TEST(ConfigRos2, ErrorsNameFileLineFieldAndRange) {
@@ -74,6 +75,16 @@ TEST(ConfigRos2, ErrorsNameFileLineFieldAndRange) {
   EXPECT_EQ(error_of("multicast = false"),
             "r.toml:2: ros2.peers must name at least one peer when multicast = false "
             "(nothing to discover)");
+  // The publish thread's SCHED_FIFO priority: 0..98, and below the loop's (default 80).
+  EXPECT_EQ(error_of("priority = 99"),
+            "r.toml:3: ros2.priority = 99 is outside the allowed range [0, 98]");
+  EXPECT_EQ(error_of("priority = 80"),
+            "r.toml:3: ros2.priority = 80 must be below realtime.priority (80): the publish "
+            "thread must never preempt the loop");
+  EXPECT_EQ(error_of("priority = 79"), "");
+  auto no_rt = parse_config("[realtime]\npriority = 0\n[ros2]\npriority = 90\n", "n.toml");
+  ASSERT_TRUE(no_rt.ok()) << no_rt.error().message;  // a loop without SCHED_FIFO: any priority
+  EXPECT_EQ(no_rt->ros2->priority, 90);
   EXPECT_EQ(error_of("domian_id = 3"),
             "r.toml:3: ros2.domian_id is not a known setting (misspelt?)");
 }

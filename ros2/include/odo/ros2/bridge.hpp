@@ -46,8 +46,9 @@ class Bridge {
   Bridge(const Bridge&) = delete;
   Bridge& operator=(const Bridge&) = delete;
 
-  // start: runs the publish thread (rate_hz); error if it is running already.
-  Status start();
+  // start: runs the publish thread (rate_hz), which first calls thread_setup (e.g. to give
+  // itself a real-time priority); error if it is running already.
+  Status start(std::function<void()> thread_setup = {});
   // stop: ends and joins the thread; idempotent. The destructor stops too.
   void stop();
   // stats: counters so far (any thread).

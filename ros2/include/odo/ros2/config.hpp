@@ -17,6 +17,8 @@ namespace odo::ros2 {
 inline constexpr std::uint32_t kDomainIdMax = 232;
 inline constexpr std::size_t kNameLengthMax = 255;  // frame ids and the namespace [characters]
 inline constexpr double kRateMinHz = 0.1;
+// The publish thread's SCHED_FIFO priority stays below the kernel's 99 (migration, watchdog).
+inline constexpr int kPriorityMax = 98;
 // kBuiltWithDds: this build has the DDS bridge (-DODO_ROS2=ON); without it the configuration is
 // still read and checked, and enabled = true is an error.
 inline constexpr bool kBuiltWithDds = ODO_ROS2_DDS != 0;
@@ -32,6 +34,7 @@ struct Config {
   std::vector<std::string> interfaces;   // network interfaces DDS may use ({} = DDS's choice)
   std::vector<std::string> peers;        // unicast discovery peers ({} = multicast only)
   bool multicast = true;                 // SPDP multicast discovery (false: peers only)
+  int priority = 0;  // SCHED_FIFO priority of the publish thread, 1..kPriorityMax; 0: normal
 };
 
 // validate_domain_id: domain_id in [0, kDomainIdMax].
