@@ -7,9 +7,10 @@
 #   sim       encoder = the simulated robot (its exact-arc motion model is most of the cost)
 #   counting  encoder = a counter-register read (the firmware's own cost of a tick)
 #   gyro      sim plus the consumer gyro and the gyrodometry fusion (issue 16)
+#   persist   counting plus the state persister (issue 17): its cost is the difference
 # and prints instructions per tick for the full tick and for every function it calls (inclusive).
 # Exit 1 when a target is missed: pose update <= 330, full tick <= 1000 instructions (issue 9);
-# full tick with the gyro <= 1100 (issue 16).
+# full tick with the gyro <= 1100 (issue 16); the persister's share <= 50 (issue 17).
 # Rerun after merging new stages (covariance, CAN frame encoding): they show up as new rows.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,9 +26,11 @@ drv=build/bench/tests/bench/tick_driver
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 status=0
 echo "callgrind: $n ticks at 1 kHz, $(g++ --version | head -1), preset bench (-O2 -DNDEBUG), $(uname -m)"
-for mode in sim counting gyro; do
+for mode in sim counting gyro persist; do
+  args=("$mode" "$n")
+  [[ $mode == persist ]] && args=(counting "$n" persist)
   valgrind --tool=callgrind --callgrind-out-file="$tmp/$mode.out" \
-    --toggle-collect='odo::loop::OdometryLoop::tick()' "$drv" "$mode" "$n" >"$tmp/$mode.log" 2>&1
+    --toggle-collect='odo::loop::OdometryLoop::tick()' "$drv" "${args[@]}" >"$tmp/$mode.log" 2>&1
   callgrind_annotate --inclusive=yes --threshold=100 "$tmp/$mode.out" >"$tmp/$mode.txt" 2>/dev/null
   echo
   echo "encoder = $mode: instructions per tick (inclusive; rows below the tick are its callees)"
@@ -40,6 +43,13 @@ for mode in sim counting gyro; do
       if (ir / n >= 0.5) printf "  %10.1f  %s\n", ir / n, fn
     }' "$tmp/$mode.txt" | head -25 | tee "$tmp/$mode.rows"
   tick=$(awk '/OdometryLoop::tick\(\)/ { print $1; exit }' "$tmp/$mode.rows")
+  if [[ $mode == persist ]]; then
+    share=$(awk -v t="$tick" -v c="$counting_tick" 'BEGIN { printf "%.1f", t - c }')
+    echo "  => full tick $tick with the persister: its share $share (target <= 50)"
+    awk -v s="$share" 'BEGIN { exit !(s <= 50) }' || status=1
+    continue
+  fi
+  [[ $mode == counting ]] && counting_tick=$tick
   if [[ $mode == gyro ]]; then
     echo "  => full tick $tick with the gyro (target <= 1100)"
     awk -v t="$tick" 'BEGIN { exit !(t <= 1100) }' || status=1

@@ -1,5 +1,5 @@
 // tick_driver: runs N loop ticks for instruction counting with callgrind
-// (tools/callgrind_tick.sh). Usage: tick_driver sim|counting|gyro N [all]
+// (tools/callgrind_tick.sh). Usage: tick_driver sim|counting|gyro N [all|persist]
 //   sim       the simulated robot on a long arc (as BM_LoopTick)
 //   counting  a counter-register encoder (as BM_LoopTickFirmwareOnly)
 //   gyro      sim with the consumer gyro (1 kHz samples) and the fusion in the loop; the robot
@@ -8,13 +8,20 @@
 // The CAN broadcaster is attached as in odometryd with the simulated bus: default rates at
 // 1 kHz (pose and velocity every 20th tick, uncertainty and status every 100th, timing every
 // 1000th), the wire drained every tick; `all` sends every message on every tick (worst case).
+// `persist` also attaches the state persister as odometryd does (issue 17: a record every 20th
+// tick at the default 50 Hz, written by its own thread into a file under /tmp).
+#include <unistd.h>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <iostream>
 #include <memory>
+#include <optional>
+#include <string>
 
 #include "counting_encoder.hpp"
 #include "odo/firmware/can_broadcast.hpp"
+#include "odo/firmware/state_persist.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_can_bus.hpp"
@@ -23,10 +30,12 @@
 #include "odo/sim/virtual_clock.hpp"
 
 int main(int argc, char** argv) {
-  if (argc < 3 || argc > 4 || (argc == 4 && std::strcmp(argv[3], "all") != 0) ||
+  const bool all = argc == 4 && std::strcmp(argv[3], "all") == 0;
+  const bool persist = argc == 4 && std::strcmp(argv[3], "persist") == 0;
+  if (argc < 3 || argc > 4 || (argc == 4 && !all && !persist) ||
       (std::strcmp(argv[1], "sim") != 0 && std::strcmp(argv[1], "counting") != 0 &&
        std::strcmp(argv[1], "gyro") != 0)) {
-    std::fprintf(stderr, "usage: tick_driver sim|counting|gyro N [all]\n");
+    std::fprintf(stderr, "usage: tick_driver sim|counting|gyro N [all|persist]\n");
     return 2;
   }
   const long n = std::atol(argv[2]);
@@ -55,13 +64,30 @@ int main(int argc, char** argv) {
       odo::loop::OdometryLoop::create(cfg, k, enc, clock, with_gyro ? &gyro : nullptr).value();
   odo::sim::SimCanPort port;
   odo::fw::CanBroadcastOptions co;
-  co.div = argc == 4 ? odo::fw::CanDivisors{1, 1, 1, 1, 1}
-                     : odo::fw::CanDivisors{20, 20, 100, 100, 1000};
+  co.div = all ? odo::fw::CanDivisors{1, 1, 1, 1, 1} : odo::fw::CanDivisors{20, 20, 100, 100, 1000};
   port.connect_wire();
   odo::fw::CanBroadcaster can(co, port, &loop->commands(), nullptr);
   loop->add_observer(&can);
+  std::unique_ptr<odo::fw::StatePersister> persister;
+  const std::string state_path = "/tmp/tick_driver_state." + std::to_string(getpid());
+  if (persist) {
+    auto p = odo::fw::StatePersister::create(state_path, 50.0, 1000.0, *loop, {});
+    if (!p) {
+      std::fprintf(stderr, "tick_driver: %s\n", p.error().message.c_str());
+      return 1;
+    }
+    persister = std::move(p).value();
+    loop->add_observer(persister.get());
+  }
   loop->start();
+  if (persister) persister->start(std::cerr, std::nullopt, "");
   for (long i = 0; i < n; ++i) loop->tick();
+  if (persister) {
+    persister->stop();
+    std::printf("state records written=%llu\n",
+                static_cast<unsigned long long>(persister->written()));
+    std::remove(state_path.c_str());
+  }
   const odo::Pose2& p = loop->odometry().pose();
   const odo::Gyrodometry* f = loop->fusion();
   std::printf("ticks=%llu x=%.6f y=%.6f theta=%.6f can_sent=%llu fusion_events=%llu\n",
