@@ -61,7 +61,7 @@ void OdometryLoop::start() noexcept {
   const EncoderSample s = enc_->read(clock_->now());
   if (resume_offered_) apply_resume(s);
   // The gyro's samples up to now belong to no interval of the encoders: dropped.
-  if (gyro_ != nullptr) last_gyro_ = gyro_->read(clock_->now());
+  if (gyro_ != nullptr) fused_in_.gyro = gyro_->read(clock_->now());
   prev_left_ = s.left;
   prev_right_ = s.right;
   prev_stamp_ = s.stamp;
@@ -151,7 +151,7 @@ void OdometryLoop::integrate(const EncoderSample& s) noexcept {
   const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
   const double dt = to_seconds(s.stamp - prev_stamp_);
   if (fusion_) {
-    integrate_fused(dl, dr, dt, gyro_->read(s.stamp));
+    integrate_fused(dl, dr, dt, s.stamp);
   } else {
     odom_.advance(dl, dr, dt);
   }
@@ -161,18 +161,23 @@ void OdometryLoop::integrate(const EncoderSample& s) noexcept {
 }
 
 void OdometryLoop::integrate_fused(std::int64_t dl, std::int64_t dr, double dt,
-                                   const GyroSample& g) noexcept {
-  last_gyro_ = g;
+                                   TimeNs stamp) noexcept {
+  FusionInput& in = fused_in_;
+  in.gyro = gyro_->read(stamp);
   const Kinematics& k = odom_.kinematics();
-  FusionInput in;
   in.dt = dt;
   in.d_left = static_cast<double>(dl) * k.metres_per_count_left();
   in.d_right = static_cast<double>(dr) * k.metres_per_count_right();
   in.wheelbase = k.wheelbase();
-  in.gyro = g;
   const FusedTick f = fusion_->step(in);
   last_fusion_flags_ = f.flags;
-  odom_.advance_fused(dl, dr, dt, f.dtheta, f.ds, (f.flags & kFusionGyroUsed) != 0, f.var_heading);
+  if ((f.flags & kFusionGyroUsed) == 0) {
+    // Odometry's own increment and no travel correction: the plain path, which computes exactly
+    // what advance_fused would for it (Odometry::update_fused's contract), at the plain cost.
+    odom_.advance(dl, dr, dt);
+  } else {
+    odom_.advance_fused(dl, dr, dt, f.dtheta, f.ds, true, f.var_heading);
+  }
 }
 
 void OdometryLoop::record_wakeup(TimeNs latency) noexcept {
@@ -209,14 +214,14 @@ LoopSnapshot& OdometryLoop::fill_snapshot(const EncoderSample& s, TimeNs woke) n
 void OdometryLoop::fill_gyro_status(LoopGyroStatus& g) const noexcept {
   if (!fusion_) return;  // stays all zero: the default of every slot
   g.enabled = true;
-  g.gyro_flags = last_gyro_.flags;
+  g.gyro_flags = fused_in_.gyro.flags;
   g.fusion_flags = last_fusion_flags_;
-  g.rate_z = last_gyro_.rate_z;
+  g.rate_z = fused_in_.gyro.rate_z;
   g.bias = fusion_->bias();
   g.bias_valid = fusion_->bias_valid();
   g.scale = fusion_->scale();
   g.fusion = fusion_->counters();
-  g.gyro = last_gyro_.counters;
+  g.gyro = fused_in_.gyro.counters;
 }
 
 void OdometryLoop::record_compute(LoopSnapshot& snap, TimeNs latency, TimeNs woke,

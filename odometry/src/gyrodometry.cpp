@@ -85,7 +85,8 @@ Gyrodometry::Gyrodometry(const GyrodometryParams& p) : p_(p) {
   m_ = static_cast<std::size_t>(std::ceil(ticks - 1e-9));
   g_ = std::max(0.0, static_cast<double>(m_) - ticks);
   // The window, the two ticks beyond its old edge (J_old there), and odometry m ticks back.
-  ring_.assign(std::max(n_ + 2, m_ + 1), Entry{});
+  size_ = std::max(n_ + 2, m_ + 1);
+  ring_.assign(size_, Entry{});
   const double t_w = static_cast<double>(n_) * p.tick;
   noise_term_ = p.k_sigma * p.noise.rate_noise_density * std::sqrt(t_w);
   gyro_var_ = p.noise.rate_noise_density * p.noise.rate_noise_density * t_w;
@@ -118,11 +119,6 @@ void Gyrodometry::reset() noexcept {
   still_for_ = 0.0;
 }
 
-std::size_t Gyrodometry::index(std::size_t age) const noexcept {
-  // age < ring size: one conditional wrap instead of a division.
-  return head_ >= age ? head_ - age : head_ + ring_.size() - age;
-}
-
 double Gyrodometry::threshold() const noexcept {
   // The two sensors' random errors are independent: their variances add (sum_var_ is never
   // negative in exact arithmetic; the running sum's rounding could make it -1e-20).
@@ -132,7 +128,7 @@ double Gyrodometry::threshold() const noexcept {
 
 double Gyrodometry::edge_bounds() const noexcept {
   // Before the ring is full the edges' neighbours are missing; step() compares only full rings.
-  if (filled_ < ring_.size()) return 0.0;
+  if (filled_ < size_) return 0.0;
   const Entry &g0 = at(0), &g1 = at(1);
   const Entry &gn1 = at(n_ - 1), &gn = at(n_), &gn2 = at(n_ + 1);
   double e = delay_per_tick_ * std::fabs(g0.gyro - gn.gyro);
@@ -146,13 +142,22 @@ double Gyrodometry::edge_bounds() const noexcept {
   return e + std::min(by_old, by_new);
 }
 
-void Gyrodometry::add_to_window(const Entry& e, double sign) noexcept {
-  sum_odo_ += sign * e.odo_cmp;
-  sum_var_ += sign * e.var_cmp;
+void Gyrodometry::add_to_window(const Entry& e) noexcept {
+  sum_odo_ += e.odo_cmp;
+  sum_var_ += e.var_cmp;
   if (e.err_ok)
-    sum_err_ += sign * e.err;
+    sum_err_ += e.err;
   else
-    bad_ = sign > 0.0 ? bad_ + 1 : bad_ - 1;
+    ++bad_;
+}
+
+void Gyrodometry::remove_from_window(const Entry& e) noexcept {
+  sum_odo_ -= e.odo_cmp;
+  sum_var_ -= e.var_cmp;
+  if (e.err_ok)
+    sum_err_ -= e.err;
+  else
+    --bad_;
 }
 
 void Gyrodometry::resum() noexcept {
@@ -162,7 +167,7 @@ void Gyrodometry::resum() noexcept {
   bad_ = 0;
   for (std::size_t age = 0; age < std::min(filled_, n_); ++age) {
     const Entry& e = at(age);
-    add_to_window(e, 1.0);
+    add_to_window(e);
     if (age < half_) {
       sum_new_l_ += e.d_left;
       sum_new_r_ += e.d_right;
@@ -173,7 +178,9 @@ void Gyrodometry::resum() noexcept {
   }
 }
 
-void Gyrodometry::align(Entry& e) noexcept {
+// align, push and limit_flags run on every tick and are called from this file only: inline, so
+// that step() pays no call (and register saves) for them.
+inline void Gyrodometry::align(Entry& e) noexcept {
   // The newest entry is in the ring (age 0): its aligned gyro increment and odometry's of m ticks
   // ago (see the top of gyrodometry.hpp). Comparable only when everything it reads is there.
   const Entry& prev = at(1);
@@ -184,17 +191,27 @@ void Gyrodometry::align(Entry& e) noexcept {
   e.err = e.err_ok ? (1.0 - g_) * e.gyro + g_ * prev.gyro - e.odo_cmp : 0.0;
 }
 
-void Gyrodometry::push(const Entry& e) noexcept {
-  const std::size_t size = ring_.size();
-  const std::size_t next = head_ + 1 == size ? 0 : head_ + 1;
-  ring_[next] = e;
-  head_ = next;
-  if (filled_ < size) ++filled_;
-  Entry& fresh = ring_[head_];
-  align(fresh);
-  add_to_window(fresh, 1.0);
-  sum_new_l_ += fresh.d_left;
-  sum_new_r_ += fresh.d_right;
+[[gnu::always_inline]] inline Gyrodometry::Entry& Gyrodometry::push(const FusionInput& in,
+                                                                    double odo, bool usable,
+                                                                    double dt) noexcept {
+  head_ = head_ + 1 == size_ ? 0 : head_ + 1;
+  if (filled_ < size_) ++filled_;
+  // Written in place (not built and copied: 80 bytes a tick); align() sets the comparison fields.
+  Entry& e = ring_[head_];
+  e.odo = odo;
+  e.d_left = in.d_left;
+  e.d_right = in.d_right;
+  // Chong-Kleeman: wheel variances k^2 |d|; the heading difference divides by b twice.
+  e.var = (k2_left_ * std::fabs(in.d_left) + k2_right_ * std::fabs(in.d_right)) /
+          (in.wheelbase * in.wheelbase);
+  e.gyro_ok = usable;
+  e.raw = usable ? (in.gyro.rate_z - bias_) * dt : 0.0;
+  e.gyro = scale_ * e.raw;
+  e.replaced = false;
+  align(e);
+  add_to_window(e);
+  sum_new_l_ += e.d_left;
+  sum_new_r_ += e.d_right;
   if (filled_ > half_) {  // the entry now of age half_ moves from the newer to the older half
     const Entry& mid = at(half_);
     sum_new_l_ -= mid.d_left;
@@ -204,27 +221,24 @@ void Gyrodometry::push(const Entry& e) noexcept {
   }
   if (filled_ > n_) {  // the entry now of age n leaves the window (older half)
     const Entry& old = at(n_);
-    add_to_window(old, -1.0);
+    remove_from_window(old);
     sum_old_l_ -= old.d_left;
     sum_old_r_ -= old.d_right;
   }
   // Re-sum every kResumWraps passes of the ring: the running sums' rounding stays far below a
   // count (1e-16 relative per addition, a few thousand additions), at 1/16 of the cost.
   if (head_ == 0 && ++wraps_ % kResumWraps == 0) resum();
+  return e;
 }
 
-void Gyrodometry::update_bias(const FusionInput& in, bool rate_ok, bool still, double dt) noexcept {
-  if (!still) {
-    still_for_ = 0.0;
-    return;
-  }
+void Gyrodometry::update_bias(double rate, bool rate_ok, double dt) noexcept {
   still_for_ += dt;
   // The first still_time of a standstill only confirms it (the robot may still rock after
   // braking); after that the gyro's mean is its bias: a running mean over the seconds averaged so
   // far, which becomes an exponential average of horizon bias_tau to follow the bias's drift.
   if (!rate_ok || still_for_ < p_.still_time) return;
   bias_time_ = std::min(bias_time_ + dt, p_.bias_tau);
-  bias_ += (in.gyro.rate_z - bias_) * dt / bias_time_;
+  bias_ += (rate - bias_) * dt / bias_time_;
   update_b_res();
 }
 
@@ -243,14 +257,14 @@ void Gyrodometry::update_scale(double odo, double raw_gyro, double dt) noexcept 
   }
 }
 
-std::uint32_t Gyrodometry::limit_flags() const noexcept {
+inline std::uint32_t Gyrodometry::limit_flags() const noexcept {
   std::uint32_t f = 0;
   const Entry& e = ring_[head_];
   // Speeds per tick: one count of quantisation is m / tick (0.046 m/s for 0.23 mm at 200 Hz),
   // far below any useful limit.
   if (std::fabs(e.d_left) > v_max_tick_ || std::fabs(e.d_right) > v_max_tick_)
     f |= kFusionSpeedLimit;
-  if (filled_ == ring_.size()) {
+  if (filled_ == size_) {
     // Accelerations from the mean speeds of the two halves of the window: a count per half is
     // 2 m / T_h^2 of acceleration (0.18 m/s^2 for 0.23 mm and T_h = 0.05 s), per tick it would be
     // 2 m / tick^2 = 18 m/s^2.
@@ -275,27 +289,12 @@ double Gyrodometry::begin_interval() noexcept {
   return correction;
 }
 
-Gyrodometry::Entry Gyrodometry::entry(const FusionInput& in, double odo, bool usable,
-                                      double dt) const noexcept {
-  Entry e;
-  e.odo = odo;
-  e.d_left = in.d_left;
-  e.d_right = in.d_right;
-  // Chong-Kleeman: wheel variances k^2 |d|; the heading difference divides by b twice.
-  e.var = (k2_left_ * std::fabs(in.d_left) + k2_right_ * std::fabs(in.d_right)) /
-          (in.wheelbase * in.wheelbase);
-  e.gyro_ok = usable;
-  e.raw = usable ? (in.gyro.rate_z - bias_) * dt : 0.0;
-  e.gyro = scale_ * e.raw;
-  return e;
-}
-
 std::uint32_t Gyrodometry::disagree_flag() const noexcept {
   // Only full rings are compared (edge_bounds needs the ticks beyond the window's old edge);
   // T >= base_threshold_: most ticks are decided without the window-dependent terms.
   const double abs_err = std::fabs(sum_err_);
   const bool flag =
-      bad_ == 0 && filled_ == ring_.size() && abs_err > base_threshold_ && abs_err > threshold();
+      bad_ == 0 && filled_ == size_ && abs_err > base_threshold_ && abs_err > threshold();
   return flag ? kFusionDisagree : 0u;
 }
 
@@ -315,18 +314,20 @@ FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
     if (gyro_was_ok_) ++counters_.gyro_faults;
   }
   gyro_was_ok_ = rate_ok;
-  const bool still = in.d_left == 0.0 && in.d_right == 0.0;
-  if (still) out.flags |= kFusionStill;
-  update_bias(in, rate_ok, still, dt);
+  if (in.d_left == 0.0 && in.d_right == 0.0) {
+    out.flags |= kFusionStill;
+    update_bias(in.gyro.rate_z, rate_ok, dt);
+  } else {
+    still_for_ = 0.0;  // moving: a standstill starts over
+  }
   const bool usable = rate_ok && bias_valid();
   if (!bias_valid()) out.flags |= kFusionNoBias;
-  push(entry(in, odo, usable, dt));
+  const Entry& fresh = push(in, odo, usable, dt);
   if (!usable) {
     in_interval_ = false;  // a faulty gyro ends any flagged interval: odometry from here on
     hold_ = 0;
     return out;
   }
-  const Entry& fresh = ring_[head_];
   if (scale_estimation_ && !in_interval_ && fresh.err_ok)
     update_scale(fresh.odo_cmp, (1.0 - g_) * fresh.raw + g_ * at(1).raw, dt);
   const std::uint32_t limits = limit_flags();

@@ -81,6 +81,8 @@ SimGyro::SimGyro(SimRobot& robot, const GyroModel& m, std::uint64_t seed, TimeNs
   // the f T samples of T seconds, times T, has the angle random walk's sigma N sqrt(T).
   sigma_ = m.noise_density * std::sqrt(1.0 / to_seconds(period_));
   walk_step_ = m.bias_walk * std::sqrt(to_seconds(period_));
+  walk_step1_ = walk_step_ * std::sqrt(3.0);  // read()'s walk factor for one sample
+  inv_period_ = 1.0 / to_seconds(period_);
   next_t_ = robot.time() + period_;
   last_theta_ = robot.true_pose().theta;
   book_.stale_timeout = stale_timeout;
@@ -89,12 +91,16 @@ SimGyro::SimGyro(SimRobot& robot, const GyroModel& m, std::uint64_t seed, TimeNs
   hist_n_ = 1;
 }
 
-double SimGyro::heading_at(TimeNs t) const noexcept {
+// heading_at and sample run for every sample and are called from read() only: inline.
+inline double SimGyro::heading_at(TimeNs t) const noexcept {
   // Newest first: the wanted time is almost always between the last two reads.
   const Past* newer = &hist_[hist_head_];
   for (std::size_t i = 1; i < hist_n_; ++i) {
-    const Past& older = hist_[(hist_head_ + kHistory - i) % kHistory];
+    const Past& older = hist_[(hist_head_ - i) & (kHistory - 1)];
     if (older.t <= t) {
+      // A sample at a read's time (the reads and samples on one clock): no interpolation (the
+      // interpolation would add 0 * (newer - older) to it).
+      if (older.t == t) return older.theta;
       const double span = static_cast<double>(newer->t - older.t);
       if (span <= 0.0) return newer->theta;
       const double f = static_cast<double>(t - older.t) / span;
@@ -105,22 +111,23 @@ double SimGyro::heading_at(TimeNs t) const noexcept {
   return newer->theta;  // older than the history: the oldest known heading
 }
 
-double SimGyro::sample(double true_rate, bool& saturated) noexcept {
+inline double SimGyro::sample(double true_rate, bool& saturated) noexcept {
   double r = (1.0 + m_.scale_error) * true_rate + m_.bias_offset + walk_ + sigma_ * normal_();
   if (saturate_left_ > 0) {
     --saturate_left_;
     ++injected_.saturated_samples;
     r = 2.0 * m_.full_scale;
   }
-  const double q = std::nearbyint(r / lsb_);
+  const double q = round_to_int(r / lsb_);
   const double hi = static_cast<double>(raw_max_), lo = -hi - 1.0;
   saturated = q >= hi || q <= lo;
   return (q > hi ? hi : (q < lo ? lo : q)) * lsb_;
 }
 
 GyroSample SimGyro::read(TimeNs now) noexcept {
-  robot_.advance_to(now);
-  hist_head_ = (hist_head_ + 1) % kHistory;
+  // The encoder's read of the same tick has usually moved the robot to `now` already.
+  if (robot_.time() < now) robot_.advance_to(now);
+  hist_head_ = (hist_head_ + 1) & (kHistory - 1);
   hist_[hist_head_] = {robot_.time(), robot_.true_pose().theta};
   if (hist_n_ < kHistory) ++hist_n_;
   if (silence_ > 0) {
@@ -129,11 +136,10 @@ GyroSample SimGyro::read(TimeNs now) noexcept {
   }
   GyroSample s;
   double sum = 0.0;
-  const double inv_period = 1.0 / to_seconds(period_);
   // Every sample whose motion ended at next_t_ is available delay_ later.
   while (next_t_ + delay_ <= now) {
     const double theta = heading_at(next_t_);
-    const double true_rate = (theta - last_theta_) * inv_period;
+    const double true_rate = (theta - last_theta_) * inv_period_;
     last_theta_ = theta;
     const TimeNs avail = next_t_ + delay_;
     next_t_ += period_;
@@ -152,10 +158,13 @@ GyroSample SimGyro::read(TimeNs now) noexcept {
   }
   // The bias walks once per read by the samples' combined step (sigma K sqrt(n T_s)), drawn
   // uniform with that sigma (sqrt(3) (2u - 1)): summed over many reads it is the same Brownian
-  // walk (central limit), at a fraction of a Gaussian draw's cost.
+  // walk (central limit). u comes from the last sample's normal draw, from bits that draw did
+  // not use: no generator call of its own.
   if (s.samples > 0 && walk_step_ > 0.0) {
     const double u = normal_.uniform();
-    walk_ += walk_step_ * std::sqrt(3.0 * static_cast<double>(s.samples)) * (2.0 * u - 1.0);
+    const double step =
+        s.samples == 1 ? walk_step1_ : walk_step_ * std::sqrt(3.0 * static_cast<double>(s.samples));
+    walk_ += step * (2.0 * u - 1.0);
   }
   book_.close(s, now, s.samples > 0 ? sum / s.samples : 0.0);
   if (nan_left_ > 0) {

@@ -170,8 +170,9 @@ class OdometryLoop {
   TimeNs wait_for_deadline() noexcept;
   // integrate: the encoder sample's motion since the previous good one (and the gyro's, fused).
   void integrate(const EncoderSample& s) noexcept;
-  // integrate_fused: one interval of count deltas dl, dr over dt [s] with the gyro's reading.
-  void integrate_fused(std::int64_t dl, std::int64_t dr, double dt, const GyroSample& g) noexcept;
+  // integrate_fused: one interval of count deltas dl, dr over dt [s] with the gyro's reading up to
+  // `stamp` [ns].
+  void integrate_fused(std::int64_t dl, std::int64_t dr, double dt, TimeNs stamp) noexcept;
   // record_wakeup: the wake-up latency [ns] into the statistics.
   void record_wakeup(TimeNs latency) noexcept;
   // fill_snapshot: this tick's snapshot in the back slot (every field that changes).
@@ -196,7 +197,9 @@ class OdometryLoop {
   YawRateSource* gyro_ = nullptr;
   std::optional<Gyrodometry> fusion_;  // engaged when gyro_ is set
   bool gyro_scale_estimation_ = true;
-  GyroSample last_gyro_;  // the gyro's last reading (for the snapshot)
+  // The last tick's fusion input; its gyro field is the gyro's last reading (for the snapshot),
+  // read into it directly (a 64-byte GyroSample copied once a tick, not twice).
+  FusionInput fused_in_;
   std::uint32_t last_fusion_flags_ = 0;
   std::array<TickObserver*, kMaxObservers> observers_{};
   std::size_t n_observers_ = 0;

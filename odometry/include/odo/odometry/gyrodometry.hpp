@@ -222,18 +222,20 @@ class Gyrodometry {
     bool replaced = false;  // err already integrated as a correction
   };
   explicit Gyrodometry(const GyrodometryParams& p);
-  void update_bias(const FusionInput& in, bool rate_ok, bool still, double dt) noexcept;
+  // update_bias: a still tick of length dt [s] with the gyro's rate [rad/s] (usable if rate_ok).
+  void update_bias(double rate, bool rate_ok, double dt) noexcept;
   void update_scale(double odo, double raw_gyro, double dt) noexcept;
   void update_b_res() noexcept;
   // travel_step: the centre-travel correction [m] of this tick, after the interval's heading
   // corrections reached c [rad] (see the top of this file).
   double travel_step(double c) noexcept;
-  // entry: this tick's ring entry (travels, odometry's increment and variance, the gyro's).
-  Entry entry(const FusionInput& in, double odo, bool usable, double dt) const noexcept;
   std::uint32_t disagree_flag() const noexcept;  // kFusionDisagree when |E| > T
-  void push(const Entry& e) noexcept;
+  // push: this tick's entry (travels, odometry's increment odo [rad] and variance, the gyro's),
+  // written in place as the newest, aligned and added to the window's sums.
+  Entry& push(const FusionInput& in, double odo, bool usable, double dt) noexcept;
   void align(Entry& e) noexcept;
-  void add_to_window(const Entry& e, double sign) noexcept;
+  void add_to_window(const Entry& e) noexcept;       // into the window's running sums
+  void remove_from_window(const Entry& e) noexcept;  // out of them (it left the window)
   void resum() noexcept;
   double edge_bounds() const noexcept;
   std::uint32_t limit_flags() const noexcept;
@@ -244,12 +246,16 @@ class Gyrodometry {
   // continue_interval: a further flagged tick replaces odometry's increment of m ticks ago by the
   // gyro's aligned one (err [rad]).
   void continue_interval(double odo, double err, double dt, FusedTick& out) noexcept;
-  std::size_t index(std::size_t age) const noexcept;  // ring index of an age (0: the newest)
+  // index: ring index of an age (0: the newest); age < ring size: one conditional wrap.
+  std::size_t index(std::size_t age) const noexcept {
+    return head_ >= age ? head_ - age : head_ + size_ - age;
+  }
   Entry& at(std::size_t age) noexcept { return ring_[index(age)]; }
   const Entry& at(std::size_t age) const noexcept { return ring_[index(age)]; }
 
   GyrodometryParams p_;
   std::vector<Entry> ring_;
+  std::size_t size_ = 0;                   // ring_.size(), kept (a division by sizeof(Entry))
   std::size_t head_ = 0;                   // index of the newest entry
   std::size_t filled_ = 0;                 // entries in use (<= ring size)
   std::size_t n_ = 2;                      // ticks in the window

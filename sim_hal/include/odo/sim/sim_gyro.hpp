@@ -89,11 +89,20 @@ class SimGyro final : public YawRateSource {
     TimeNs t;
     double theta;
   };
-  static constexpr std::size_t kHistory = 64;
+  static constexpr std::size_t kHistory = 64;  // a power of two (indices wrap by a mask)
+  // round_to_int: std::nearbyint in the default rounding mode (to nearest, ties to even), inline
+  // (nearbyint is a library call on baseline x86-64): adding and subtracting 1.5 * 2^52 rounds
+  // |v| < 2^51 exactly so; larger magnitudes are integers already.
+  static double round_to_int(double v) noexcept {
+    constexpr double kShift = 0x1.8p52;
+    return (v < 0x1.0p51 && v > -0x1.0p51) ? (v + kShift) - kShift : v;
+  }
   SimRobot& robot_;
   GyroModel m_;
   ZigguratNormal normal_;
   double lsb_ = 0.0, sigma_ = 0.0, walk_step_ = 0.0;
+  double walk_step1_ = 0.0;  // walk_step_ sqrt(3): a read's walk factor for one sample
+  double inv_period_ = 0.0;  // 1 / sample period [1/s]
   std::int64_t raw_max_ = 0;
   TimeNs period_ = 0, delay_ = 0;
   TimeNs next_t_ = 0;        // truth time of the next sample [ns]
