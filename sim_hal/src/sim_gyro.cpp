@@ -161,7 +161,7 @@ GyroSample SimGyro::read(TimeNs now) noexcept {
   // walk (central limit). u comes from the last sample's normal draw, from bits that draw did
   // not use: no generator call of its own.
   if (s.samples > 0 && walk_step_ > 0.0) {
-    const double u = normal_.uniform();
+    const double u = normal_.spare_uniform();
     const double step =
         s.samples == 1 ? walk_step1_ : walk_step_ * std::sqrt(3.0 * static_cast<double>(s.samples));
     walk_ += step * (2.0 * u - 1.0);

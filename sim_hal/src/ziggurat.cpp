@@ -12,6 +12,17 @@ constexpr double kM1 = 2147483648.0;  // 2^31
 
 }  // namespace
 
+Xoshiro256pp::Xoshiro256pp(std::uint64_t seed) noexcept {
+  // SplitMix64 (Steele, Lea & Flood 2014): consecutive outputs fill the state; its outputs are a
+  // bijection of distinct counters, so the four words are never all zero.
+  for (std::uint64_t& w : s_) {
+    std::uint64_t z = (seed += 0x9e3779b97f4a7c15u);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
+    w = z ^ (z >> 31);
+  }
+}
+
 ZigguratNormal::ZigguratNormal(std::uint64_t seed) : rng_(seed) {
   double dn = kR, tn = kR;
   const double q = kV / std::exp(-0.5 * dn * dn);

@@ -64,6 +64,71 @@ TEST(ZigguratNormal, MomentsAndTails) {
   for (int i = 0; i < 1000; ++i) ASSERT_EQ(a(), b());
 }
 
+TEST(ZigguratNormal, SpareUniformIsUniformAndIndependentOfTheNormal) {
+  // The simulated gyro's bias walk takes its uniform from the 25 bits of a normal draw's word that
+  // the normal does not use. 2e6 pairs (x, u): u's mean 1/2 within 5 standard errors
+  // (sqrt(1/12 / 2e6) = 2.04e-4), its variance 1/12 within 5 of its standard errors
+  // (sqrt((1/80 - 1/144) / 2e6) = 5.27e-5); its correlations with x and with x^2 (a dependence
+  // through the magnitude) within 5 / sqrt(2e6) = 3.5e-3 of 0; and the fraction of u below 1/4 as
+  // uniform (0.25 within 5 sqrt(0.1875 / 2e6) = 1.53e-3).
+  ZigguratNormal z(11);
+  const int n = 2'000'000;
+  double su = 0.0, su2 = 0.0, sx = 0.0, sx2 = 0.0, sx4 = 0.0, sxu = 0.0, sx2u = 0.0;
+  int quarter = 0;
+  for (int i = 0; i < n; ++i) {
+    const double x = z(), u = z.spare_uniform();
+    ASSERT_GT(u, 0.0);
+    ASSERT_LT(u, 1.0);
+    su += u;
+    su2 += u * u;
+    sx += x;
+    sx2 += x * x;
+    sx4 += x * x * x * x;
+    sxu += x * u;
+    sx2u += x * x * u;
+    quarter += u < 0.25;
+  }
+  const double mu = su / n, vu = su2 / n - mu * mu;
+  const double mx = sx / n, vx = sx2 / n - mx * mx;
+  const double mx2 = sx2 / n, vx2 = sx4 / n - mx2 * mx2;
+  const double corr_xu = (sxu / n - mx * mu) / std::sqrt(vx * vu);
+  const double corr_x2u = (sx2u / n - mx2 * mu) / std::sqrt(vx2 * vu);
+  EXPECT_NEAR(mu, 0.5, 5 * 2.04e-4);
+  EXPECT_NEAR(vu, 1.0 / 12.0, 5 * 5.27e-5);
+  EXPECT_NEAR(corr_xu, 0.0, 3.5e-3);
+  EXPECT_NEAR(corr_x2u, 0.0, 3.5e-3);
+  EXPECT_NEAR(static_cast<double>(quarter) / n, 0.25, 1.53e-3);
+}
+
+TEST(SimGyro, BiasWalkMatchesTheRandomWalkCoefficient) {
+  // Bias instability as a random walk of coefficient K: after N samples of period T_s the walk
+  // has variance K^2 N T_s, whether the reads take one sample each (1 ms ticks) or ten (10 ms).
+  // 2000 gyros (seeds), 1 s each: the sample variance within 16 % (5 relative standard errors
+  // sqrt(2 / 2000) = 3.2 %) of K^2 N T_s, and the mean within 5 standard errors of 0.
+  const GyroModel model = consumer_gyro();  // K = 9.70e-7 rad/s/sqrt(s), 1 kHz
+  for (const TimeNs tick : {TimeNs{1'000'000}, TimeNs{10'000'000}}) {
+    const int gyros = 2000;
+    double sum = 0.0, sum2 = 0.0;
+    std::uint64_t samples = 0;
+    for (int i = 0; i < gyros; ++i) {
+      SimRobot robot = SimRobot::create(RobotGeometry{}, Scenario{{2.0, 0.0, 0.0}}).value();
+      SimGyro g = SimGyro::create(robot, model, static_cast<std::uint64_t>(i) + 1).value();
+      GyroSample s;
+      for (TimeNs t = tick; t <= kNsPerSecond; t += tick) s = g.read(t);
+      const double walk = g.bias() - model.bias_offset;
+      sum += walk;
+      sum2 += walk * walk;
+      samples = s.counters.samples;  // the same for every seed
+    }
+    const double expected =
+        model.bias_walk * model.bias_walk * static_cast<double>(samples) / model.odr;
+    const double mean = sum / gyros, var = sum2 / gyros - mean * mean;
+    EXPECT_GT(samples, 990u);
+    EXPECT_NEAR(var, expected, 0.16 * expected) << "tick " << tick << " ns";
+    EXPECT_NEAR(mean, 0.0, 5.0 * std::sqrt(expected / gyros)) << "tick " << tick << " ns";
+  }
+}
+
 TEST(SimGyro, ParameterSetsFromTheDatasheets) {
   // BMI088: 0.014 deg/s/sqrt(Hz) = 2.443461e-4 rad/s/sqrt(Hz); 2000 deg/s = 34.90659 rad/s over
   // 32768 LSB = 1.065264e-3 rad/s (16.384 LSB per deg/s); 1 deg/s offset = 1.745329e-2 rad/s.
