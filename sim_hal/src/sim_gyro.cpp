@@ -1,5 +1,6 @@
 #include "odo/sim/sim_gyro.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -118,10 +119,12 @@ inline double SimGyro::sample(double true_rate, bool& saturated) noexcept {
     ++injected_.saturated_samples;
     r = 2.0 * m_.full_scale;
   }
-  const double q = round_to_int(r / lsb_);
+  // Saturated to the word's range before rounding: the same as rounding and then saturating (the
+  // ends are integers), and it keeps round_to_int's argument where it is exact. NaN passes.
   const double hi = static_cast<double>(raw_max_), lo = -hi - 1.0;
+  const double q = round_to_int(std::min(std::max(r / lsb_, lo), hi));
   saturated = q >= hi || q <= lo;
-  return (q > hi ? hi : (q < lo ? lo : q)) * lsb_;
+  return q * lsb_;
 }
 
 GyroSample SimGyro::read(TimeNs now) noexcept {

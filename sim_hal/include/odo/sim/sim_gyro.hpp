@@ -90,12 +90,15 @@ class SimGyro final : public YawRateSource {
     double theta;
   };
   static constexpr std::size_t kHistory = 64;  // a power of two (indices wrap by a mask)
-  // round_to_int: std::nearbyint in the default rounding mode (to nearest, ties to even), inline
-  // (nearbyint is a library call on baseline x86-64): adding and subtracting 1.5 * 2^52 rounds
-  // |v| < 2^51 exactly so; larger magnitudes are integers already.
+  // round_to_int: std::nearbyint in the default rounding mode (to nearest, ties to even) for
+  // |v| <= 2^51, inline (nearbyint is a library call on baseline x86-64): v + 1.5 * 2^52 then
+  // lies in [2^52, 2^53], where the spacing of doubles is 1, and subtracting 1.5 * 2^52 again is
+  // exact. The caller keeps v in range (sample() saturates it to a word of at most 32 bits
+  // first); NaN stays NaN. Only the sign of a zero can differ (-0.4 gives +0, nearbyint -0),
+  // which no sum of samples keeps.
   static double round_to_int(double v) noexcept {
     constexpr double kShift = 0x1.8p52;
-    return (v < 0x1.0p51 && v > -0x1.0p51) ? (v + kShift) - kShift : v;
+    return (v + kShift) - kShift;
   }
   SimRobot& robot_;
   GyroModel m_;
