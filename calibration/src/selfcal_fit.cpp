@@ -175,7 +175,8 @@ Verdict decide(const SelfCalConfig& c, const SelfCalResult& r) {
   if (r.sigma[0] > c.max_sigma_factor || r.sigma[1] > c.max_sigma_factor ||
       r.sigma[2] > c.max_sigma_wheelbase)
     return Verdict::kTooUncertain;
-  return r.score_candidate < r.score_in_use ? Verdict::kAccepted : Verdict::kNotBetter;
+  return r.score_candidate < (1.0 - c.min_improvement) * r.score_in_use ? Verdict::kAccepted
+                                                                        : Verdict::kNotBetter;
 }
 
 }  // namespace
