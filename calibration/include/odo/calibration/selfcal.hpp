@@ -25,7 +25,10 @@
 //     fix is rejected (its two excursions merge into one) and the fit is redone. Robust
 //     re-check: each rejected fix is tested again against the final estimate (both of its
 //     excursions within the gate, with the parameter uncertainty added to S) and re-admitted
-//     if it passes, followed by one more fit.
+//     if it passes, followed by one more fit. When half of the fixes (at least 3) would be
+//     rejected, the outliers have dragged the estimate (24 h soak: b = 288 mm, 19 good fixes
+//     rejected): the rejection starts again, removing each time the fix whose removal leaves
+//     the smallest chi2 per dof (leave-one-out).
 //  4. Scale: excursions that end where they started (a dock) cannot see the distance scale:
 //     multiplying c_L, c_R and b by one factor scales the closed path about its start. When the
 //     standard deviation of m = (c_L + c_R)/2 exceeds max_sigma_factor, the estimate and its
