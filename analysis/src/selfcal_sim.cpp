@@ -77,16 +77,16 @@ sim::Scenario random_excursion(std::mt19937_64& rng, const Pose2& start) {
   return s;
 }
 
-double selfcal_e_max_syst(const calib::Factors& f, bool rough) {
+double selfcal_e_max_syst(const calib::Factors& f, bool rough, int n, std::uint64_t floor_seed) {
   const Kinematics k = selfcal_kinematics(f);
   std::vector<calib::UmbmarkRun> runs;
-  for (int i = 0; i < 10; ++i) {
+  for (int i = 0; i < 2 * n; ++i) {
     sim::SquareOptions so;
-    so.direction = i < 5 ? sim::Turn::kClockwise : sim::Turn::kCounterClockwise;
+    so.direction = i < n ? sim::Turn::kClockwise : sim::Turn::kCounterClockwise;
     auto robot = *sim::SimRobot::create(truth_geometry(), sim::square_scenario(k, so));
     sim::UmbmarkFloor::Options fo;
     fo.roughness_height = rough ? kPaperRoughness : 0.0;
-    sim::UmbmarkFloor floor(fo, 500 + static_cast<std::uint64_t>(i));
+    sim::UmbmarkFloor floor(fo, floor_seed + static_cast<std::uint64_t>(i));
     robot.set_travel_perturbation(&floor);
     Odometry odo(k);
     std::int64_t pl = robot.counts_left(), pr = robot.counts_right();
@@ -97,7 +97,7 @@ double selfcal_e_max_syst(const calib::Factors& f, bool rough) {
       pl = robot.counts_left();
       pr = robot.counts_right();
     }
-    runs.push_back({i < 5 ? calib::Direction::kCw : calib::Direction::kCcw,
+    runs.push_back({i < n ? calib::Direction::kCw : calib::Direction::kCcw,
                     robot.true_pose().x - odo.pose().x, robot.true_pose().y - odo.pose().y,
                     std::nullopt, false});
   }

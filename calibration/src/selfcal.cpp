@@ -246,6 +246,8 @@ Status check_selfcal_config(const SelfCalConfig& c) {
                       {"max_sigma_wheelbase", c.max_sigma_wheelbase}}) {
     if (!(std::isfinite(v) && v > 0.0)) return positive(f, v);
   }
+  if (!(c.min_improvement >= 0.0 && c.min_improvement <= 0.9))
+    return range_error({"min_improvement", c.min_improvement, 0.0, 0.9});
   if (auto s = check_error_model(c.odometry_noise); !s) return s;
   if (c.max_iterations < 1 || c.max_iterations > 100)
     return range_error(integer_range("max_iterations", c.max_iterations, 1, 100));

@@ -138,6 +138,7 @@ void SelfCalEstimator::fit() {
   c.hold_out_every = s_.cfg.hold_out_every;
   c.max_sigma_factor = s_.cfg.max_sigma_factor;
   c.max_sigma_wheelbase = s_.cfg.max_sigma_wheelbase;
+  c.min_improvement = s_.cfg.min_improvement;
   const std::vector<calib::CountSegment> segs(segs_.begin(), segs_.end());
   auto track = calib::build_track(segs, window_);
   auto r = track ? calib::fit_fixes(*track, c) : Result<calib::SelfCalResult>(track.error());

@@ -40,21 +40,31 @@ odo::calib::FixTrack make_track(int excursions) {
   return t;
 }
 
-// fit_fixes over N excursions (the whole pipeline: rejection, re-check, held-out fit); items
-// are fixes, so items/s is the inverse of the cost per fix.
-void BM_FitFixes(benchmark::State& state) {
+// fit_fixes over N excursions (the whole pipeline: rejection, re-check, the acceptance folds);
+// items are fixes, so items/s is the inverse of the cost per fix. BM_FitFixes: the default
+// cross-validated acceptance (four folds' fits and the fit on all); BM_FitFixesHoldOut: one
+// fold held out, as before.
+void fit_fixes_bench(benchmark::State& state, odo::calib::Acceptance a) {
   const auto n = static_cast<int>(state.range(0));
   const odo::calib::FixTrack t = make_track(n);
   odo::calib::SelfCalConfig c;
   c.metres_per_count = 1.4381e-5;
   c.in_use = {1.0, 1.0, 0.34};
+  c.acceptance = a;
   for (auto _ : state) {
     auto r = odo::calib::fit_fixes(t, c);
     benchmark::DoNotOptimize(r);
   }
   state.SetItemsProcessed(state.iterations() * n);
 }
+void BM_FitFixes(benchmark::State& state) {
+  fit_fixes_bench(state, odo::calib::Acceptance::kCrossValidated);
+}
+void BM_FitFixesHoldOut(benchmark::State& state) {
+  fit_fixes_bench(state, odo::calib::Acceptance::kHoldOut);
+}
 BENCHMARK(BM_FitFixes)->Arg(5)->Arg(20)->Arg(40)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FitFixesHoldOut)->Arg(20)->Unit(benchmark::kMillisecond);
 
 // One tick of the loop's recording: add_tick with LabMate counts at 100 Hz (a segment closes
 // every second tick).

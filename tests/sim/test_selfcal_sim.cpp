@@ -156,18 +156,24 @@ TEST(SELFCAL_SUITE, NoiseFreeFixesWithinFiveHundredthsOfAPercent) {
   }
 }
 
+// manual_pass: the factors of one manual UMBmark pass, `odomctl umbmark simulate --noise paper
+// --seed S` (5 + 5 squares on the report's floor, 2 mm / 0.4 deg reference).
+Factors manual_pass(std::uint64_t seed) {
+  analysis::UmbmarkSimOptions uo;
+  uo.noise = analysis::UmbmarkNoise::kPaper;
+  uo.seed = seed;
+  auto manual = analysis::run_umbmark_simulation(uo);
+  EXPECT_TRUE(manual) << manual.error().message;
+  return manual ? manual->passes[0].result.composed : Factors{1.0, 1.0, kBn};
+}
+
 // noisy_seed: 20 excursions with fixes of sigma 5 mm and 0.5 deg on the report's floor
 // (roughness up to 1.3 mm every ~2 cm) under the excursions and under every UMBmark square,
 // and one manual UMBmark pass (the firmware's simulation at the report's noise: that floor and
 // the 2 mm / 0.4 deg reference, 5 + 5 runs). Both E_max,syst are measured by the same 5 + 5
 // squares on the same floor. Returns {self-calibrated, manual} [m].
 std::pair<double, double> noisy_seed(std::uint64_t seed, bool table) {
-  analysis::UmbmarkSimOptions uo;
-  uo.noise = analysis::UmbmarkNoise::kPaper;
-  uo.seed = seed;
-  auto manual = analysis::run_umbmark_simulation(uo);
-  EXPECT_TRUE(manual) << manual.error().message;
-  const Factors m = manual->passes[0].result.composed;
+  const Factors m = manual_pass(seed);
   const double e_manual = e_max_syst(m, true);
   const Drive d = drive({20, 0.005, 0.5 * kPi / 180.0, true, seed});
   double e = 0.0;
@@ -213,21 +219,75 @@ double median(std::vector<double> v) {
   return 0.5 * (v[(v.size() - 1) / 2] + v[v.size() / 2]);
 }
 
-// Issue 18's target, over 8 seeds (both methods are noisy): the median E_max,syst of the
-// self-calibrated robot after 20 excursions no worse than the median of one manual pass.
-// NOT MET yet (14.3 mm against 10.7 mm): E_max,syst on this floor moves 6 mm per 0.1 mm of b,
-// the squares' effective b is 338.2 mm and the excursions give 338.1 mm on average.
-// Built as study_selfcal (label target: not run by tools/test.sh until it is met).
-TEST(SELFCAL_SUITE, NoisyFixesBeatOneManualUmbmarkPass) {
-  std::vector<double> e_self, e_manual;
-  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
-    const auto [s, m] = noisy_seed(seed, false);
-    e_self.push_back(s);
-    e_manual.push_back(m);
+// The yardstick: E_max,syst of the effective truth on the report's floor (c_R/c_L 0.9985, the
+// floor shortening every wheel's travel by ~0.32 %: b = 0.337 / (1 - 0.0032) = 338.08 mm at
+// scale 1) over independent floor draws. With 5 + 5 squares the centres of gravity keep the
+// floor's random error (measured: 12.0 +- 4.7 mm over 40 draws); with 200 + 200 what is left is
+// the systematic error (2.1 +- 1.1 mm over 8 draws): every draw below 5 mm.
+TEST(SELFCAL_SUITE, TheReportsFiveSquaresMeasureTheFloorMoreThanTheCalibration) {
+  const double r = 0.9985, b = 0.337 / (1 - 0.0032);
+  const Factors truth{2 / (1 + r), 2 * r / (1 + r), b};
+  for (int runs : {5, 200}) {
+    const int draws = runs == 5 ? 40 : 8;
+    double sum = 0, sum2 = 0, lo = 1e9, hi = 0;
+    for (int k = 0; k < draws; ++k) {
+      const double e = analysis::selfcal_e_max_syst(truth, true, runs, 200000 + 1000 * k);
+      sum += e;
+      sum2 += e * e;
+      lo = std::min(lo, e);
+      hi = std::max(hi, e);
+    }
+    const double mean = sum / draws, sd = std::sqrt((sum2 - draws * mean * mean) / (draws - 1));
+    std::printf("%d + %d squares, %d floor draws: E_max,syst %.2f +- %.2f mm (%.2f .. %.2f)\n",
+                runs, runs, draws, 1e3 * mean, 1e3 * sd, 1e3 * lo, 1e3 * hi);
+    if (runs == 5) EXPECT_GT(hi, 0.015);  // one perfect calibration scores above 15 mm
+    if (runs == 200) EXPECT_LT(hi, 0.005);
   }
-  std::printf("median E_max,syst over 8 seeds: self-calibrated %.2f mm, manual pass %.2f mm\n",
-              1e3 * median(e_self), 1e3 * median(e_manual));
-  EXPECT_LE(median(e_self), median(e_manual));
+}
+
+// Issue 18's target: E_max,syst of the self-calibrated robot (20 excursions, 5 mm / 0.5 deg
+// dock fixes, the report's floor) no worse than after one manual UMBmark pass at the report's
+// noise, over 24 seeds. Both calibrations are scored by the same squares on the same floor;
+// the yardstick is the systematic error the report means, the centres of gravity of 200 cw +
+// 200 ccw squares (floor seeds 100000 ..): with the report's 5 + 5 squares the floor's random
+// error stays in the centres of gravity and one calibration scores 5 to 18 mm depending on a
+// 0.05 mm change of b (BENCHMARKS.md). The 5 + 5 figure is printed too. The manual pass uses
+// the floor seeds of `umbmark simulate --seed S`, the excursions seeds S * 1000 + e: the same
+// floor statistics, independent draws. Built as study_selfcal (label target).
+TEST(SELFCAL_SUITE, NoisyFixesBeatOneManualUmbmarkPass) {
+  constexpr int kSeeds = 24, kRuns = 200;
+  constexpr std::uint64_t kYardstick = 100000;
+  std::vector<double> s5, m5, s_sys, m_sys;
+  for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
+    const Factors m = manual_pass(seed);
+    const Drive d = drive({20, 0.005, 0.5 * kPi / 180.0, true, seed});
+    auto r = fit(d, config(true), 21);
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_EQ(r->verdict, calib::Verdict::kAccepted) << "seed " << seed;
+    const Factors f = r->estimate;
+    s5.push_back(e_max_syst(f, true));
+    m5.push_back(e_max_syst(m, true));
+    s_sys.push_back(analysis::selfcal_e_max_syst(f, true, kRuns, kYardstick));
+    m_sys.push_back(analysis::selfcal_e_max_syst(m, true, kRuns, kYardstick));
+    std::printf(
+        "seed %2llu: self b %.3f mm c_r/c_l %.6f | manual b %.3f mm c_r/c_l %.6f | E_max,syst "
+        "5+5: self %5.2f manual %5.2f mm; 200+200: self %5.2f manual %5.2f mm\n",
+        static_cast<unsigned long long>(seed), 1e3 * f.wheelbase, f.c_r / f.c_l, 1e3 * m.wheelbase,
+        m.c_r / m.c_l, 1e3 * s5.back(), 1e3 * m5.back(), 1e3 * s_sys.back(), 1e3 * m_sys.back());
+  }
+  for (std::size_t b = 0; b < kSeeds; b += 8) {
+    auto block = [b](const std::vector<double>& v) {
+      return 1e3 * median({v.begin() + static_cast<std::ptrdiff_t>(b),
+                           v.begin() + static_cast<std::ptrdiff_t>(b + 8)});
+    };
+    std::printf(
+        "seeds %2zu-%2zu: median 5+5 self %.2f manual %.2f; 200+200 self %.2f manual %.2f mm\n",
+        b + 1, b + 8, block(s5), block(m5), block(s_sys), block(m_sys));
+  }
+  std::printf(
+      "median over %d seeds: 5+5 self %.2f manual %.2f mm; 200+200 self %.2f manual %.2f mm\n",
+      kSeeds, 1e3 * median(s5), 1e3 * median(m5), 1e3 * median(s_sys), 1e3 * median(m_sys));
+  EXPECT_LE(median(s_sys), median(m_sys));
 }
 #endif
 

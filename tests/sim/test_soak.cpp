@@ -29,29 +29,15 @@
 #include "odo/sim/fault_encoder.hpp"
 #include "sim_fixture.hpp"
 
+// The loop must not allocate: operator new is counted (g_allocations).
+#include "counting_new.hpp"
+
 #ifndef ODO_SOAK_HOURS
 #define ODO_SOAK_HOURS 0.25
 #endif
 #ifndef ODO_SOAK_NAME
 #define ODO_SOAK_NAME QuarterHour
 #endif
-
-namespace {
-std::atomic<std::uint64_t> g_allocations{0};
-}  // namespace
-
-// Counting allocator for this test program: the loop must not allocate after start-up.
-void* operator new(std::size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace odo::test {
 namespace {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -150,6 +151,15 @@ std::vector<LegCounts> mixed_leg(int i) {
 
 const Factors kTruth{0.995, 1.004, 0.41};
 
+// jitter: adds Gaussian noise of standard deviation s to every fix's x, y [m] and theta [rad].
+void jitter(FixTrack& t, double s, std::mt19937_64& rng, std::normal_distribution<double>& n01) {
+  for (PoseFix& f : t.fixes) {
+    f.x += s * n01(rng);
+    f.y += s * n01(rng);
+    *f.theta += s * n01(rng);
+  }
+}
+
 TEST(SelfCal, MixedExcursionsRecoverTheTruth) {
   std::vector<std::vector<LegCounts>> legs;
   for (int i = 0; i < 6; ++i) legs.push_back(mixed_leg(i));
@@ -241,11 +251,7 @@ TEST(SelfCal, CovarianceMatchesMonteCarlo) {
   const int kDraws = 400;
   for (int d = 0; d < kDraws; ++d) {
     FixTrack t = clean;
-    for (PoseFix& f : t.fixes) {
-      f.x += 5e-3 * n01(rng);
-      f.y += 5e-3 * n01(rng);
-      *f.theta += 5e-3 * n01(rng);
-    }
+    jitter(t, 5e-3, rng, n01);
     auto r = fit_fixes(t, exact_config());
     ASSERT_TRUE(r) << r.error().message;
     const double v[3] = {r->estimate.c_l, r->estimate.c_r, r->estimate.wheelbase};
@@ -268,6 +274,7 @@ TEST(SelfCal, AcceptanceNeedsBetterHeldOutPredictionAndSmallSigma) {
   const FixTrack t = track(legs, kTruth, {}, 1e-4);
   SelfCalConfig c = exact_config();
   c.hold_out_every = 4;  // excursions 3, 7, 11 (0-based) held out
+  c.acceptance = Acceptance::kHoldOut;
   auto r = fit_fixes(t, c);
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_EQ(r->excursions_held_out, 3);
@@ -286,6 +293,111 @@ TEST(SelfCal, AcceptanceNeedsBetterHeldOutPredictionAndSmallSigma) {
   r = fit_fixes(t, c);
   ASSERT_TRUE(r);
   EXPECT_EQ(r->verdict, Verdict::kTooUncertain);
+}
+
+TEST(SelfCal, CrossValidationPredictsEveryExcursionAndFitsThemAll) {
+  // 16 excursions, kind (i / 4) % 4: excursions 0-3 of kind 0, 4-7 of kind 1, ... Four folds
+  // (k % 4): fold j holds out excursions j, j + 4, j + 8, j + 12, one of each kind, so each
+  // fold's fit sees 3/4 of the data and every excursion is predicted once: 16 held out.
+  // The candidate is the fit on all 16, the same numbers as hold_out_every = 0 gives; the
+  // kHoldOut candidate sees 12, so its sigmas are larger for every parameter. (Not by exactly
+  // sqrt(16 / 12): consecutive excursions share a fix, so their information does not add, and
+  // removing one changes its neighbours' weight; measured 0.70, 0.81 and 0.82.)
+  std::vector<std::vector<LegCounts>> legs;
+  for (int i = 0; i < 16; ++i) legs.push_back(mixed_leg((i / 4) % 4));
+  const FixTrack t = track(legs, kTruth, {}, 1e-3);
+  SelfCalConfig c = exact_config();
+  c.hold_out_every = 4;
+  auto cv = fit_fixes(t, c);
+  ASSERT_TRUE(cv) << cv.error().message;
+  EXPECT_EQ(cv->excursions_held_out, 16);
+  EXPECT_EQ(cv->excursions_fit, 16);
+  EXPECT_EQ(cv->verdict, Verdict::kAccepted);
+  EXPECT_LT(cv->score_candidate, 1e-3);
+  EXPECT_GT(cv->score_in_use, 1.0);
+  SelfCalConfig none = c;
+  none.hold_out_every = 0;
+  auto all = fit_fixes(t, none);
+  ASSERT_TRUE(all);
+  EXPECT_EQ(cv->estimate.c_l, all->estimate.c_l);
+  EXPECT_EQ(cv->estimate.c_r, all->estimate.c_r);
+  EXPECT_EQ(cv->estimate.wheelbase, all->estimate.wheelbase);
+  c.acceptance = Acceptance::kHoldOut;
+  auto ho = fit_fixes(t, c);
+  ASSERT_TRUE(ho);
+  EXPECT_EQ(ho->excursions_held_out, 4);
+  EXPECT_EQ(ho->excursions_fit, 12);
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::printf("parameter %zu: sigma cross-validated / hold-out %.3f\n", i,
+                cv->sigma[i] / ho->sigma[i]);
+    EXPECT_LT(cv->sigma[i], ho->sigma[i]) << "parameter " << i;
+  }
+}
+
+TEST(SelfCal, ACandidateMustBeatTheCalibrationInUseByTheMargin) {
+  // The data of the test above with the truth in use.
+  std::vector<std::vector<LegCounts>> legs;
+  for (int i = 0; i < 16; ++i) legs.push_back(mixed_leg((i / 4) % 4));
+  FixTrack t = track(legs, kTruth, {}, 1e-3);
+  SelfCalConfig c = exact_config();
+  c.hold_out_every = 4;
+  c.in_use = kTruth;
+  // Fixes with 1 mm / 1 mrad noise: a candidate fitted to that noise predicts the held-out
+  // excursions about as well as the truth (measured: 1.021 against 1.043, 2 % lower), which
+  // without a margin would replace the truth; with the default 10 % the truth stays.
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n01;
+  jitter(t, 1e-3, rng, n01);
+  auto r = fit_fixes(t, c);
+  ASSERT_TRUE(r);
+  std::printf("truth in use, 1 mm fixes: held-out score candidate %.4f, in use %.4f\n",
+              r->score_candidate, r->score_in_use);
+  EXPECT_EQ(r->verdict, Verdict::kNotBetter);
+  c.min_improvement = 0.0;
+  r = fit_fixes(t, c);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->verdict, Verdict::kAccepted);
+  // The margin is a fraction of the in-use score, 0 .. 0.9; outside, the field is named.
+  c.min_improvement = 0.95;
+  auto bad = fit_fixes(t, c);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("min_improvement"), std::string::npos);
+}
+
+TEST(SelfCal, TwoFarOutliersAreFoundWhereverTheyAre) {
+  // 16 mixed excursions, fixes of 5 mm / 5 mrad noise; every pair of fixes (1..16) moved 0.5-5 m
+  // in a random direction (x, y only, as a wrong landmark match): exactly that pair must be
+  // rejected. (These pairs the worst-scored-first rejection finds alone too; the case that
+  // needs the leave-one-out restart, an estimate dragged to b = 288 mm, came from the 24 h soak,
+  // selfcal_soak_24h, which checks that no good fix is flagged.)
+  std::vector<std::vector<LegCounts>> legs;
+  for (int i = 0; i < 16; ++i) legs.push_back(mixed_leg(i));
+  const FixTrack clean = track(legs, kTruth, {}, 5e-3);
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n01;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  SelfCalConfig c = exact_config();
+  c.odometry_noise = {4e-4, 5.8e-4};
+  int wrong = 0, cases = 0;
+  for (int i = 1; i <= 16; ++i) {
+    for (int j = i + 1; j <= 16; ++j) {
+      FixTrack t = clean;
+      jitter(t, 5e-3, rng, n01);
+      for (int k : {i, j}) {
+        const double r = 0.5 + 4.5 * u(rng), a = 2 * kPi * u(rng);
+        t.fixes[static_cast<std::size_t>(k)].x += r * std::cos(a);
+        t.fixes[static_cast<std::size_t>(k)].y += r * std::sin(a);
+      }
+      auto res = fit_fixes(t, c);
+      ASSERT_TRUE(res) << res.error().message;
+      ++cases;
+      if (res->rejected != std::vector<int>{i, j}) {
+        ++wrong;
+        ADD_FAILURE() << "corrupted " << i << ", " << j << ": rejected " << res->fixes_rejected;
+      }
+    }
+  }
+  std::printf("%d pairs, %d with a wrong rejection\n", cases, wrong);
 }
 
 TEST(SelfCal, ClosedLoopsHoldTheScale) {

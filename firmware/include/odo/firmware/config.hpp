@@ -261,6 +261,7 @@ struct SelfCalSection {
   int hold_out_every = 4;               // every n-th excursion held out for the acceptance test
   double max_sigma_factor = 2e-4;       // acceptance bound on sigma(c_L), sigma(c_R)
   double max_sigma_wheelbase = 2e-4;    // [m] acceptance bound on sigma(b)
+  double min_improvement = 0.1;         // held-out score below (1 - this) x the one in use
   double prior_sigma_factor = 0.05;     // prior around the calibration in use
   double prior_sigma_wheelbase = 0.02;  // [m]
 };
@@ -282,6 +283,7 @@ inline constexpr SelfCalRange<int> kSelfCalIntegers[] = {
 inline constexpr SelfCalRange<double> kSelfCalNumbers[] = {
     {"max_sigma_factor", &SelfCalSection::max_sigma_factor, 1e-6, 0.1, ""},
     {"max_sigma_wheelbase", &SelfCalSection::max_sigma_wheelbase, 1e-6, 0.1, "m"},
+    {"min_improvement", &SelfCalSection::min_improvement, 0.0, 0.9, ""},
     {"prior_sigma_factor", &SelfCalSection::prior_sigma_factor, 1e-4, 0.5, ""},
     {"prior_sigma_wheelbase", &SelfCalSection::prior_sigma_wheelbase, 1e-4, 1.0, "m"}};
 

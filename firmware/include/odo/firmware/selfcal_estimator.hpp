@@ -83,6 +83,14 @@ class SelfCalEstimator {
   SelfCalCounters counters() const;
   // in_use: the kinematic parameters the estimator believes the loop runs on.
   KinematicParams in_use() const;
+  // Backlog: what the estimator holds between fits (its memory grows with these only).
+  struct Backlog {
+    std::size_t segments = 0;  // count segments kept for the window
+    std::size_t window = 0;    // fixes in the window (<= max_fixes)
+    std::size_t pending = 0;   // fixes not ripe yet
+  };
+  // backlog: from the estimator's thread, or while it is not running (soak and tests).
+  Backlog backlog() const noexcept { return {segs_.size(), window_.size(), pending_.size()}; }
 
  private:
   void take_fixes(TimeNs until);
