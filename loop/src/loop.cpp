@@ -49,7 +49,8 @@ OdometryLoop::OdometryLoop(TimeNs period, const LoopConfig& cfg, const Kinematic
       calibration_(cfg.calibration),
       enc_(&enc),
       clock_(&clock),
-      bits_(enc.counter_bits()) {}
+      bits_(enc.counter_bits()),
+      start_wait_(cfg.start_wait) {}
 
 bool OdometryLoop::add_observer(TickObserver* o) noexcept {
   if (n_observers_ >= kMaxObservers) return false;
@@ -58,7 +59,15 @@ bool OdometryLoop::add_observer(TickObserver* o) noexcept {
 }
 
 void OdometryLoop::start() noexcept {
-  const EncoderSample s = enc_->read(clock_->now());
+  EncoderSample s = enc_->read(clock_->now());
+  // A reference reading before the encoder is ready would make a resume impossible
+  // (encoder-not-ready) and the first real counts relative to nothing: wait for it, bounded.
+  constexpr std::uint32_t kNotReady = kEncoderReadError | kEncoderStaleLeft | kEncoderStaleRight;
+  for (const TimeNs until = clock_->now() + start_wait_;
+       (s.flags & kNotReady) != 0 && clock_->now() < until;) {
+    clock_->sleep_until(clock_->now() + kNsPerSecond / 1000);  // 1 ms
+    s = enc_->read(clock_->now());
+  }
   if (resume_offered_) apply_resume(s);
   // The gyro's samples up to now belong to no interval of the encoders: dropped.
   if (gyro_ != nullptr) last_gyro_ = gyro_->read(clock_->now());
@@ -96,6 +105,7 @@ void OdometryLoop::apply_resume(const EncoderSample& s) noexcept {
   // The downtime is one long step, as after an overrun: its counts are integrated exactly
   // once (the arc of a constant-curvature gap is exact) and the covariance grows for it.
   odom_.advance(resume_.dl, resume_.dr, to_seconds(resume_.gap));
+  resume_.pose = odom_.pose();
 }
 
 LoopSnapshot& OdometryLoop::copy_newest() noexcept {

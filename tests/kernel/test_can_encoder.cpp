@@ -18,6 +18,7 @@
 #include "odo/drivers/can_encoder.hpp"
 #include "odo/drivers/monotonic_clock.hpp"
 #include "odo/drivers/socketcan_bus.hpp"
+#include "odo/odometry/count_delta.hpp"
 
 namespace odo::test {
 namespace {
@@ -123,6 +124,7 @@ TEST(CanEncoderKernel, OdriveCountsFromCansendAndForeignIdsFilteredByTheKernel) 
   ASSERT_TRUE(v.ok);
   Rig r;
   ASSERT_TRUE(r.open(v.name, odrive_config()));
+  // Read before the first frames: the wheels are reported as 0, so they count from them.
   EXPECT_EQ(r.enc->read(r.clock.now()).flags, kEncoderStaleLeft | kEncoderStaleRight);
   // Reference frames: left shadow 0x76543210 (bytes 10 32 54 76, little endian), count in CPR
   // 0xFFFFFFFF (ignored); right shadow 0xFFFFFFFE = -2.
@@ -156,19 +158,25 @@ TEST(CanEncoderKernel, GenericLayoutBothWheelsInOneExtendedBigEndianFrame) {
   c.right = CanCountLayout{0x18FF0010, true, 4, 32, false, true};
   Rig r;
   ASSERT_TRUE(r.open(v.name, c));
-  // Reference: left 0xFFFFFFF0, right 0x00000010.
+  // First frame before any read: left 0xFFFFFFF0, right 0x00000010, reported as the
+  // controller's 32-bit counters hold them, sign-extended for the loop's wrap rule:
+  // 0xFFFFFFF0 = 4294967280 - 2^32 = -16, and 16.
   ASSERT_EQ(run("cansend vcce1 18FF0010#FFFFFFF000000010"), 0);
-  EncoderSample s = r.settle(50);
-  EXPECT_EQ(s.flags, 0u);
+  const EncoderSample a = r.settle(50);
+  EXPECT_EQ(a.flags, 0u);
+  EXPECT_EQ(a.left, -16);
+  EXPECT_EQ(a.right, 16);
   // left 0xFFFFFFF0 -> 0x00000020 wraps: 0x20 + 2^32 - 0xFFFFFFF0 = 32 + 16 = +48;
   // right 0x10 -> 0x08 = -8; 0x18FF0011 (one id off) is dropped by the kernel.
   ASSERT_EQ(run("cansend vcce1 18FF0011#0000000000000000 && "
                 "cansend vcce1 18FF0010#0000002000000008"),
             0);
-  s = r.settle(50);
+  const EncoderSample s = r.settle(50);
   EXPECT_EQ(s.flags, 0u);
-  EXPECT_EQ(s.left, 48);
-  EXPECT_EQ(s.right, -8);
+  EXPECT_EQ(s.left, 32);
+  EXPECT_EQ(s.right, 8);
+  EXPECT_EQ(wrap_delta(a.left, s.left, 32), 48);
+  EXPECT_EQ(wrap_delta(a.right, s.right, 32), -8);
   EXPECT_EQ(r.bus->counters().received, 2u);
 }
 

@@ -98,6 +98,9 @@ struct LoopConfig {
   GyrodometryParams gyrodometry;
   // Estimate the gyro's scale factor from turns while the kinematics are calibrated.
   bool gyro_scale_estimation = true;
+  // [ns] start(): while the reference reading is stale or failed (a CAN controller that has not
+  // sent yet), read again every millisecond for at most this long; 0: take the first reading.
+  TimeNs start_wait = 0;
 };
 
 class OdometryLoop {
@@ -193,6 +196,7 @@ class OdometryLoop {
   EncoderSource* enc_;
   Clock* clock_;
   int bits_;
+  TimeNs start_wait_;  // [ns] LoopConfig::start_wait
   YawRateSource* gyro_ = nullptr;
   std::optional<Gyrodometry> fusion_;  // engaged when gyro_ is set
   bool gyro_scale_estimation_ = true;
