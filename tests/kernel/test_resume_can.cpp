@@ -492,7 +492,11 @@ TEST(ResumeCanVcan, UnderSystemdAfterSigkillAndWatchdogRestartsResume) {
     d << "[Unit]\nDefaultDependencies=no\n[Service]\nStandardOutput=append:" << log
       << "\nStandardError=inherit\n"
       << "ExecStopPost=/bin/sh -c 'cp /run/odometryd/state.bin /run/odometryd/state.stopped; "
-         "echo $SERVICE_RESULT $EXIT_CODE $EXIT_STATUS >> /run/odometryd/results'\n";
+         "echo $SERVICE_RESULT $EXIT_CODE $EXIT_STATUS >> /run/odometryd/results'\n"
+      // What the daemon's sandbox shows of the boot id: the kernel's file (hidden by
+      // ProcSubset=pid) and the variable the unit sets from %b.
+      << "ExecStartPre=/bin/sh -c '{ test -e /proc/sys/kernel/random/boot_id && echo visible "
+         "|| echo hidden $ODOMETRYD_BOOT_ID; } > /run/odometryd/sandbox'\n";
     std::ofstream cfg("/etc/odometryd/odometryd.toml");
     cfg << "[loop]\nrate_hz = 200\nstatus_period = 0\n"
         << "[robot]\nwheel_diameter = " << kDiameter << "\ncounts_per_rev = " << kCountsPerRev
@@ -540,6 +544,13 @@ TEST(ResumeCanVcan, UnderSystemdAfterSigkillAndWatchdogRestartsResume) {
   }();
   const auto boot = fw::read_boot_id();
   ASSERT_TRUE(boot.ok());
+  {
+    const std::string sandbox = slurp("/run/odometryd/sandbox");
+    ASSERT_EQ(sandbox.rfind("hidden ", 0), 0u) << "the unit's sandbox shows /proc/sys: " << sandbox;
+    const auto from_b = fw::parse_boot_id(sandbox.substr(7));
+    ASSERT_TRUE(from_b.ok()) << sandbox;
+    EXPECT_EQ(*from_b, *boot) << "%b is not the kernel's boot id";
+  }
   // hit: signal the service, wait for the restarted daemon's decision and check that it
   // continued the record the stopped one left.
   auto hit = [&](const char* signal, int nth) {
