@@ -90,10 +90,8 @@ void CanEncoderSource::accept(int i, std::int64_t value, TimeNs stamp,
   const std::int64_t raw = reverse ? wrap_sub(0, value, bits) : wrap_bits(value, bits);
   if (!w.primed) {
     // The controller's own counter is reported, so that counts stay continuous across restarts
-    // of this process. Only when a read has already reported this wheel (as 0, before its
-    // first frame) is the first frame the reference: the loop latched that 0, and the absolute
-    // count would be a jump from it.
-    w.offset = w.reported_unprimed ? raw : 0;
+    // of this process (the loop takes a wheel's first fresh count as its reference).
+    w.offset = 0;
     w.primed = true;
   } else {
     const std::int64_t step = wrap_sub(raw, w.last_raw, bits);
@@ -171,7 +169,6 @@ EncoderSample CanEncoderSource::read(TimeNs now) noexcept {
     const auto k = static_cast<std::size_t>(i);
     if (got[k]) accept(i, newest[k], newest_stamp[k], s.flags);
     Wheel& w = wheel_[k];
-    if (!w.primed) w.reported_unprimed = true;
     const bool stale = !w.primed || now - w.last_stamp > cfg_.timeout;
     if (stale && !w.stale && w.primed) ++counters_.stale_events;
     w.stale = stale;

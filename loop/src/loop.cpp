@@ -74,6 +74,7 @@ void OdometryLoop::start() noexcept {
   prev_left_ = s.left;
   prev_right_ = s.right;
   prev_stamp_ = s.stamp;
+  unreferenced_ = s.flags & (kEncoderStaleLeft | kEncoderStaleRight);
   // Loop time starts once the reference counts are latched, however long that read took; the
   // first deadline is one period later.
   start_ = clock_->now();
@@ -156,6 +157,7 @@ void OdometryLoop::integrate(const EncoderSample& s) noexcept {
   // After a failed encoder read the gyro is not read either: its samples keep accumulating and
   // the next read averages them over the same (longer) interval as the next good counts.
   if ((s.flags & kEncoderReadError) != 0) return;
+  if (unreferenced_ != 0) take_reference(s);
   // Counts are cumulative, so a late tick simply integrates a longer interval: nothing is lost.
   const std::int64_t dl = wrap_delta(prev_left_, s.left, bits_);
   const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
@@ -168,6 +170,19 @@ void OdometryLoop::integrate(const EncoderSample& s) noexcept {
   prev_left_ = s.left;
   prev_right_ = s.right;
   prev_stamp_ = s.stamp;
+}
+
+void OdometryLoop::take_reference(const EncoderSample& s) noexcept {
+  // A count read while the wheel was stale since start is no reference (a CAN controller that
+  // had not sent yet reads 0): the first fresh count is, so the wheel's motion starts there.
+  if ((unreferenced_ & kEncoderStaleLeft) != 0 && (s.flags & kEncoderStaleLeft) == 0) {
+    prev_left_ = s.left;
+    unreferenced_ &= ~static_cast<std::uint32_t>(kEncoderStaleLeft);
+  }
+  if ((unreferenced_ & kEncoderStaleRight) != 0 && (s.flags & kEncoderStaleRight) == 0) {
+    prev_right_ = s.right;
+    unreferenced_ &= ~static_cast<std::uint32_t>(kEncoderStaleRight);
+  }
 }
 
 void OdometryLoop::integrate_fused(std::int64_t dl, std::int64_t dr, double dt,

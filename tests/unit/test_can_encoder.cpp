@@ -157,9 +157,9 @@ struct CanEncoder : ::testing::Test {
   }
 };
 
-// A read before the wheels' first frames reports them as 0 (the loop latches that as its
-// reference): those wheels then count from their first frame, never jumping to the absolute count.
-TEST_F(CanEncoder, BeforeTheFirstFrameStaleAndZeroThenRelativeToIt) {
+// A read before the wheels' first frames reports them as 0 and stale; from the first frame on
+// they are the controller's counts (the loop takes the first fresh count as its reference).
+TEST_F(CanEncoder, BeforeTheFirstFrameStaleAndZeroThenTheControllersCounts) {
   CanEncoderSource enc = make();
   EXPECT_EQ(enc.counter_bits(), 32);
   EncoderSample s = enc.read(10 * kMs);
@@ -171,16 +171,16 @@ TEST_F(CanEncoder, BeforeTheFirstFrameStaleAndZeroThenRelativeToIt) {
   port.inject(odrive(1, -5000, 15 * kMs));
   s = enc.read(20 * kMs);
   EXPECT_EQ(s.flags, 0u);
-  EXPECT_EQ(s.left, 0);  // the first frame is the reference: 0 was reported before it
-  EXPECT_EQ(s.right, 0);
+  EXPECT_EQ(s.left, 1000);  // as sent, no reference subtracted
+  EXPECT_EQ(s.right, -5000);
   EXPECT_EQ(s.stamp, 20 * kMs);
   // 10 ms later: +50 and -30 counts (well under 10 000 counts/s * 10 ms = 100).
   port.inject(odrive(0, 1050, 25 * kMs));
   port.inject(odrive(1, -5030, 25 * kMs));
   s = enc.read(30 * kMs);
   EXPECT_EQ(s.flags, 0u);
-  EXPECT_EQ(s.left, 50);
-  EXPECT_EQ(s.right, -30);
+  EXPECT_EQ(s.left, 1050);
+  EXPECT_EQ(s.right, -5030);
 }
 
 TEST_F(CanEncoder, FramesBeforeTheFirstReadGiveTheControllersOwnCounts) {

@@ -16,8 +16,8 @@
 // - counts are the controller's own counter (after `reverse`, sign-extended from the field's
 //   width: the loop's wrap rule applies), so they are continuous across restarts of odometryd
 //   while the controller keeps counting (issue 17); before the first frame a wheel reads 0 and
-//   is stale, and a wheel that was read as 0 that way counts from its first frame instead (the
-//   loop took that 0 as its reference: the absolute count would be a jump);
+//   is stale (the loop takes a wheel's first fresh count as its reference, so that 0 is never
+//   a jump to the first count);
 // - a wheel whose newest frame is older than `timeout` is flagged kEncoderStaleLeft/Right and
 //   keeps its last count; stale_events counts each fresh -> stale transition (the start-up
 //   state before the first frame is not an event). On recovery the count difference since the
@@ -113,12 +113,11 @@ class CanEncoderSource final : public EncoderSource {
   void send_requests(TimeNs now) noexcept;
 
   struct Wheel {
-    std::int64_t offset = 0;         // subtracted from the sender's count (re-basing after jumps)
-    std::int64_t last_raw = 0;       // last accepted count (after reverse)
-    TimeNs last_stamp = 0;           // receive time of the newest frame [ns]
-    bool primed = false;             // a frame has arrived
-    bool reported_unprimed = false;  // a read reported this wheel before its first frame
-    bool stale = true;               // flagged stale at the last read
+    std::int64_t offset = 0;    // subtracted from the sender's count (re-basing after jumps)
+    std::int64_t last_raw = 0;  // last accepted count (after reverse)
+    TimeNs last_stamp = 0;      // receive time of the newest frame [ns]
+    bool primed = false;        // a frame has arrived
+    bool stale = true;          // flagged stale at the last read
   };
 
   CanBus* bus_;
