@@ -96,12 +96,22 @@ volatile sig_atomic_t g_feeder_go = 0;
   std::fprintf(f, "t,left,right\n");
   std::uint32_t left = static_cast<std::uint32_t>(kLeft0),
                 right = static_cast<std::uint32_t>(kRight0);
-  timespec next{};
-  clock_gettime(CLOCK_MONOTONIC, &next);
-  for (std::int64_t k = 0, n = 0; g_feeder_stop == 0; ++n) {
-    if (g_feeder_go != 0 && ++k > 0) {
+  auto now_ns = [] {
+    timespec t{};
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return static_cast<TimeNs>(t.tv_sec) * kNsPerSecond + t.tv_nsec;
+  };
+  const TimeNs start = now_ns();
+  TimeNs go_at = -1;
+  for (std::int64_t k = 0; g_feeder_stop == 0;) {
+    // The wheels turn with real time: a frame sent late (the feeder starved under emulation)
+    // carries the counts of the moment it is sent, as a real controller's would; late frames
+    // are skipped, never sent in a burst (which would look like an implausible jump).
+    const TimeNs now = now_ns();
+    if (g_feeder_go != 0 && go_at < 0) go_at = now;
+    for (const std::int64_t due = go_at < 0 ? 0 : (now - go_at) / kFramePeriod + 1; k < due;) {
       int dl = 0, dr = 0;
-      step_counts(k, dl, dr);
+      step_counts(++k, dl, dr);
       left += static_cast<std::uint32_t>(dl);  // modulo 2^32, as the controller's int32
       right += static_cast<std::uint32_t>(dr);
     }
@@ -119,17 +129,16 @@ volatile sig_atomic_t g_feeder_go = 0;
           fr.data[4 + i] = static_cast<std::uint8_t>(right >> (8 * i));
         }
       }
-      // A full transmit queue is retried: a frame is never skipped, the log stays exact.
+      // A full transmit queue is retried: a frame is never lost, the log stays exact.
       while (write(s, &fr, sizeof fr) != static_cast<ssize_t>(sizeof fr) && g_feeder_stop == 0)
         usleep(200);
     }
-    std::fprintf(f, "%.2f,%d,%d\n", static_cast<double>(n) * 0.01, static_cast<std::int32_t>(left),
+    std::fprintf(f, "%.6f,%d,%d\n", to_seconds(now - start), static_cast<std::int32_t>(left),
                  static_cast<std::int32_t>(right));
-    next.tv_nsec += kFramePeriod;
-    if (next.tv_nsec >= 1'000'000'000) {
-      next.tv_nsec -= 1'000'000'000;
-      ++next.tv_sec;
-    }
+    // The next period boundary after now.
+    const TimeNs next_ns = start + ((now_ns() - start) / kFramePeriod + 1) * kFramePeriod;
+    const timespec next{static_cast<time_t>(next_ns / kNsPerSecond),
+                        static_cast<long>(next_ns % kNsPerSecond)};
     while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr) == EINTR &&
            g_feeder_stop == 0) {
     }
