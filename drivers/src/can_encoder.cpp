@@ -89,8 +89,9 @@ void CanEncoderSource::accept(int i, std::int64_t value, TimeNs stamp,
   const bool reverse = i == 0 ? cfg_.reverse_left : cfg_.reverse_right;
   const std::int64_t raw = reverse ? wrap_sub(0, value, bits) : wrap_bits(value, bits);
   if (!w.primed) {
-    // The first frame is the reference: the wheel reads 0 here, as it did before.
-    w.offset = raw;
+    // The controller's own counter is reported, so that counts stay continuous across restarts
+    // of this process (the loop takes a wheel's first fresh count as its reference).
+    w.offset = 0;
     w.primed = true;
   } else {
     const std::int64_t step = wrap_sub(raw, w.last_raw, bits);

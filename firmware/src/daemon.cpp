@@ -280,6 +280,11 @@ int Daemon::configure() {
   }
   lc.gyrodometry = rig_->gyrodometry();
   lc.gyro_scale_estimation = cfg_->gyro.scale_estimation;
+  // CAN controllers send on their own schedule: the reference reading waits for their first
+  // frames (at most the stale timeout), so that it is their own counters (a resume needs them).
+  if (cfg_->encoder.backend == EncoderKind::kCan &&
+      cfg_->can_encoder.bus == CanEncoderBus::kSocketCan)
+    lc.start_wait = from_seconds(cfg_->can_encoder.timeout);
   auto created = loop::OdometryLoop::create(lc, *calibrated, *encoder, rig_->clock(), rig_->gyro());
   if (!created) return fail(cfg_->source + ": " + created.error().message);
   loop_ = std::move(created).value();

@@ -10,6 +10,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 
@@ -46,15 +47,6 @@ bool on_tmpfs(const std::string& path) {
   return ::statfs(dir.c_str(), &f) == 0 && f.f_type == TMPFS_MAGIC;
 }
 
-// boot_identity: the boot id; where /proc/sys is hidden (the unit's ProcSubset=pid) and the
-// state file is on a tmpfs such as /run, a record there is from this boot by construction and
-// the all-zero id stands for "this boot" in both the record and the check.
-Result<loop::BootId> boot_identity(const std::string& state_path) {
-  auto id = read_boot_id();
-  if (!id && on_tmpfs(state_path)) return loop::BootId{};
-  return id;
-}
-
 }  // namespace
 
 Result<loop::BootId> parse_boot_id(std::string_view text) {
@@ -88,6 +80,23 @@ Result<loop::BootId> read_boot_id(const std::string& path) {
   return id;
 }
 
+Result<loop::BootId> current_boot_id(const std::string& state_path, const char* env,
+                                     const std::string& path) {
+  auto id = read_boot_id(path);
+  if (id) return id;
+  if (env != nullptr) {
+    auto e = parse_boot_id(env);
+    if (!e)
+      return make_error(Errc::kParse,
+                        std::string(kBootIdEnv) + "=\"" + env + "\": " + e.error().message);
+    return e;
+  }
+  // A record on a tmpfs (emptied by every reboot) is from this boot by construction: the
+  // all-zero id stands for "this boot" in both the record and the check.
+  if (on_tmpfs(state_path)) return loop::BootId{};
+  return id;
+}
+
 Result<loop::StateRecord> read_state_file(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
@@ -104,7 +113,17 @@ Result<loop::StateRecord> read_state_file(const std::string& path) {
 }
 
 bool counters_survive_restart(const Config& cfg) {
-  return cfg.encoder.backend == EncoderKind::kHctl1100 && cfg.hctl1100.bus == HctlBus::kGpio;
+  switch (cfg.encoder.backend) {
+    case EncoderKind::kHctl1100:
+      return cfg.hctl1100.bus == HctlBus::kGpio;
+    case EncoderKind::kCan:
+      // The driver reports the controllers' own counters (drivers/can_encoder.hpp).
+      return cfg.can_encoder.bus == CanEncoderBus::kSocketCan;
+    case EncoderKind::kGpio:  // decoded by this process: edges are lost while it is down
+    case EncoderKind::kSim:   // restarts with the process
+      return false;
+  }
+  return false;
 }
 
 // ---- StatePersister ----
@@ -209,8 +228,13 @@ void StatePersister::run(std::ostream& log, std::optional<loop::ResumeReason> fi
       char line[400];
       int n = 0;
       if (why == loop::ResumeReason::kResumed) {
-        n = std::snprintf(line, sizeof line, "odometryd: resume: resumed after a gap of %.3f s\n",
-                          to_seconds(d.gap));
+        // The gap's counts, integrated as one step, and the pose that gave: what a check of
+        // the resume (against the counts the controllers sent) needs.
+        n = std::snprintf(line, sizeof line,
+                          "odometryd: resume: resumed after a gap of %.3f s (left %+lld, right "
+                          "%+lld counts) at x %.10f m, y %.10f m, theta %.12f rad\n",
+                          to_seconds(d.gap), static_cast<long long>(d.dl),
+                          static_cast<long long>(d.dr), d.pose.x, d.pose.y, d.pose.theta);
       } else {
         const std::string_view name = loop::resume_reason_name(why);
         n = std::snprintf(line, sizeof line, "odometryd: resume: fresh start (%.*s)%s\n",
@@ -234,7 +258,7 @@ ResumeWiring prepare_resume(const Config& cfg, loop::OdometryLoop& loop,
     return w;
   }
   loop::StateRecord identity;
-  auto boot = boot_identity(cfg.resume.path);
+  auto boot = current_boot_id(cfg.resume.path, std::getenv(kBootIdEnv));
   if (boot) identity.boot_id = *boot;
   identity.backend = backend_id(cfg);
   identity.calibration_sequence = calibration_sequence;

@@ -49,7 +49,8 @@ OdometryLoop::OdometryLoop(TimeNs period, const LoopConfig& cfg, const Kinematic
       calibration_(cfg.calibration),
       enc_(&enc),
       clock_(&clock),
-      bits_(enc.counter_bits()) {}
+      bits_(enc.counter_bits()),
+      start_wait_(cfg.start_wait) {}
 
 bool OdometryLoop::add_observer(TickObserver* o) noexcept {
   if (n_observers_ >= kMaxObservers) return false;
@@ -58,13 +59,22 @@ bool OdometryLoop::add_observer(TickObserver* o) noexcept {
 }
 
 void OdometryLoop::start() noexcept {
-  const EncoderSample s = enc_->read(clock_->now());
+  EncoderSample s = enc_->read(clock_->now());
+  // A reference reading before the encoder is ready would make a resume impossible
+  // (encoder-not-ready) and the first real counts relative to nothing: wait for it, bounded.
+  constexpr std::uint32_t kNotReady = kEncoderReadError | kEncoderStaleLeft | kEncoderStaleRight;
+  for (const TimeNs until = clock_->now() + start_wait_;
+       (s.flags & kNotReady) != 0 && clock_->now() < until;) {
+    clock_->sleep_until(clock_->now() + kNsPerSecond / 1000);  // 1 ms
+    s = enc_->read(clock_->now());
+  }
   if (resume_offered_) apply_resume(s);
   // The gyro's samples up to now belong to no interval of the encoders: dropped.
   if (gyro_ != nullptr) fused_in_.gyro = gyro_->read(clock_->now());
   prev_left_ = s.left;
   prev_right_ = s.right;
   prev_stamp_ = s.stamp;
+  unreferenced_ = s.flags & (kEncoderStaleLeft | kEncoderStaleRight);
   // Loop time starts once the reference counts are latched, however long that read took; the
   // first deadline is one period later.
   start_ = clock_->now();
@@ -96,6 +106,7 @@ void OdometryLoop::apply_resume(const EncoderSample& s) noexcept {
   // The downtime is one long step, as after an overrun: its counts are integrated exactly
   // once (the arc of a constant-curvature gap is exact) and the covariance grows for it.
   odom_.advance(resume_.dl, resume_.dr, to_seconds(resume_.gap));
+  resume_.pose = odom_.pose();
 }
 
 LoopSnapshot& OdometryLoop::copy_newest() noexcept {
@@ -146,6 +157,7 @@ void OdometryLoop::integrate(const EncoderSample& s) noexcept {
   // After a failed encoder read the gyro is not read either: its samples keep accumulating and
   // the next read averages them over the same (longer) interval as the next good counts.
   if ((s.flags & kEncoderReadError) != 0) return;
+  if (unreferenced_ != 0) take_reference(s);
   // Counts are cumulative, so a late tick simply integrates a longer interval: nothing is lost.
   const std::int64_t dl = wrap_delta(prev_left_, s.left, bits_);
   const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
@@ -158,6 +170,19 @@ void OdometryLoop::integrate(const EncoderSample& s) noexcept {
   prev_left_ = s.left;
   prev_right_ = s.right;
   prev_stamp_ = s.stamp;
+}
+
+void OdometryLoop::take_reference(const EncoderSample& s) noexcept {
+  // A count read while the wheel was stale since start is no reference (a CAN controller that
+  // had not sent yet reads 0): the first fresh count is, so the wheel's motion starts there.
+  if ((unreferenced_ & kEncoderStaleLeft) != 0 && (s.flags & kEncoderStaleLeft) == 0) {
+    prev_left_ = s.left;
+    unreferenced_ &= ~static_cast<std::uint32_t>(kEncoderStaleLeft);
+  }
+  if ((unreferenced_ & kEncoderStaleRight) != 0 && (s.flags & kEncoderStaleRight) == 0) {
+    prev_right_ = s.right;
+    unreferenced_ &= ~static_cast<std::uint32_t>(kEncoderStaleRight);
+  }
 }
 
 void OdometryLoop::integrate_fused(std::int64_t dl, std::int64_t dr, double dt,

@@ -19,7 +19,7 @@ out=$(systemd-analyze verify --man=no "$tmp/odometryd.service" 2>&1); rc=$?
 [ $rc = 0 ] && [ -z "$out" ] || { echo "FAIL: systemd-analyze verify"; exit 1; }
 for key in Type=notify WatchdogSec= 'AmbientCapabilities=CAP_SYS_NICE CAP_IPC_LOCK' \
   'CapabilityBoundingSet=CAP_SYS_NICE CAP_IPC_LOCK' NoNewPrivileges=yes \
-  RuntimeDirectory=odometryd RuntimeDirectoryPreserve=restart; do
+  RuntimeDirectory=odometryd RuntimeDirectoryPreserve=restart 'Environment=ODOMETRYD_BOOT_ID=%b'; do
   grep -q "^$key" "$unit" || { echo "FAIL: $key missing"; exit 1; }
 done
 echo "systemd unit: verify clean"

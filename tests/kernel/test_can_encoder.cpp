@@ -18,6 +18,7 @@
 #include "odo/drivers/can_encoder.hpp"
 #include "odo/drivers/monotonic_clock.hpp"
 #include "odo/drivers/socketcan_bus.hpp"
+#include "odo/odometry/count_delta.hpp"
 
 namespace odo::test {
 namespace {
@@ -123,24 +124,29 @@ TEST(CanEncoderKernel, OdriveCountsFromCansendAndForeignIdsFilteredByTheKernel) 
   ASSERT_TRUE(v.ok);
   Rig r;
   ASSERT_TRUE(r.open(v.name, odrive_config()));
-  EXPECT_EQ(r.enc->read(r.clock.now()).flags, kEncoderStaleLeft | kEncoderStaleRight);
+  // Read before the first frames: the wheels are 0 and stale.
+  const EncoderSample before = r.enc->read(r.clock.now());
+  EXPECT_EQ(before.flags, kEncoderStaleLeft | kEncoderStaleRight);
+  EXPECT_EQ(before.left, 0);
   // Reference frames: left shadow 0x76543210 (bytes 10 32 54 76, little endian), count in CPR
   // 0xFFFFFFFF (ignored); right shadow 0xFFFFFFFE = -2.
   ASSERT_EQ(run("cansend vcce0 00A#10325476FFFFFFFF && cansend vcce0 02A#FEFFFFFF00000000"), 0);
-  EncoderSample s = r.settle(50);
-  EXPECT_EQ(s.flags, 0u);
-  EXPECT_EQ(s.left, 0);
-  EXPECT_EQ(s.right, 0);
+  const EncoderSample a = r.settle(50);
+  EXPECT_EQ(a.flags, 0u);
+  EXPECT_EQ(a.left, 0x76543210);  // the controller's counts as sent
+  EXPECT_EQ(a.right, -2);
   // Foreign frames: other ids, our id as a 29-bit frame, a remote request of our id.
   ASSERT_EQ(run("cansend vcce0 0AB#1122334455667788 && cansend vcce0 0000000A#0100000000000000"
                 " && cansend vcce0 04A#0100000000000000 && cansend vcce0 00A#R"),
             0);
   // Counts: left 0x76544210 = 0x76543210 + 0x1000 (+4096); right 0x00000005 = -2 + 7.
   ASSERT_EQ(run("cansend vcce0 00A#1042547600000000 && cansend vcce0 02A#0500000005000000"), 0);
-  s = r.settle(50);
+  const EncoderSample s = r.settle(50);
   EXPECT_EQ(s.flags, 0u);
-  EXPECT_EQ(s.left, 4096);
-  EXPECT_EQ(s.right, 7);
+  EXPECT_EQ(s.left, 0x76544210);
+  EXPECT_EQ(s.right, 5);
+  EXPECT_EQ(wrap_delta(a.left, s.left, 32), 4096);
+  EXPECT_EQ(wrap_delta(a.right, s.right, 32), 7);
   // Exactly our four data frames reached user space: the kernel dropped the other four.
   EXPECT_EQ(r.bus->counters().received, 4u);
   EXPECT_EQ(r.enc->stats().foreign, 0u);
@@ -156,19 +162,25 @@ TEST(CanEncoderKernel, GenericLayoutBothWheelsInOneExtendedBigEndianFrame) {
   c.right = CanCountLayout{0x18FF0010, true, 4, 32, false, true};
   Rig r;
   ASSERT_TRUE(r.open(v.name, c));
-  // Reference: left 0xFFFFFFF0, right 0x00000010.
+  // First frame before any read: left 0xFFFFFFF0, right 0x00000010, reported as the
+  // controller's 32-bit counters hold them, sign-extended for the loop's wrap rule:
+  // 0xFFFFFFF0 = 4294967280 - 2^32 = -16, and 16.
   ASSERT_EQ(run("cansend vcce1 18FF0010#FFFFFFF000000010"), 0);
-  EncoderSample s = r.settle(50);
-  EXPECT_EQ(s.flags, 0u);
+  const EncoderSample a = r.settle(50);
+  EXPECT_EQ(a.flags, 0u);
+  EXPECT_EQ(a.left, -16);
+  EXPECT_EQ(a.right, 16);
   // left 0xFFFFFFF0 -> 0x00000020 wraps: 0x20 + 2^32 - 0xFFFFFFF0 = 32 + 16 = +48;
   // right 0x10 -> 0x08 = -8; 0x18FF0011 (one id off) is dropped by the kernel.
   ASSERT_EQ(run("cansend vcce1 18FF0011#0000000000000000 && "
                 "cansend vcce1 18FF0010#0000002000000008"),
             0);
-  s = r.settle(50);
+  const EncoderSample s = r.settle(50);
   EXPECT_EQ(s.flags, 0u);
-  EXPECT_EQ(s.left, 48);
-  EXPECT_EQ(s.right, -8);
+  EXPECT_EQ(s.left, 32);
+  EXPECT_EQ(s.right, 8);
+  EXPECT_EQ(wrap_delta(a.left, s.left, 32), 48);
+  EXPECT_EQ(wrap_delta(a.right, s.right, 32), -8);
   EXPECT_EQ(r.bus->counters().received, 2u);
 }
 

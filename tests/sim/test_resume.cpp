@@ -5,13 +5,16 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <random>
 #include <vector>
 
+#include "odo/drivers/can_encoder.hpp"
 #include "odo/drivers/hctl1100_encoder.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/loop/state_record.hpp"
 #include "odo/sim/hctl1100_model.hpp"
+#include "odo/sim/sim_can_bus.hpp"
 #include "odo/sim/virtual_clock.hpp"
 
 namespace odo {
@@ -222,6 +225,91 @@ TEST(Resume, ChipResetStartsFresh) {
   b->start();
   EXPECT_EQ(b->resume_decision().reason, loop::ResumeReason::kCounterJump);
   EXPECT_EQ(b->odometry().pose().x, 0.0);
+}
+
+// A motor controller that starts sending only 30 ms after the loop starts: ODrive count frames
+// of both axes every 10 ms, counts from 5000, +10 per frame, put on the port as time passes
+// (each read first publishes what was sent up to then), read by the real CAN driver.
+struct LateController final : EncoderSource {
+  LateController() {
+    drivers::CanEncoderConfig c;
+    c.left = drivers::odrive_count_layout(0);
+    c.right = drivers::odrive_count_layout(1);
+    c.timeout = from_seconds(0.1);
+    c.max_counts_per_s = 200000;
+    enc.emplace(drivers::CanEncoderSource::create(port, c).value());
+  }
+  EncoderSample read(TimeNs now) noexcept override {
+    for (; next <= now; next += from_seconds(0.01), count += 10) {
+      for (std::uint32_t node = 0; node < 2; ++node) {
+        CanFrame f;
+        f.id = node << 5 | 0x00A;
+        f.len = 8;
+        for (int i = 0; i < 4; ++i)
+          f.data[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(count >> (8 * i));
+        f.stamp = next;
+        port.inject(f);
+      }
+    }
+    return enc->read(now);
+  }
+  int counter_bits() const noexcept override { return 32; }
+  sim::SimCanPort port{8, 512};
+  std::optional<drivers::CanEncoderSource> enc;
+  TimeNs next = from_seconds(0.03);
+  std::int32_t count = 5000;
+};
+
+// The loop's start waits (start_wait) for the controller's first frames, so that its reference
+// is the controller's own count and a record made at 4900 counts resumes with the 100 counts of
+// the gap; without the wait the reference is the driver's 0 before any frame: no resume
+// (encoder-not-ready), and the loop counts the wheels from their first fresh count, never
+// jumping from 0 to 5000.
+TEST(ResumeCan, StartWaitsForTheControllersFirstFramesThenResumes) {
+  const Kinematics k = kinematics();
+  loop::StateRecord rec;
+  rec.sequence = 1;
+  rec.left = rec.right = 4900;
+  rec.counter_bits = 32;
+  rec.backend = 1;
+  rec.metres_per_count_left = k.metres_per_count_left();
+  rec.metres_per_count_right = k.metres_per_count_right();
+  rec.wheelbase = k.wheelbase();
+  rec.pose = Pose2{1.0, 2.0, 0.5};
+  for (const bool wait : {true, false}) {
+    sim::VirtualClock clock;
+    LateController ctl;
+    loop::LoopConfig cfg{100.0};
+    cfg.start_wait = wait ? from_seconds(0.1) : 0;
+    auto l = loop::OdometryLoop::create(cfg, k, ctl, clock).value();
+    loop::ResumeContext c = context_for(*l);
+    c.max_wheel_speed = 3.0;
+    l->resume_from(rec, c);
+    l->start();
+    if (wait) {
+      // First frames at 30 ms (count 5000): read at 30 ms, after 30 waits of 1 ms.
+      EXPECT_EQ(l->last_left(), 5000);
+      EXPECT_EQ(l->last_right(), 5000);
+      EXPECT_EQ(l->last_stamp(), from_seconds(0.03));
+      ASSERT_TRUE(l->resume_decision().resumed())
+          << loop::resume_reason_name(l->resume_decision().reason);
+      EXPECT_EQ(l->resume_decision().dl, 100);
+      EXPECT_EQ(l->resume_decision().dr, 100);
+      // Straight on from (1, 2) at 0.5 rad: 100 counts * 1.438e-5 m = 1.438 mm.
+      const double d = 100 * k.metres_per_count_left();
+      EXPECT_NEAR(l->odometry().pose().x, 1.0 + d * std::cos(0.5), 1e-12);
+      EXPECT_NEAR(l->odometry().pose().y, 2.0 + d * std::sin(0.5), 1e-12);
+    } else {
+      EXPECT_EQ(l->last_left(), 0);
+      EXPECT_EQ(l->resume_decision().reason, loop::ResumeReason::kEncoderNotReady);
+      // Ticks up to 100 ms: frames at 30..100 ms, counts 5000..5070; the first fresh count is
+      // the wheels' reference: 70 counts of motion, no jump from 0 to 5000.
+      tick_until(*l, clock, 0.1);
+      EXPECT_EQ(l->last_left(), 5070);
+      EXPECT_EQ(l->last_right(), 5070);
+      EXPECT_NEAR(l->odometry().distance(), 70 * k.metres_per_count_left(), 1e-15);
+    }
+  }
 }
 
 }  // namespace

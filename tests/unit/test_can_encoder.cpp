@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "odo/drivers/can_encoder.hpp"
+#include "odo/odometry/count_delta.hpp"
 #include "odo/sim/sim_can_bus.hpp"
 #include "odo/sim/sim_odrive.hpp"
 
@@ -156,7 +157,9 @@ struct CanEncoder : ::testing::Test {
   }
 };
 
-TEST_F(CanEncoder, BeforeTheFirstFrameStaleAndZeroThenRelativeToIt) {
+// A read before the wheels' first frames reports them as 0 and stale; from the first frame on
+// they are the controller's counts (the loop takes the first fresh count as its reference).
+TEST_F(CanEncoder, BeforeTheFirstFrameStaleAndZeroThenTheControllersCounts) {
   CanEncoderSource enc = make();
   EXPECT_EQ(enc.counter_bits(), 32);
   EncoderSample s = enc.read(10 * kMs);
@@ -168,16 +171,83 @@ TEST_F(CanEncoder, BeforeTheFirstFrameStaleAndZeroThenRelativeToIt) {
   port.inject(odrive(1, -5000, 15 * kMs));
   s = enc.read(20 * kMs);
   EXPECT_EQ(s.flags, 0u);
-  EXPECT_EQ(s.left, 0);  // the first frame is the reference
-  EXPECT_EQ(s.right, 0);
+  EXPECT_EQ(s.left, 1000);  // as sent, no reference subtracted
+  EXPECT_EQ(s.right, -5000);
   EXPECT_EQ(s.stamp, 20 * kMs);
   // 10 ms later: +50 and -30 counts (well under 10 000 counts/s * 10 ms = 100).
   port.inject(odrive(0, 1050, 25 * kMs));
   port.inject(odrive(1, -5030, 25 * kMs));
   s = enc.read(30 * kMs);
   EXPECT_EQ(s.flags, 0u);
-  EXPECT_EQ(s.left, 50);
-  EXPECT_EQ(s.right, -30);
+  EXPECT_EQ(s.left, 1050);
+  EXPECT_EQ(s.right, -5030);
+}
+
+TEST_F(CanEncoder, FramesBeforeTheFirstReadGiveTheControllersOwnCounts) {
+  port.inject(odrive(0, 1000, 15 * kMs));
+  port.inject(odrive(1, -5000, 15 * kMs));
+  CanEncoderSource enc = make();
+  EncoderSample s = enc.read(20 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 1000);  // the shadow counts as sent: no reference subtracted
+  EXPECT_EQ(s.right, -5000);
+  port.inject(odrive(0, 1050, 25 * kMs));
+  port.inject(odrive(1, -5030, 25 * kMs));
+  s = enc.read(30 * kMs);
+  EXPECT_EQ(s.left, 1050);
+  EXPECT_EQ(s.right, -5030);
+}
+
+TEST_F(CanEncoder, CountsAreContinuousAcrossARestartOfTheReader) {
+  // Issue 17: a restarted daemon (a new source on the same bus) reads the controllers' counters
+  // where the old one left them, plus what the wheels moved meanwhile. Right reversed: the
+  // negation is the same in both runs.
+  cfg.reverse_right = true;
+  std::int64_t left_before = 0, right_before = 0;
+  {
+    CanEncoderSource first = make();
+    port.inject(odrive(0, 70'000, 10 * kMs));
+    port.inject(odrive(1, 70'000, 10 * kMs));
+    const EncoderSample s = first.read(10 * kMs);
+    left_before = s.left;
+    right_before = s.right;
+  }
+  EXPECT_EQ(left_before, 70'000);
+  EXPECT_EQ(right_before, -70'000);
+  // Down for 1 s while the controllers count on: +9000 and +8000 counts (under the 10 000
+  // counts/s limit; the new source has no previous frame to check a step against).
+  port.inject(odrive(0, 79'000, 1010 * kMs));
+  port.inject(odrive(1, 78'000, 1010 * kMs));
+  CanEncoderSource second = make();
+  const EncoderSample s = second.read(1010 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 79'000);
+  EXPECT_EQ(s.right, -78'000);
+  EXPECT_EQ(wrap_delta(left_before, s.left, 32), 9000);
+  EXPECT_EQ(wrap_delta(right_before, s.right, 32), -8000);
+}
+
+TEST_F(CanEncoder, SixteenBitUnsignedCountsAreSignExtendedForTheWrapRule) {
+  // A generic 16-bit unsigned counter (little endian at byte 0, ids 0x120/0x121). 0xFFF0 =
+  // 65520 is reported as the 16-bit counter the loop sees: 65520 - 65536 = -16; 0x0010 after
+  // it is +32 counts by the wrap rule (16 - (-16)), the same in every run of the daemon.
+  cfg.left = CanCountLayout{0x120, false, 0, 16, false, false};
+  cfg.right = CanCountLayout{0x121, false, 0, 16, false, false};
+  CanEncoderSource enc = make();
+  EXPECT_EQ(enc.counter_bits(), 16);
+  port.inject(frame(0x120, {0xF0, 0xFF}, 10 * kMs));
+  port.inject(frame(0x121, {0x05, 0x00}, 10 * kMs));
+  const EncoderSample a = enc.read(10 * kMs);
+  EXPECT_EQ(a.left, -16);
+  EXPECT_EQ(a.right, 5);
+  port.inject(frame(0x120, {0x10, 0x00}, 20 * kMs));
+  port.inject(frame(0x121, {0x01, 0x00}, 20 * kMs));
+  const EncoderSample b = enc.read(20 * kMs);
+  EXPECT_EQ(b.flags, 0u);
+  EXPECT_EQ(b.left, 16);
+  EXPECT_EQ(b.right, 1);
+  EXPECT_EQ(wrap_delta(a.left, b.left, 16), 32);
+  EXPECT_EQ(wrap_delta(a.right, b.right, 16), -4);
 }
 
 TEST_F(CanEncoder, StoppedWheelIsStaleAfterTheTimeoutOnceAndRecoversWithRealMotion) {
@@ -220,14 +290,14 @@ TEST_F(CanEncoder, ImplausibleJumpIsReportedNotIntegrated) {
   port.inject(odrive(1, 240, 20 * kMs));  // right: +140 < 151, plausible
   EncoderSample s = enc.read(20 * kMs);
   EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kEncoderImplausibleJump));
-  EXPECT_EQ(s.left, 0);  // not integrated
-  EXPECT_EQ(s.right, 140);
+  EXPECT_EQ(s.left, 100);   // not integrated: the count before the jump
+  EXPECT_EQ(s.right, 240);  // +140
   EXPECT_EQ(s.counters.implausible_jumps, 1u);
-  // Motion after the jump counts from the new base: 600 -> 640 is +40.
+  // Motion after the jump counts from the new base: 600 -> 640 is +40, 100 + 40 = 140.
   port.inject(odrive(0, 640, 30 * kMs));
   s = enc.read(30 * kMs);
   EXPECT_EQ(s.flags, 0u);
-  EXPECT_EQ(s.left, 40);
+  EXPECT_EQ(s.left, 140);
 }
 
 TEST_F(CanEncoder, Int32WrapIsMotionNotAJump) {
@@ -236,19 +306,21 @@ TEST_F(CanEncoder, Int32WrapIsMotionNotAJump) {
   // + 2^32 = +80 counts.
   port.inject(odrive(0, 2147483600, 10 * kMs));
   port.inject(odrive(1, 0, 10 * kMs));
-  enc.read(10 * kMs);
+  const EncoderSample a = enc.read(10 * kMs);
+  EXPECT_EQ(a.left, 2147483600);
   port.inject(odrive(0, -2147483616, 20 * kMs));
   port.inject(odrive(1, 0, 20 * kMs));
   const EncoderSample s = enc.read(20 * kMs);
-  EXPECT_EQ(s.flags, 0u);
-  EXPECT_EQ(s.left, 80);
+  EXPECT_EQ(s.flags, 0u);  // not flagged as a jump
+  EXPECT_EQ(s.left, -2147483616);
+  EXPECT_EQ(wrap_delta(a.left, s.left, 32), 80);
 }
 
 TEST_F(CanEncoder, SixtyFourBitCountsWrapWithoutOverflow) {
   // Regression (fuzz_canenc, first seconds): with 64-bit counts the step last - first was
   // computed in signed 64-bit arithmetic and overflowed (UBSan). Left: INT64_MAX - 9 then
   // INT64_MIN + 10: modulo 2^64 the step is +20 counts. Right, reversed: INT64_MIN (its
-  // negation is itself modulo 2^64) then INT64_MIN + 5, negated: a step of -5.
+  // negation is itself modulo 2^64) then INT64_MIN + 5, negated: INT64_MAX - 4, a step of -5.
   cfg.left = CanCountLayout{0x100, false, 0, 64, true, false};
   cfg.right = CanCountLayout{0x101, false, 0, 64, true, false};
   cfg.reverse_right = true;
@@ -261,13 +333,17 @@ TEST_F(CanEncoder, SixtyFourBitCountsWrapWithoutOverflow) {
   };
   port.inject(le64(0x100, 0x7FFFFFFFFFFFFFF6ull, 10 * kMs));
   port.inject(le64(0x101, 0x8000000000000000ull, 10 * kMs));
-  enc.read(10 * kMs);
+  const EncoderSample a = enc.read(10 * kMs);
+  EXPECT_EQ(a.left, INT64_MAX - 9);
+  EXPECT_EQ(a.right, INT64_MIN);
   port.inject(le64(0x100, 0x800000000000000Aull, 20 * kMs));
   port.inject(le64(0x101, 0x8000000000000005ull, 20 * kMs));
   const EncoderSample s = enc.read(20 * kMs);
   EXPECT_EQ(s.flags, 0u);
-  EXPECT_EQ(s.left, 20);
-  EXPECT_EQ(s.right, -5);
+  EXPECT_EQ(s.left, INT64_MIN + 10);
+  EXPECT_EQ(s.right, INT64_MAX - 4);
+  EXPECT_EQ(wrap_delta(a.left, s.left, 64), 20);
+  EXPECT_EQ(wrap_delta(a.right, s.right, 64), -5);
 }
 
 TEST_F(CanEncoder, ReverseNegatesTheCount) {
@@ -275,12 +351,14 @@ TEST_F(CanEncoder, ReverseNegatesTheCount) {
   CanEncoderSource enc = make();
   port.inject(odrive(0, 10, 10 * kMs));
   port.inject(odrive(1, 10, 10 * kMs));
-  enc.read(10 * kMs);
+  const EncoderSample a = enc.read(10 * kMs);
+  EXPECT_EQ(a.left, 10);
+  EXPECT_EQ(a.right, -10);
   port.inject(odrive(0, 30, 20 * kMs));
   port.inject(odrive(1, 30, 20 * kMs));
   const EncoderSample s = enc.read(20 * kMs);
-  EXPECT_EQ(s.left, 20);
-  EXPECT_EQ(s.right, -20);
+  EXPECT_EQ(s.left, 30);    // +20
+  EXPECT_EQ(s.right, -30);  // -20
 }
 
 TEST_F(CanEncoder, FloodBeyondTheCapIsReadOverTheNextTicksAndOnlyTheNewestCountMatters) {
@@ -303,13 +381,13 @@ TEST_F(CanEncoder, FloodBeyondTheCapIsReadOverTheNextTicksAndOnlyTheNewestCountM
   EXPECT_EQ(enc.stats().decoded, 200u);
   EXPECT_EQ(enc.stats().capped_reads, 4u);
   // Frame 3(k-1)+1 is foreign k, 3(k-1)+2 left k (count k), 3k right k (count 2k). Read 1
-  // takes frames 1..64 (up to foreign 22): its newest counts, left 21 and right 42, are the
-  // reference. The newest at the end are left 100 and right 200: 100 - 21 = 79 and
-  // 200 - 42 = 158. All frames carry the stamp 5 ms, so the limit per read is
+  // takes frames 1..64 (up to foreign 22): its newest counts are left 21 and right 42. The
+  // newest at the end are left 100 and right 200 (the counts as sent). All frames carry the
+  // stamp 5 ms, so the limit per read is
   // 10 000 * (0 + 0.005 s slack) + 1 = 51 counts; the largest step per read is the right
   // wheel's 84 -> 128 = 44 (read 3 ends at frame 192 = right 64): no jump is flagged.
-  EXPECT_EQ(s.left, 79);
-  EXPECT_EQ(s.right, 158);
+  EXPECT_EQ(s.left, 100);
+  EXPECT_EQ(s.right, 200);
   EXPECT_EQ(s.flags, 0u);
   EXPECT_EQ(s.counters.implausible_jumps, 0u);
 }
@@ -325,8 +403,8 @@ TEST_F(CanEncoder, ShortFramesAndRemoteRequestsWithOurIdAreIgnored) {
   rtr.len = 8;
   port.inject(rtr);
   const EncoderSample s = enc.read(3 * kMs);
-  EXPECT_EQ(s.left, 0);
-  EXPECT_EQ(s.right, 0);
+  EXPECT_EQ(s.left, 7);  // unchanged since the count frames
+  EXPECT_EQ(s.right, 7);
   EXPECT_EQ(enc.stats().short_frames, 1u);
   EXPECT_EQ(enc.stats().remote, 1u);
 }

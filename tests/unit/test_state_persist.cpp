@@ -22,6 +22,27 @@ TEST(StatePersist, BootIdParsesTheKernelsText) {
   EXPECT_FALSE(parse_boot_id("0123abcd-4567-89ab-cdef-0011223344ff00"));
 }
 
+TEST(StatePersist, BootIdFromTheEnvironmentWhereProcSysIsHidden) {
+  const std::string hidden = ::testing::TempDir() + "no_such_dir/boot_id";
+  const std::string state = ::testing::TempDir() + "state.bin";
+  // The kernel's file wins when readable.
+  const std::string file = ::testing::TempDir() + "boot_id_test";
+  std::ofstream(file) << "00000000-0000-0000-0000-0000000000aa\n";
+  auto id = current_boot_id(state, "0123abcd456789abcdef0011223344ff", file);
+  ASSERT_TRUE(id) << id.error().message;
+  EXPECT_EQ((*id)[15], 0xaa);
+  // Hidden: systemd's %b (32 hex digits, no dashes) from ODOMETRYD_BOOT_ID.
+  id = current_boot_id(state, "0123abcd456789abcdef0011223344ff", hidden);
+  ASSERT_TRUE(id) << id.error().message;
+  EXPECT_EQ((*id)[0], 0x01);
+  EXPECT_EQ((*id)[15], 0xff);
+  // A value that is no boot id is an error naming the variable and the value, never "this boot".
+  id = current_boot_id(state, "%b", hidden);
+  ASSERT_FALSE(id);
+  EXPECT_NE(id.error().message.find("ODOMETRYD_BOOT_ID=\"%b\""), std::string::npos)
+      << id.error().message;
+}
+
 TEST(StatePersist, OnlyCountersThatKeepCountingResume) {
   Config c = default_config();
   c.encoder.backend = EncoderKind::kGpio;  // decoded by this process: lost while it is down
@@ -32,6 +53,11 @@ TEST(StatePersist, OnlyCountersThatKeepCountingResume) {
   c.hctl1100.bus = HctlBus::kSim;  // the register model restarts with the process
   EXPECT_FALSE(counters_survive_restart(c));
   c.hctl1100.bus = HctlBus::kGpio;  // the chips count on their own
+  EXPECT_TRUE(counters_survive_restart(c));
+  c.encoder.backend = EncoderKind::kCan;
+  c.can_encoder.bus = CanEncoderBus::kSim;  // the simulated ODrives restart with the process
+  EXPECT_FALSE(counters_survive_restart(c));
+  c.can_encoder.bus = CanEncoderBus::kSocketCan;  // the controllers' own counters
   EXPECT_TRUE(counters_survive_restart(c));
 }
 

@@ -13,8 +13,11 @@
 // - takes at most max_frames_per_read frames from the bus without blocking; frames beyond stay
 //   queued (in the kernel socket buffer) for the next read, and since the counts are cumulative
 //   only the newest frame of each wheel matters: a backlog delays, never loses, motion;
-// - counts are reported relative to the first frame of each wheel (so the loop's reference
-//   reading is never a jump); before the first frame a wheel reads 0 and is stale;
+// - counts are the controller's own counter (after `reverse`, sign-extended from the field's
+//   width: the loop's wrap rule applies), so they are continuous across restarts of odometryd
+//   while the controller keeps counting (issue 17); before the first frame a wheel reads 0 and
+//   is stale (the loop takes a wheel's first fresh count as its reference, so that 0 is never
+//   a jump to the first count);
 // - a wheel whose newest frame is older than `timeout` is flagged kEncoderStaleLeft/Right and
 //   keeps its last count; stale_events counts each fresh -> stale transition (the start-up
 //   state before the first frame is not an event). On recovery the count difference since the
@@ -110,7 +113,7 @@ class CanEncoderSource final : public EncoderSource {
   void send_requests(TimeNs now) noexcept;
 
   struct Wheel {
-    std::int64_t offset = 0;    // subtracted from the sender's count (first frame, re-basing)
+    std::int64_t offset = 0;    // subtracted from the sender's count (re-basing after jumps)
     std::int64_t last_raw = 0;  // last accepted count (after reverse)
     TimeNs last_stamp = 0;      // receive time of the newest frame [ns]
     bool primed = false;        // a frame has arrived

@@ -28,14 +28,24 @@ Result<loop::BootId> parse_boot_id(std::string_view text);
 // read_boot_id: the running kernel's boot id from `path`.
 Result<loop::BootId> read_boot_id(const std::string& path = kBootIdPath);
 
+// kBootIdEnv: the boot id given by the service manager where /proc/sys is hidden (the unit's
+// ProcSubset=pid): Environment=ODOMETRYD_BOOT_ID=%b.
+inline constexpr const char* kBootIdEnv = "ODOMETRYD_BOOT_ID";
+// current_boot_id: the boot id from `path`; when that cannot be read, from `env` (the value of
+// kBootIdEnv, nullptr when unset; a value that is no UUID is an error naming the variable);
+// without either, the all-zero id when `state_path` is on a tmpfs (a record there is from this
+// boot), else the error.
+Result<loop::BootId> current_boot_id(const std::string& state_path, const char* env,
+                                     const std::string& path = kBootIdPath);
+
 // read_state_file: the newest valid record of the state file at `path`; Errc::kNotFound when
 // there is none, Errc::kCorrupt when neither slot holds a valid record.
 Result<loop::StateRecord> read_state_file(const std::string& path);
 
 // counters_survive_restart: whether the configured backend's counters keep counting while
-// odometryd is down: the HCTL-1100 chips on their bus (bus = "gpio"). GPIO quadrature (decoded
-// by this process), the simulated backends (they restart with the process) and, for now, CAN
-// (the driver counts from the first frame it sees, README "Restarts") do not.
+// odometryd is down: the HCTL-1100 chips on their bus (bus = "gpio") and the motor controllers'
+// counters on SocketCAN (the driver reports them as the controllers hold them). GPIO quadrature
+// (decoded by this process) and the simulated backends (they restart with the process) do not.
 bool counters_survive_restart(const Config& cfg);
 
 // StatePersister: a TickObserver that, every n-th tick (and at once on the tick a command such

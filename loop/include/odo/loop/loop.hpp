@@ -98,6 +98,10 @@ struct LoopConfig {
   GyrodometryParams gyrodometry;
   // Estimate the gyro's scale factor from turns while the kinematics are calibrated.
   bool gyro_scale_estimation = true;
+  // [ns] start(): while the reference reading is stale or failed (a CAN controller that has not
+  // sent yet), read again every millisecond for at most this long; 0: take the first reading.
+  // A wheel still stale then is referenced at its first fresh reading (no jump from its 0).
+  TimeNs start_wait = 0;
 };
 
 class OdometryLoop {
@@ -170,6 +174,8 @@ class OdometryLoop {
   TimeNs wait_for_deadline() noexcept;
   // integrate: the encoder sample's motion since the previous good one (and the gyro's, fused).
   void integrate(const EncoderSample& s) noexcept;
+  // take_reference: a wheel fresh for the first time since start() starts counting here.
+  void take_reference(const EncoderSample& s) noexcept;
   // integrate_fused: one interval of count deltas dl, dr over dt [s] with the gyro's reading up to
   // `stamp` [ns].
   void integrate_fused(std::int64_t dl, std::int64_t dr, double dt, TimeNs stamp) noexcept;
@@ -194,6 +200,7 @@ class OdometryLoop {
   EncoderSource* enc_;
   Clock* clock_;
   int bits_;
+  TimeNs start_wait_;  // [ns] LoopConfig::start_wait
   YawRateSource* gyro_ = nullptr;
   std::optional<Gyrodometry> fusion_;  // engaged when gyro_ is set
   bool gyro_scale_estimation_ = true;
@@ -208,6 +215,9 @@ class OdometryLoop {
   TimeNs deadline_ = 0;
   std::int64_t prev_left_ = 0;
   std::int64_t prev_right_ = 0;
+  // Stale flags of wheels that have not had a fresh reading since start(): their reference
+  // count is taken from their first fresh reading, not integrated from the stale one.
+  std::uint32_t unreferenced_ = 0;
   TimeNs prev_stamp_ = 0;
   LoopStats stats_;
   LatencyHistogram wakeup_hist_;

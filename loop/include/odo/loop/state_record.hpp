@@ -114,6 +114,7 @@ struct ResumeDecision {
   TimeNs gap = 0;       // sample time of `current` minus the record's [ns]
   std::int64_t dl = 0;  // counts of each wheel during the gap (wrap rule)
   std::int64_t dr = 0;
+  Pose2 pose;  // on kResumed: the pose the loop starts from (the record's plus the gap's step)
   bool resumed() const noexcept { return reason == ResumeReason::kResumed; }
 };
 
