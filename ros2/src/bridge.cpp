@@ -40,6 +40,16 @@ TimeNs now_ns(clockid_t id) {
   return static_cast<TimeNs>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
 }
 
+// cpu_relax: tells the core that this is a busy-wait loop (frees the sibling hyperthread and
+// saves power; a no-op where there is no such hint).
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__) || (defined(__arm__) && __ARM_ARCH >= 7)
+  asm volatile("yield");
+#endif
+}
+
 void put_stamp(builtin_interfaces_msg_dds__Time_& t, const RosTime& r) {
   t.sec = r.sec;
   t.nanosec = r.nanosec;
@@ -49,6 +59,7 @@ void put_stamp(builtin_interfaces_msg_dds__Time_& t, const RosTime& r) {
 
 struct Bridge::Impl {
   Config cfg;
+  TimeNs loop_period_ns = 0;
   SampleSource source;
   SetPoseSink sink;
   dds_entity_t domain = 0;  // only when our XML configures the domain (else CYCLONEDDS_URI)
@@ -65,7 +76,9 @@ struct Bridge::Impl {
   TimeNs last_sample = INT64_MIN;
   std::atomic<std::uint64_t> odom_published{0}, tf_published{0}, unchanged_skipped{0},
       write_errors{0}, set_pose_received{0}, set_pose_rejected{0};
-  std::atomic<std::int64_t> write_age_sum_ns{0}, write_age_max_ns{0};
+  std::atomic<std::int64_t> write_age_sum_ns{0}, write_age_max_ns{0}, last_published{0};
+  std::atomic<std::uint64_t> spin_count{0}, spin_late{0}, spin_given_up{0};
+  std::atomic<std::int64_t> spin_wait_sum_ns{0};
 
   ~Impl() {
     // Deleting the domain (or the participant) deletes everything created under it.
@@ -78,6 +91,8 @@ struct Bridge::Impl {
   Status open();
   enum class Published : std::uint8_t { kYes, kUnchanged, kNoSample };
   Published publish_once();
+  Published publish(const OdomSample& s);
+  Published spin_publish(TimeNs due);
   void take_set_pose();
   void run();
 };
@@ -128,6 +143,10 @@ Bridge::Impl::Published Bridge::Impl::publish_once() {
     unchanged_skipped.fetch_add(1, std::memory_order_relaxed);
     return Published::kUnchanged;
   }
+  return publish(s);
+}
+
+Bridge::Impl::Published Bridge::Impl::publish(const OdomSample& s) {
   last_sample = s.sample_time;
   // The offset is read at every publish, so a wall-clock step shows in the next stamp.
   auto f = odometry_fields(s, realtime_minus_monotonic());
@@ -147,6 +166,7 @@ Bridge::Impl::Published Bridge::Impl::publish_once() {
     write_errors.fetch_add(1, std::memory_order_relaxed);
   } else {
     odom_published.fetch_add(1, std::memory_order_relaxed);
+    last_published.store(s.sample_time, std::memory_order_relaxed);
     const TimeNs age = now_ns(CLOCK_MONOTONIC) - s.sample_time;
     write_age_sum_ns.fetch_add(age, std::memory_order_relaxed);
     // Only this thread writes the maximum: load and store suffice.
@@ -197,26 +217,60 @@ void Bridge::Impl::take_set_pose() {
   }
 }
 
+// spin_publish: the early wake-up's wait. Polls the loop's buffer until the sample of the tick due
+// at `due` [ns, CLOCK_MONOTONIC] is there (sample time at least due - half a loop period: a
+// tick late by its wake-up latency still counts) and writes it at once; gives up at due +
+// spin_us (the loop is late or stopped) and falls back to publishing the newest sample.
+Bridge::Impl::Published Bridge::Impl::spin_publish(TimeNs due) {
+  const TimeNs first = due - loop_period_ns / 2;
+  const TimeNs give_up = due + static_cast<TimeNs>(cfg.spin_us) * 1000;
+  const TimeNs woke = now_ns(CLOCK_MONOTONIC);
+  OdomSample s;
+  TimeNs now = woke;
+  while (!(source(s) && s.sample_time >= first)) {
+    if (now >= give_up) {
+      spin_given_up.fetch_add(1, std::memory_order_relaxed);
+      spin_wait_sum_ns.fetch_add(now - woke, std::memory_order_relaxed);
+      return publish_once();
+    }
+    cpu_relax();
+    now = now_ns(CLOCK_MONOTONIC);
+  }
+  if (now == woke) spin_late.fetch_add(1, std::memory_order_relaxed);
+  spin_count.fetch_add(1, std::memory_order_relaxed);
+  spin_wait_sum_ns.fetch_add(now - woke, std::memory_order_relaxed);
+  return publish(s);
+}
+
 void Bridge::Impl::run() {
   // steady_clock is CLOCK_MONOTONIC on Linux (libstdc++), the clock of the sample times.
   const auto period =
       chr::duration_cast<chr::steady_clock::duration>(chr::duration<double>(1.0 / cfg.rate_hz));
   const auto retry = std::max<chr::steady_clock::duration>(kPublishDelay, period / 8);
+  const chr::microseconds spin{cfg.spin_us};
+  TimeNs due = 0;  // early wake-up: sample time of the tick to poll for; 0: publish the newest
   std::unique_lock lock(m);
   while (!stopping) {
     lock.unlock();
     take_set_pose();
-    const Published p = publish_once();
+    const Published p = due != 0 ? spin_publish(due) : publish_once();
     lock.lock();
     const auto now = chr::steady_clock::now();
     auto next = now + retry;  // no new sample yet: look again soon
+    due = 0;
     if (p == Published::kYes) {
       // Phase-locked to the loop: wake kPublishDelay after the tick one period after the sample
-      // just published, so a sample waits ~kPublishDelay, not up to a loop period, to go out.
-      // Sample times on another clock (replay, a virtual clock) fall back to a free-running
-      // period; so does a wake-up already missed (a stalled write skips ticks, never bursts).
-      next = chr::steady_clock::time_point(chr::nanoseconds(last_sample)) + period + kPublishDelay;
-      if (next <= now || next > now + 2 * period) next = now + period;
+      // just published, so a sample waits ~kPublishDelay, not up to a loop period, to go out;
+      // with spin_us, wake spin_us before that tick and poll for it (spin_publish). Sample times
+      // on another clock (replay, a virtual clock) fall back to a free-running period; so does a
+      // wake-up already missed (a stalled write skips ticks, never bursts).
+      const auto tick = chr::steady_clock::time_point(chr::nanoseconds(last_sample)) + period;
+      next = spin.count() > 0 ? tick - spin : tick + kPublishDelay;
+      if (next <= now || next > now + 2 * period) {
+        next = now + period;
+      } else if (spin.count() > 0) {
+        due = chr::duration_cast<chr::nanoseconds>(tick.time_since_epoch()).count();
+      }
     }
     cv.wait_until(lock, next, [this] { return stopping; });
   }
@@ -238,6 +292,7 @@ Result<std::unique_ptr<Bridge>> Bridge::create(const Config& c, double loop_rate
   if (!source) return make_error(Errc::kInvalidArgument, "ros2: no sample source given");
   auto impl = std::make_unique<Impl>();
   impl->cfg = c;
+  impl->loop_period_ns = static_cast<TimeNs>(1e9 / loop_rate_hz);
   impl->source = std::move(source);
   impl->sink = std::move(sink);
   if (auto s = impl->open(); !s) return std::move(s).error();
@@ -274,6 +329,11 @@ BridgeStats Bridge::stats() const {
                  r(i.write_errors),   r(i.set_pose_received), r(i.set_pose_rejected)};
   st.write_age_sum_ns = i.write_age_sum_ns.load(std::memory_order_relaxed);
   st.write_age_max_ns = i.write_age_max_ns.load(std::memory_order_relaxed);
+  st.last_published = i.last_published.load(std::memory_order_relaxed);
+  st.spin_count = r(i.spin_count);
+  st.spin_late = r(i.spin_late);
+  st.spin_given_up = r(i.spin_given_up);
+  st.spin_wait_sum_ns = i.spin_wait_sum_ns.load(std::memory_order_relaxed);
   return st;
 }
 

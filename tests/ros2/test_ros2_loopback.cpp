@@ -37,19 +37,26 @@ TimeNs realtime_now() {
 
 constexpr int kOdom = 20;  // messages each peer waits for
 
+// loopback_config: the bridge on 127.0.0.1 only (no multicast, unicast discovery) on domain,
+// publishing at rate_hz.
+Config loopback_config(int domain, double rate_hz) {
+  Config c;
+  c.enabled = true;
+  c.domain_id = static_cast<std::uint32_t>(domain);
+  c.rate_hz = rate_hz;
+  c.interfaces = {"lo"};
+  c.multicast = false;
+  c.peers = {"127.0.0.1"};
+  return c;
+}
+
 class Ros2Loopback : public ::testing::Test {
  protected:
   // run: bridge (100 Hz, tf on, namespace ns) fed by a 1 kHz simulated loop; the peer at path
   // receives kOdom odom and tf messages and publishes set_pose (1.5, -2.5, 0.7, variance 0.01).
   void run(const std::string& peer, const std::string& ns, int domain) {
-    Config c;
-    c.enabled = true;
-    c.domain_id = static_cast<std::uint32_t>(domain);
+    Config c = loopback_config(domain, 100);
     c.ns = ns;
-    c.rate_hz = 100;
-    c.interfaces = {"lo"};
-    c.multicast = false;
-    c.peers = {"127.0.0.1"};
     test::SimLoop loop(1000);
     auto b = Bridge::create(
         c, 1000, [&](OdomSample& s) { return loop.read(s); },
@@ -194,12 +201,7 @@ TEST(Ros2Bridge, PublishesEachSampleOnceAndStopsWithoutWaitingForItsPeriod) {
   // the bridge could lock to): one write of odom and tf, then the free-running fallback waits a
   // whole period (rate 0.5 Hz: 2 s) before it reads again, and stop() must not wait for it.
   // stop() reads once more and does not write the same sample twice.
-  Config c;
-  c.domain_id = static_cast<std::uint32_t>(test_domain(2));
-  c.rate_hz = 0.5;
-  c.interfaces = {"lo"};
-  c.multicast = false;
-  c.peers = {"127.0.0.1"};
+  const Config c = loopback_config(test_domain(2), 0.5);
   int calls = 0;
   auto b = Bridge::create(
       c, 1000,
@@ -228,6 +230,42 @@ TEST(Ros2Bridge, PublishesEachSampleOnceAndStopsWithoutWaitingForItsPeriod) {
   EXPECT_EQ(calls, 2);
   EXPECT_EQ(st.unchanged_skipped, 1u);
   (*b)->stop();  // idempotent
+}
+
+TEST(Ros2Bridge, EarlyWakeUpKeepsTheRateAndStillSendsTheLastSampleAtStop) {
+  // spin_us = 500 at 100 Hz from a 1 kHz loop: the thread wakes 0.5 ms before each due tick
+  // and polls the buffer for that tick's sample. It must still write at the configured rate
+  // (one tick in ten, not every tick it sees while polling), nearly every write after the first
+  // must have gone through the poll, and once the loop stopped its final sample must go out
+  // (the poll gives up, stop() reads once more).
+  Config c = loopback_config(test_domain(3), 100);
+  c.spin_us = 500;
+  test::SimLoop loop(1000);
+  auto b = Bridge::create(
+      c, 1000, [&](OdomSample& s) { return loop.read(s); }, nullptr);
+  ASSERT_TRUE(b.ok()) << b.error().message;
+  loop.start();
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE((*b)->start().ok());
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  loop.stop();
+  const double ran_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  OdomSample final_sample;
+  ASSERT_TRUE(loop.read(final_sample));
+  (*b)->stop();
+  const BridgeStats st = (*b)->stats();
+  // At most one write per 10 ms of running, plus the first and the final one; at least 60 %
+  // of the rate (the thread may be starved on a loaded machine, and skips rather than bursts).
+  EXPECT_LE(st.odom_published, static_cast<std::uint64_t>(ran_s * 100) + 2) << ran_s << " s";
+  EXPECT_GE(st.odom_published, 60u);
+  EXPECT_EQ(st.tf_published, st.odom_published);
+  // Every write but the first (no phase yet) and the last (after stop) followed a poll, unless
+  // the thread woke too late for a period and fell back to the free-running period.
+  EXPECT_GE(st.spin_count + st.spin_given_up + 10, st.odom_published);
+  EXPECT_GT(st.spin_count, 0u);
+  EXPECT_GT(st.spin_wait_sum_ns, 0);
+  EXPECT_EQ(st.last_published, final_sample.sample_time);
+  EXPECT_EQ(st.write_errors, 0u);
 }
 
 }  // namespace

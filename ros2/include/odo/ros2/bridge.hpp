@@ -34,6 +34,16 @@ struct BridgeStats {
   // the bridge's share of the sample-to-receipt latency.
   std::int64_t write_age_sum_ns = 0;
   std::int64_t write_age_max_ns = 0;
+  // Sample time of the newest sample written to rt/odom [ns, CLOCK_MONOTONIC]; 0: none yet.
+  TimeNs last_published = 0;
+  // Early wake-up (Config::spin_us > 0): publishes whose due sample the thread polled for
+  // (spin_count), of those the ones already there when it woke, i.e. its wake-up was later than
+  // spin_us (spin_late), the wake-ups with no due sample by due + spin_us, published the old way
+  // (spin_given_up), and the time spent polling in all of them [ns] (its CPU cost).
+  std::uint64_t spin_count = 0;
+  std::uint64_t spin_late = 0;
+  std::uint64_t spin_given_up = 0;
+  std::int64_t spin_wait_sum_ns = 0;
 };
 
 class Bridge {
@@ -46,8 +56,9 @@ class Bridge {
   Bridge(const Bridge&) = delete;
   Bridge& operator=(const Bridge&) = delete;
 
-  // start: runs the publish thread (rate_hz), which first calls thread_setup (e.g. to give
-  // itself a real-time priority); error if it is running already.
+  // start: runs the publish thread (rate_hz, phase-locked to the samples' times; with
+  // Config::spin_us it wakes that long before each due tick and polls for its sample), which
+  // first calls thread_setup (e.g. to give itself a real-time priority); error if running.
   Status start(std::function<void()> thread_setup = {});
   // stop: ends and joins the thread; idempotent. The destructor stops too.
   void stop();
