@@ -259,9 +259,11 @@ TEST(Ros2Bridge, EarlyWakeUpKeepsTheRateAndStillSendsTheLastSampleAtStop) {
   EXPECT_LE(st.odom_published, static_cast<std::uint64_t>(ran_s * 100) + 2) << ran_s << " s";
   EXPECT_GE(st.odom_published, 60u);
   EXPECT_EQ(st.tf_published, st.odom_published);
-  // Every write but the first (no phase yet) and the last (after stop) followed a poll, unless
-  // the thread woke too late for a period and fell back to the free-running period.
-  EXPECT_GE(st.spin_count + st.spin_given_up + 10, st.odom_published);
+  // Every write but the first (no phase yet) and the last (after stop) followed a poll, or a
+  // wait for a tick the simulated loop (not real-time here) made late, or replaced a tick that
+  // never came; a few may have fallen back to the free-running period (the thread woke late).
+  EXPECT_GE(st.spin_count + st.due_waits + st.stale_published + 10, st.odom_published)
+      << "spin_late " << st.spin_late;
   EXPECT_GT(st.spin_count, 0u);
   EXPECT_GT(st.spin_wait_sum_ns, 0);
   EXPECT_EQ(st.last_published, final_sample.sample_time);
