@@ -250,8 +250,9 @@ Bridge::Impl::Published Bridge::Impl::publish_due(TimeNs due) {
         due_waits.fetch_add(1, std::memory_order_relaxed);
         return Published::kLate;
       }
-      stale_published.fetch_add(1, std::memory_order_relaxed);
-      return publish_once();
+      const Published p = publish_once();
+      if (p == Published::kYes) stale_published.fetch_add(1, std::memory_order_relaxed);
+      return p;
     }
     cpu_relax();
     now = now_ns(CLOCK_MONOTONIC);
