@@ -3,7 +3,7 @@
 # side by side, idle and with load on the other core. The figure is the ratio
 # loop / cyclictest of p99 and max wake-up latency (issue 9 target: <= 1.5 idle and loaded).
 #   tools/jitter.sh [--seconds S] [--priority P] [--cpu C] [--load-cpu L] [--odometryd PATH]
-#                   [--ros2 PEER [--ros2-rate HZ]]
+#                   [--ros2 PEER [--ros2-rate HZ] [--ros2-spin US]]
 # Defaults: 60 s, priority 80, loop and cyclictest on CPU 0, load (stress-ng --cpu 1, or a
 # shell busy loop when stress-ng is missing) on CPU 1. Needs root or CAP_SYS_NICE + CAP_IPC_LOCK
 # (without them both run unprivileged and the script says so). Packages: rt-tests, stress-ng.
@@ -11,10 +11,11 @@
 # `release` preset's build (built here when missing).
 # --ros2 PEER: the same with the ROS 2 output on ([ros2] on lo, unicast, --ros2-rate Hz, default
 # 1000: every tick) and PEER (tests/ros2's ros2_cyclone_peer or ros2_fastdds_peer) receiving it,
-# so that the loop runs beside a busy DDS thread (issue 19: wake-up latency with and without DDS).
+# so that the loop runs beside a busy DDS thread (issue 19: wake-up latency with and without DDS);
+# --ros2-spin US sets [ros2] spin_us (the publish thread's early wake-up and bounded poll).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-secs=60 prio=80 cpu=0 load_cpu=1 bin=build/release/firmware/odometryd peer= ros2_rate=1000
+secs=60 prio=80 cpu=0 load_cpu=1 bin=build/release/firmware/odometryd peer= ros2_rate=1000 ros2_spin=0
 while (($#)); do
   case $1 in
     --seconds) secs=$2; shift 2 ;;
@@ -24,10 +25,11 @@ while (($#)); do
     --odometryd) bin=$2; shift 2 ;;
     --ros2) peer=$2; shift 2 ;;
     --ros2-rate) ros2_rate=$2; shift 2 ;;
+    --ros2-spin) ros2_spin=$2; shift 2 ;;
     *) echo "jitter.sh: unknown option '$1' (see the header of $0)" >&2; exit 2 ;;
   esac
 done
-for v in "$secs" "$prio" "$cpu" "$load_cpu" "$ros2_rate"; do
+for v in "$secs" "$prio" "$cpu" "$load_cpu" "$ros2_rate" "$ros2_spin"; do
   [[ $v =~ ^[0-9]+$ ]] || { echo "jitter.sh: '$v' must be a non-negative integer" >&2; exit 2; }
 done
 ((prio >= 1 && prio <= 99)) || { echo "jitter.sh: --priority $prio outside 1..99" >&2; exit 2; }
@@ -66,6 +68,7 @@ rate_hz = $ros2_rate
 interfaces = ["lo"]
 multicast = false
 peers = ["127.0.0.1"]
+spin_us = $ros2_spin
 TOML
 fi
 # start_peer: the DDS receiver beside the loop (--ros2), until odometryd stopped publishing.
@@ -108,7 +111,7 @@ PY
 }
 
 echo "jitter: $secs s per condition, 1 kHz, SCHED_FIFO $prio, CPU $cpu; load on CPU $load_cpu;"
-[ -z "$peer" ] || echo "        ROS 2 output on at $ros2_rate Hz, received by $(basename "$peer") on lo"
+[ -z "$peer" ] || echo "        ROS 2 output on at $ros2_rate Hz (spin_us $ros2_spin), received by $(basename "$peer") on lo"
 echo "        $(uname -r), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(nproc) CPUs"
 printf '| condition | loop p99 [us] | cyclictest p99 [us] | p99 ratio | loop max [us] | cyclictest max [us] | max ratio | loop ticks | cyclictest loops |\n'
 printf '|---|---|---|---|---|---|---|---|---|\n'

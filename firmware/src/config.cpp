@@ -213,6 +213,7 @@ void read_ros2(TableReader t, ros2::Config& c, double loop_hz, int loop_priority
   c.peers = t.strings("peers", c.peers);
   c.multicast = t.boolean("multicast", c.multicast);
   c.priority = static_cast<int>(t.integer("priority", c.priority, 0, ros2::kPriorityMax));
+  c.spin_us = static_cast<int>(t.integer("spin_us", c.spin_us, 0, ros2::kSpinMaxUs));
   if (!t.ok()) return;
   if (auto p = ros2::check(c, loop_hz)) t.reject(p->key, p->what);
   if (c.priority > 0 && loop_priority > 0 && c.priority >= loop_priority)

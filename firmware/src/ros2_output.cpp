@@ -113,7 +113,14 @@ nlohmann::json Ros2Output::json() const {
           {"set_pose_rejected", st.set_pose_rejected},
           {"set_pose_posted", set_pose_posted_.load(std::memory_order_relaxed)},
           {"set_pose_dropped", set_pose_dropped_.load(std::memory_order_relaxed)},
-          {"write_age_max", to_seconds(st.write_age_max_ns)}};
+          {"write_age_p50", to_seconds(st.write_age_p50_ns)},
+          {"write_age_p99", to_seconds(st.write_age_p99_ns)},
+          {"write_age_max", to_seconds(st.write_age_max_ns)},
+          {"spin_count", st.spin_count},
+          {"spin_late", st.spin_late},
+          {"due_waits", st.due_waits},
+          {"stale_published", st.stale_published},
+          {"spin_wait_sum", to_seconds(st.spin_wait_sum_ns)}};
 }
 
 }  // namespace odo::fw

@@ -4,8 +4,10 @@
 #include <time.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
@@ -34,10 +36,25 @@ dds_qos_t* ros_default_qos() {
 // snapshot at the end of the tick (tens of microseconds after the sample).
 constexpr chr::microseconds kPublishDelay{200};
 
+// Histogram of the write ages (sample time to the rt/odom write's return): 10 us bins up to
+// 10 ms, the last bin holding everything beyond.
+constexpr TimeNs kAgeBinNs = 10'000;
+constexpr std::size_t kAgeBins = 1001;
+
 TimeNs now_ns(clockid_t id) {
   timespec ts{};
   clock_gettime(id, &ts);
   return static_cast<TimeNs>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
+}
+
+// cpu_relax: tells the core that this is a busy-wait loop (frees the sibling hyperthread and
+// saves power; a no-op where there is no such hint).
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__) || (defined(__arm__) && __ARM_ARCH >= 7)
+  asm volatile("yield");
+#endif
 }
 
 void put_stamp(builtin_interfaces_msg_dds__Time_& t, const RosTime& r) {
@@ -49,6 +66,8 @@ void put_stamp(builtin_interfaces_msg_dds__Time_& t, const RosTime& r) {
 
 struct Bridge::Impl {
   Config cfg;
+  TimeNs loop_period_ns = 0;
+  TimeNs period_ns = 0;  // of the publishing, 1 / rate_hz
   SampleSource source;
   SetPoseSink sink;
   dds_entity_t domain = 0;  // only when our XML configures the domain (else CYCLONEDDS_URI)
@@ -65,7 +84,10 @@ struct Bridge::Impl {
   TimeNs last_sample = INT64_MIN;
   std::atomic<std::uint64_t> odom_published{0}, tf_published{0}, unchanged_skipped{0},
       write_errors{0}, set_pose_received{0}, set_pose_rejected{0};
-  std::atomic<std::int64_t> write_age_sum_ns{0}, write_age_max_ns{0};
+  std::atomic<std::int64_t> write_age_sum_ns{0}, write_age_max_ns{0}, last_published{0};
+  std::atomic<std::uint64_t> spin_count{0}, spin_late{0}, due_waits{0}, stale_published{0};
+  std::atomic<std::int64_t> spin_wait_sum_ns{0};
+  std::array<std::atomic<std::uint32_t>, kAgeBins> age_hist{};
 
   ~Impl() {
     // Deleting the domain (or the participant) deletes everything created under it.
@@ -76,8 +98,12 @@ struct Bridge::Impl {
     }
   }
   Status open();
-  enum class Published : std::uint8_t { kYes, kUnchanged, kNoSample };
+  enum class Published : std::uint8_t { kYes, kUnchanged, kNoSample, kLate };
   Published publish_once();
+  Published publish(const OdomSample& s);
+  Published publish_due(TimeNs due);
+  chr::steady_clock::time_point next_wake(Published p, chr::steady_clock::time_point now,
+                                          TimeNs& due) const;
   void take_set_pose();
   void run();
 };
@@ -128,6 +154,10 @@ Bridge::Impl::Published Bridge::Impl::publish_once() {
     unchanged_skipped.fetch_add(1, std::memory_order_relaxed);
     return Published::kUnchanged;
   }
+  return publish(s);
+}
+
+Bridge::Impl::Published Bridge::Impl::publish(const OdomSample& s) {
   last_sample = s.sample_time;
   // The offset is read at every publish, so a wall-clock step shows in the next stamp.
   auto f = odometry_fields(s, realtime_minus_monotonic());
@@ -147,8 +177,11 @@ Bridge::Impl::Published Bridge::Impl::publish_once() {
     write_errors.fetch_add(1, std::memory_order_relaxed);
   } else {
     odom_published.fetch_add(1, std::memory_order_relaxed);
+    last_published.store(s.sample_time, std::memory_order_relaxed);
     const TimeNs age = now_ns(CLOCK_MONOTONIC) - s.sample_time;
     write_age_sum_ns.fetch_add(age, std::memory_order_relaxed);
+    const auto bin = static_cast<std::size_t>(std::clamp<TimeNs>(age / kAgeBinNs, 0, kAgeBins - 1));
+    age_hist[bin].fetch_add(1, std::memory_order_relaxed);
     // Only this thread writes the maximum: load and store suffice.
     if (age > write_age_max_ns.load(std::memory_order_relaxed)) {
       write_age_max_ns.store(age, std::memory_order_relaxed);
@@ -197,27 +230,73 @@ void Bridge::Impl::take_set_pose() {
   }
 }
 
+// publish_due: writes the sample of the tick due at `due` [ns, CLOCK_MONOTONIC], the first whose
+// sample time is at least due - half a loop period (a tick late by its wake-up latency still
+// counts). With spin_us the thread woke spin_us before `due` and polls for it until due +
+// spin_us; without, it looks once. kLate: the tick is not there yet (the loop woke late), look
+// again shortly; half a period after `due` the newest sample goes out instead (the loop is
+// stalled or stopped: skip, never wait for ever).
+Bridge::Impl::Published Bridge::Impl::publish_due(TimeNs due) {
+  const TimeNs first = due - loop_period_ns / 2;
+  const TimeNs poll_until = due + static_cast<TimeNs>(cfg.spin_us) * 1000;
+  const TimeNs woke = now_ns(CLOCK_MONOTONIC);
+  const bool polling = cfg.spin_us > 0 && woke < poll_until;
+  OdomSample s;
+  TimeNs now = woke;
+  while (!(source(s) && s.sample_time >= first)) {
+    if (now >= poll_until) {
+      if (polling) spin_wait_sum_ns.fetch_add(now - woke, std::memory_order_relaxed);
+      if (now < due + period_ns / 2) {
+        due_waits.fetch_add(1, std::memory_order_relaxed);
+        return Published::kLate;
+      }
+      const Published p = publish_once();
+      if (p == Published::kYes) stale_published.fetch_add(1, std::memory_order_relaxed);
+      return p;
+    }
+    cpu_relax();
+    now = now_ns(CLOCK_MONOTONIC);
+  }
+  if (polling) {
+    if (now == woke) spin_late.fetch_add(1, std::memory_order_relaxed);
+    spin_count.fetch_add(1, std::memory_order_relaxed);
+    spin_wait_sum_ns.fetch_add(now - woke, std::memory_order_relaxed);
+  }
+  return publish(s);
+}
+
+// next_wake: when to look again after `p` at `now`, and (due) the tick to wait for then.
+chr::steady_clock::time_point Bridge::Impl::next_wake(Published p,
+                                                      chr::steady_clock::time_point now,
+                                                      TimeNs& due) const {
+  const auto period = chr::nanoseconds(period_ns);
+  const chr::microseconds spin{cfg.spin_us};
+  // A late tick: look again kPublishDelay later for the same tick.
+  if (p == Published::kLate) return now + kPublishDelay;
+  due = 0;
+  // No new sample yet: look again soon.
+  if (p != Published::kYes) return now + std::max<chr::nanoseconds>(kPublishDelay, period / 8);
+  // Phase-locked to the loop: wake kPublishDelay after the tick one period after the sample just
+  // published, so a sample waits ~kPublishDelay, not up to a loop period, to go out; with
+  // spin_us, wake spin_us before that tick and poll for it. Sample times on another clock
+  // (replay, a virtual clock) fall back to a free-running period; so does a wake-up already
+  // missed (a stalled write skips ticks, never bursts).
+  const auto tick = chr::steady_clock::time_point(chr::nanoseconds(last_sample)) + period;
+  const auto next = spin.count() > 0 ? tick - spin : tick + kPublishDelay;
+  if (next <= now || next > now + 2 * period) return now + period;
+  due = last_sample + period_ns;
+  return next;
+}
+
 void Bridge::Impl::run() {
-  // steady_clock is CLOCK_MONOTONIC on Linux (libstdc++), the clock of the sample times.
-  const auto period =
-      chr::duration_cast<chr::steady_clock::duration>(chr::duration<double>(1.0 / cfg.rate_hz));
-  const auto retry = std::max<chr::steady_clock::duration>(kPublishDelay, period / 8);
+  TimeNs due = 0;  // sample time of the tick to publish next; 0: none, publish the newest
   std::unique_lock lock(m);
   while (!stopping) {
     lock.unlock();
     take_set_pose();
-    const Published p = publish_once();
+    const Published p = due != 0 ? publish_due(due) : publish_once();
     lock.lock();
-    const auto now = chr::steady_clock::now();
-    auto next = now + retry;  // no new sample yet: look again soon
-    if (p == Published::kYes) {
-      // Phase-locked to the loop: wake kPublishDelay after the tick one period after the sample
-      // just published, so a sample waits ~kPublishDelay, not up to a loop period, to go out.
-      // Sample times on another clock (replay, a virtual clock) fall back to a free-running
-      // period; so does a wake-up already missed (a stalled write skips ticks, never bursts).
-      next = chr::steady_clock::time_point(chr::nanoseconds(last_sample)) + period + kPublishDelay;
-      if (next <= now || next > now + 2 * period) next = now + period;
-    }
+    const auto next = next_wake(p, chr::steady_clock::now(), due);
     cv.wait_until(lock, next, [this] { return stopping; });
   }
   // The newest sample once more before the thread ends: after the loop stopped it is the final
@@ -238,6 +317,8 @@ Result<std::unique_ptr<Bridge>> Bridge::create(const Config& c, double loop_rate
   if (!source) return make_error(Errc::kInvalidArgument, "ros2: no sample source given");
   auto impl = std::make_unique<Impl>();
   impl->cfg = c;
+  impl->loop_period_ns = static_cast<TimeNs>(1e9 / loop_rate_hz);
+  impl->period_ns = static_cast<TimeNs>(1e9 / c.rate_hz);
   impl->source = std::move(source);
   impl->sink = std::move(sink);
   if (auto s = impl->open(); !s) return std::move(s).error();
@@ -274,6 +355,28 @@ BridgeStats Bridge::stats() const {
                  r(i.write_errors),   r(i.set_pose_received), r(i.set_pose_rejected)};
   st.write_age_sum_ns = i.write_age_sum_ns.load(std::memory_order_relaxed);
   st.write_age_max_ns = i.write_age_max_ns.load(std::memory_order_relaxed);
+  st.last_published = i.last_published.load(std::memory_order_relaxed);
+  std::array<std::uint32_t, kAgeBins> h{};
+  std::uint64_t n = 0;
+  for (std::size_t b = 0; b < kAgeBins; ++b)
+    n += h[b] = i.age_hist[b].load(std::memory_order_relaxed);
+  // Upper edge of the bin holding the q-quantile (rank ceil(q n)).
+  auto quantile = [&](double q) {
+    const auto rank = static_cast<std::uint64_t>(std::ceil(q * static_cast<double>(n)));
+    std::uint64_t seen = 0;
+    for (std::size_t b = 0; b < kAgeBins; ++b) {
+      seen += h[b];
+      if (seen >= rank && seen > 0) return static_cast<TimeNs>(b + 1) * kAgeBinNs;
+    }
+    return TimeNs{0};
+  };
+  st.write_age_p50_ns = quantile(0.5);
+  st.write_age_p99_ns = quantile(0.99);
+  st.spin_count = r(i.spin_count);
+  st.spin_late = r(i.spin_late);
+  st.due_waits = r(i.due_waits);
+  st.stale_published = r(i.stale_published);
+  st.spin_wait_sum_ns = i.spin_wait_sum_ns.load(std::memory_order_relaxed);
   return st;
 }
 

@@ -1,5 +1,6 @@
 #include "odo/ros2/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <utility>
@@ -84,6 +85,14 @@ std::string priority_problem(int priority) {
          "] (0: normal scheduling)";
 }
 
+std::string spin_problem(int spin_us, double rate_hz) {
+  // Half the publish period: the thread must sleep most of it (and spin_us is at most 2 ms).
+  const int max_us = static_cast<int>(std::min<double>(kSpinMaxUs, std::floor(0.5e6 / rate_hz)));
+  if (spin_us >= 0 && spin_us <= max_us) return "";
+  return "= " + std::to_string(spin_us) + " us is outside [0, " + std::to_string(max_us) +
+         "] (at most " + std::to_string(kSpinMaxUs) + " us and half the publish period)";
+}
+
 std::string interfaces_problem(const std::vector<std::string>& interfaces) {
   for (const auto& i : interfaces) {
     if (i.empty() || i.size() > 15 || !address_text(i)) {
@@ -137,7 +146,8 @@ std::optional<ConfigProblem> check(const Config& c, double loop_rate_hz) {
       {"rate_hz", rate_problem(c.rate_hz, loop_rate_hz)},
       {"interfaces", interfaces_problem(c.interfaces)},
       {"peers", peers_problem(c)},
-      {"priority", priority_problem(c.priority)}};
+      {"priority", priority_problem(c.priority)},
+      {"spin_us", spin_problem(c.spin_us, c.rate_hz)}};
   for (const auto& [key, what] : checks) {
     if (!what.empty()) return ConfigProblem{std::string(key), what};
   }

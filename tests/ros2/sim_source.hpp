@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <mutex>
 #include <thread>
 
@@ -38,9 +39,20 @@ inline TimeNs monotonic_now() {
   return static_cast<TimeNs>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
 }
 
+// sleep_until: CLOCK_MONOTONIC absolute t [ns].
+inline void sleep_until(TimeNs t) {
+  const timespec ts{static_cast<time_t>(t / kNsPerSecond), static_cast<long>(t % kNsPerSecond)};
+  clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+}
+
+// LateHook: called on waking for tick k; returns how late [ns] the tick is to be (0: on time),
+// as if the loop had woken that much later.
+using LateHook = std::function<TimeNs(std::int64_t k)>;
+
 class SimLoop {
  public:
-  explicit SimLoop(double loop_hz) : period_ns_(static_cast<TimeNs>(1e9 / loop_hz)) {}
+  explicit SimLoop(double loop_hz, LateHook late = {})
+      : period_ns_(static_cast<TimeNs>(1e9 / loop_hz)), late_(std::move(late)) {}
   ~SimLoop() { stop(); }
   void start() {
     thread_ = std::thread([this] { run(); });
@@ -59,15 +71,10 @@ class SimLoop {
 
  private:
   void run() {
-    timespec next{};
-    clock_gettime(CLOCK_MONOTONIC, &next);
+    const TimeNs t0 = monotonic_now();
     for (std::int64_t k = 0; !stop_; ++k) {
-      next.tv_nsec += period_ns_;
-      while (next.tv_nsec >= kNsPerSecond) {
-        next.tv_nsec -= kNsPerSecond;
-        ++next.tv_sec;
-      }
-      clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, nullptr);
+      sleep_until(t0 + (k + 1) * period_ns_);
+      if (const TimeNs late = late_ ? late_(k) : 0; late > 0) sleep_until(monotonic_now() + late);
       const OdomSample s = sample_k(k, monotonic_now());
       std::lock_guard g(m_);
       latest_ = s;
@@ -75,6 +82,7 @@ class SimLoop {
     }
   }
   TimeNs period_ns_;
+  LateHook late_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
   std::mutex m_;

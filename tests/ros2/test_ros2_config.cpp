@@ -78,6 +78,22 @@ TEST(Ros2Config, WholeConfig) {
             std::string::npos);
   c.peers = {"127.0.0.1"};
   EXPECT_TRUE(validate(c, 1000).ok());
+  // spin_us: up to kSpinMaxUs (2000) and half the publish period (1 ms at 500 Hz).
+  c.spin_us = 2000;
+  EXPECT_TRUE(validate(c, 1000).ok());
+  c.spin_us = 2001;
+  EXPECT_EQ(message_of(validate(c, 1000)),
+            "ros2.spin_us = 2001 us is outside [0, 2000] (at most 2000 us and half the publish "
+            "period)");
+  c.rate_hz = 500;
+  c.spin_us = 1001;
+  EXPECT_EQ(message_of(validate(c, 1000)),
+            "ros2.spin_us = 1001 us is outside [0, 1000] (at most 2000 us and half the publish "
+            "period)");
+  c.spin_us = 1000;
+  EXPECT_TRUE(validate(c, 1000).ok());
+  c.spin_us = 0;
+  c.rate_hz = 50;
   // And the Cyclone configuration it gives.
   EXPECT_EQ(cyclone_config_xml(c),
             "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/>"

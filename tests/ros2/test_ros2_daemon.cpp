@@ -53,9 +53,9 @@ class Ros2Daemon : public ::testing::Test {
   }
   void TearDown() override { std::system(("rm -rf '" + dir_ + "'").c_str()); }
 
-  // run: odometryd for 4 s of loop time (100 Hz, output at 50 Hz) on domain, and `peer` (a
-  // shell command prefix) beside it; fills json_ and peer_.
-  void run(const std::string& peer, int domain) {
+  // run: odometryd for 4 s of loop time (100 Hz, output at 50 Hz, `ros2_extra` appended to
+  // [ros2]) on domain, and `peer` (a shell command prefix) beside it; fills json_ and peer_.
+  void run(const std::string& peer, int domain, const std::string& ros2_extra = "") {
     const std::string cfg = dir_ + "/odometryd.toml";
     std::ofstream(cfg) << "[loop]\nrate_hz = 100\nstatus_period = 0\n"
                        << "[sim]\nscenario = \"square-ccw\"\nside = 0.1\nspeed = 0.5\n"
@@ -63,7 +63,8 @@ class Ros2Daemon : public ::testing::Test {
                        << "[realtime]\npriority = 0\nlock_memory = false\nprefault_stack = 0\n"
                        << "[calibration]\nstore = \"\"\n[can]\nbus = \"none\"\n"
                        << "[ros2]\nenabled = true\ndomain_id = " << domain << "\nrate_hz = 50\n"
-                       << "interfaces = [\"lo\"]\nmulticast = false\npeers = [\"127.0.0.1\"]\n";
+                       << "interfaces = [\"lo\"]\nmulticast = false\npeers = [\"127.0.0.1\"]\n"
+                       << ros2_extra;
     const std::string peer_cmd =
         peer + " --domain " + std::to_string(domain) + " --odom " + std::to_string(kMinOdom) +
         " --tf " + std::to_string(kMinOdom) + " --set-pose " + std::to_string(kSetX) + " " +
@@ -156,6 +157,22 @@ TEST_F(Ros2Daemon, CyclonePeerReceivesTheFinalPoseAndSetsThePose) {
           ODO_CYCLONE_PEER,
       domain(1));
   check();
+}
+
+TEST_F(Ros2Daemon, EarlyWakeUpKeepsTheRateAndTheFinalPose) {
+  // [ros2] spin_us through odometryd: the publish thread wakes 1 ms before each due tick and
+  // polls for it. Still 50 Hz (not the loop's 100 Hz), the final pose still goes out at stop
+  // (check(): the last message equals --json's pose), and the polls are counted.
+  run("CYCLONEDDS_URI='" + std::string(test::kCycloneLoopbackXml) + "' " + ODO_EMULATOR_PREFIX +
+          ODO_CYCLONE_PEER,
+      domain(3), "spin_us = 1000\n");
+  check();
+  const auto& r = json_["ros2"];
+  // 4 s at 50 Hz: 200 writes and the final one; at least half (a starved thread skips ticks).
+  EXPECT_LE(r["odom_published"].get<int>(), 202);
+  EXPECT_GE(r["odom_published"].get<int>(), 100);
+  EXPECT_GT(r["spin_count"].get<int>(), 0);
+  EXPECT_GT(r["spin_wait_sum"].get<double>(), 0.0);
 }
 
 // [ros2] priority: the publish thread asks for SCHED_FIFO at that priority and the start-up

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -37,19 +38,26 @@ TimeNs realtime_now() {
 
 constexpr int kOdom = 20;  // messages each peer waits for
 
+// loopback_config: the bridge on 127.0.0.1 only (no multicast, unicast discovery) on domain,
+// publishing at rate_hz.
+Config loopback_config(int domain, double rate_hz) {
+  Config c;
+  c.enabled = true;
+  c.domain_id = static_cast<std::uint32_t>(domain);
+  c.rate_hz = rate_hz;
+  c.interfaces = {"lo"};
+  c.multicast = false;
+  c.peers = {"127.0.0.1"};
+  return c;
+}
+
 class Ros2Loopback : public ::testing::Test {
  protected:
   // run: bridge (100 Hz, tf on, namespace ns) fed by a 1 kHz simulated loop; the peer at path
   // receives kOdom odom and tf messages and publishes set_pose (1.5, -2.5, 0.7, variance 0.01).
   void run(const std::string& peer, const std::string& ns, int domain) {
-    Config c;
-    c.enabled = true;
-    c.domain_id = static_cast<std::uint32_t>(domain);
+    Config c = loopback_config(domain, 100);
     c.ns = ns;
-    c.rate_hz = 100;
-    c.interfaces = {"lo"};
-    c.multicast = false;
-    c.peers = {"127.0.0.1"};
     test::SimLoop loop(1000);
     auto b = Bridge::create(
         c, 1000, [&](OdomSample& s) { return loop.read(s); },
@@ -194,12 +202,7 @@ TEST(Ros2Bridge, PublishesEachSampleOnceAndStopsWithoutWaitingForItsPeriod) {
   // the bridge could lock to): one write of odom and tf, then the free-running fallback waits a
   // whole period (rate 0.5 Hz: 2 s) before it reads again, and stop() must not wait for it.
   // stop() reads once more and does not write the same sample twice.
-  Config c;
-  c.domain_id = static_cast<std::uint32_t>(test_domain(2));
-  c.rate_hz = 0.5;
-  c.interfaces = {"lo"};
-  c.multicast = false;
-  c.peers = {"127.0.0.1"};
+  const Config c = loopback_config(test_domain(2), 0.5);
   int calls = 0;
   auto b = Bridge::create(
       c, 1000,
@@ -228,6 +231,126 @@ TEST(Ros2Bridge, PublishesEachSampleOnceAndStopsWithoutWaitingForItsPeriod) {
   EXPECT_EQ(calls, 2);
   EXPECT_EQ(st.unchanged_skipped, 1u);
   (*b)->stop();  // idempotent
+}
+
+TEST(Ros2Bridge, EarlyWakeUpKeepsTheRateAndStillSendsTheLastSampleAtStop) {
+  // spin_us = 500 at 100 Hz from a 1 kHz loop: the thread wakes 0.5 ms before each due tick
+  // and polls the buffer for that tick's sample. It must still write at the configured rate
+  // (one tick in ten, not every tick it sees while polling), nearly every write after the first
+  // must have gone through the poll, and once the loop stopped its final sample must go out
+  // (the poll gives up, stop() reads once more).
+  Config c = loopback_config(test_domain(3), 100);
+  c.spin_us = 500;
+  test::SimLoop loop(1000);
+  auto b = Bridge::create(
+      c, 1000, [&](OdomSample& s) { return loop.read(s); }, nullptr);
+  ASSERT_TRUE(b.ok()) << b.error().message;
+  loop.start();
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE((*b)->start().ok());
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  loop.stop();
+  const double ran_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  OdomSample final_sample;
+  ASSERT_TRUE(loop.read(final_sample));
+  (*b)->stop();
+  const BridgeStats st = (*b)->stats();
+  // At most one write per 10 ms of running, plus the first and the final one; at least 60 %
+  // of the rate (the thread may be starved on a loaded machine, and skips rather than bursts).
+  EXPECT_LE(st.odom_published, static_cast<std::uint64_t>(ran_s * 100) + 2) << ran_s << " s";
+  EXPECT_GE(st.odom_published, 60u);
+  EXPECT_EQ(st.tf_published, st.odom_published);
+  // Every write but the first (no phase yet) and the last (after stop) followed a poll, or a
+  // wait for a tick the simulated loop (not real-time here) made late, or replaced a tick that
+  // never came; a few may have fallen back to the free-running period (the thread woke late).
+  EXPECT_GE(st.spin_count + st.due_waits + st.stale_published + 10, st.odom_published)
+      << "spin_late " << st.spin_late;
+  EXPECT_GT(st.spin_count, 0u);
+  EXPECT_GT(st.spin_wait_sum_ns, 0);
+  EXPECT_EQ(st.last_published, final_sample.sample_time);
+  EXPECT_EQ(st.write_errors, 0u);
+}
+
+// LateDueTicks: a SimLoop hook that makes the loop late exactly for the ticks the bridge is due
+// to publish: the first tick that wakes at least 9.5 ms (a 100 Hz period less half a loop
+// period) after the sample the bridge published last comes kLate later. Records those ticks.
+class LateDueTicks {
+ public:
+  static constexpr TimeNs kLate = 600'000;
+  void watch(const Bridge* b) { bridge_ = b; }
+  // late: the SimLoop hook (loop thread).
+  TimeNs late(std::int64_t k) {
+    constexpr TimeNs kMs = 1'000'000;
+    const Bridge* b = bridge_.load();
+    const TimeNs last = b ? b->stats().last_published : 0;
+    if (last == 0 || last == delayed_for_ || test::monotonic_now() < last + 10 * kMs - kMs / 2) {
+      return 0;
+    }
+    delayed_for_ = last;
+    std::lock_guard g(m_);
+    delayed_.insert(k);
+    return kLate;
+  }
+  bool delayed(std::int64_t k) {
+    std::lock_guard g(m_);
+    return delayed_.count(k) > 0;
+  }
+
+ private:
+  std::atomic<const Bridge*> bridge_{nullptr};
+  TimeNs delayed_for_ = 0;  // loop thread: the last_published a tick was delayed for
+  std::mutex m_;
+  std::set<std::int64_t> delayed_;
+};
+
+TEST(Ros2Bridge, ALateDueTickIsWaitedForNotReplacedByThePreviousTick) {
+  // At 100 Hz from a 1 kHz loop, the bridge wakes 200 us after the due tick (or spin_us before
+  // it and polls until spin_us after it); the loop here delivers that tick 600 us late. The
+  // bridge must wait for it and publish it, not the tick before it (1 ms older when read, so
+  // 1.2+ ms old when received). Received by the Cyclone peer, which prints each sample's tick.
+  setenv("CYCLONEDDS_URI", test::kCycloneLoopbackXml, 1);
+  const std::string emulator = ODO_PEER_EMULATOR;
+  const std::string peer = emulator.empty() ? ODO_CYCLONE_PEER : emulator + " " + ODO_CYCLONE_PEER;
+  for (const int spin_us : {0, 300}) {
+    SCOPED_TRACE("spin_us = " + std::to_string(spin_us));
+    Config c = loopback_config(test_domain(4), 100);
+    c.spin_us = spin_us;
+    LateDueTicks late;
+    test::SimLoop loop(1000, [&](std::int64_t k) { return late.late(k); });
+    auto b = Bridge::create(
+        c, 1000, [&](OdomSample& s) { return loop.read(s); }, nullptr);
+    ASSERT_TRUE(b.ok()) << b.error().message;
+    late.watch(b->get());
+    ASSERT_TRUE((*b)->start().ok());
+    loop.start();
+    const PeerRun r =
+        run_peer(peer + " --domain " + std::to_string(test_domain(4)) + " --odom 40 --timeout 30");
+    loop.stop();
+    (*b)->stop();
+    ASSERT_EQ(r.status, 0) << (r.lines.empty() ? "" : r.lines.back());
+    int received = 0, stale = 0;
+    std::string stale_ticks;  // for the message
+    for (const auto& l : r.lines) {
+      const auto t = split(l);
+      if (t.size() < 7 || t[0] != "odom") continue;
+      // The first messages may predate the phase lock (and the first delayed tick).
+      if (++received <= 3) continue;
+      // Stale: the tick just before a delayed one, what a bridge that does not wait publishes.
+      // The delayed tick or a later one (a bridge that woke late itself) is right.
+      const std::int64_t k = std::llround(std::strtod(t[6].c_str(), nullptr) * 1024.0);
+      if (late.delayed(k + 1)) {
+        ++stale;
+        stale_ticks += " " + std::to_string(k);
+      }
+    }
+    ASSERT_GE(received, 40);
+    // A thread that woke more than half a period late may fall back to the newest sample once
+    // or twice; a bridge that does not wait publishes stale ticks every period.
+    EXPECT_LE(stale, (received - 3) / 10) << "of " << received - 3 << ":" << stale_ticks;
+    const BridgeStats st = (*b)->stats();
+    EXPECT_GT(st.due_waits, 0u);
+    EXPECT_EQ(st.write_errors, 0u);
+  }
 }
 
 }  // namespace

@@ -27,6 +27,7 @@ TEST(ConfigRos2, DefaultsAreOffWithTheRos2Names) {
   EXPECT_EQ(c->ros2->base_frame, "base_link");
   EXPECT_TRUE(c->ros2->publish_tf);
   EXPECT_TRUE(c->ros2->multicast);
+  EXPECT_EQ(c->ros2->spin_us, 0);  // the early wake-up is off unless asked for
 }
 
 TEST(ConfigRos2, EveryKeyIsRead) {
@@ -34,7 +35,7 @@ TEST(ConfigRos2, EveryKeyIsRead) {
       "[loop]\nrate_hz = 200\n[ros2]\ndomain_id = 232\nnamespace = \"/robot1\"\n"
       "odom_frame = \"odom1\"\nbase_frame = \"base_footprint\"\nrate_hz = 200\n"
       "publish_tf = false\ninterfaces = [\"eth0\", \"lo\"]\npeers = [\"192.168.1.20\"]\n"
-      "multicast = false\npriority = 40\n",
+      "multicast = false\npriority = 40\nspin_us = 300\n",
       "all.toml");
   ASSERT_TRUE(c.ok()) << c.error().message;
   const ros2::Config& r = *c->ros2;
@@ -48,6 +49,7 @@ TEST(ConfigRos2, EveryKeyIsRead) {
   EXPECT_EQ(r.peers, (std::vector<std::string>{"192.168.1.20"}));
   EXPECT_FALSE(r.multicast);
   EXPECT_EQ(r.priority, 40);
+  EXPECT_EQ(r.spin_us, 300);
 }
 
 TEST(ConfigRos2, ErrorsNameFileLineFieldAndRange) {
@@ -85,6 +87,18 @@ TEST(ConfigRos2, ErrorsNameFileLineFieldAndRange) {
   auto no_rt = parse_config("[realtime]\npriority = 0\n[ros2]\npriority = 90\n", "n.toml");
   ASSERT_TRUE(no_rt.ok()) << no_rt.error().message;  // a loop without SCHED_FIFO: any priority
   EXPECT_EQ(no_rt->ros2->priority, 90);
+  // The early wake-up: 0..2000 us (kSpinMaxUs), and at most half the publish period.
+  EXPECT_EQ(error_of("spin_us = 2001"),
+            "r.toml:3: ros2.spin_us = 2001 is outside the allowed range [0, 2000]");
+  EXPECT_EQ(error_of("spin_us = -1"),
+            "r.toml:3: ros2.spin_us = -1 is outside the allowed range [0, 2000]");
+  EXPECT_EQ(error_of("spin_us = 2000"), "");
+  auto fast =
+      parse_config("[loop]\nrate_hz = 1000\n[ros2]\nrate_hz = 1000\nspin_us = 501\n", "f.toml");
+  ASSERT_FALSE(fast.ok());
+  EXPECT_EQ(fast.error().message,
+            "f.toml:5: ros2.spin_us = 501 us is outside [0, 500] (at most 2000 us and half the "
+            "publish period)");
   EXPECT_EQ(error_of("domian_id = 3"),
             "r.toml:3: ros2.domian_id is not a known setting (misspelt?)");
 }

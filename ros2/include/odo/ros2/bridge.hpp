@@ -34,6 +34,21 @@ struct BridgeStats {
   // the bridge's share of the sample-to-receipt latency.
   std::int64_t write_age_sum_ns = 0;
   std::int64_t write_age_max_ns = 0;
+  // Its median and 99th percentile [ns], to 10 us (upper bin edge; 10 ms + 10 us: beyond 10 ms).
+  std::int64_t write_age_p50_ns = 0;
+  std::int64_t write_age_p99_ns = 0;
+  // Sample time of the newest sample written to rt/odom [ns, CLOCK_MONOTONIC]; 0: none yet.
+  TimeNs last_published = 0;
+  // Early wake-up (Config::spin_us > 0): publishes whose due sample the thread polled for
+  // (spin_count), of those the ones already there when it woke, i.e. its wake-up was later than
+  // spin_us (spin_late), and the time spent polling [ns] (its CPU cost).
+  std::uint64_t spin_count = 0;
+  std::uint64_t spin_late = 0;
+  std::int64_t spin_wait_sum_ns = 0;
+  // Looks at a due tick that was not there yet (the loop woke late: looked again 200 us later),
+  // and publishes of an older sample because the due tick had not come half a period after it.
+  std::uint64_t due_waits = 0;
+  std::uint64_t stale_published = 0;
 };
 
 class Bridge {
@@ -46,8 +61,9 @@ class Bridge {
   Bridge(const Bridge&) = delete;
   Bridge& operator=(const Bridge&) = delete;
 
-  // start: runs the publish thread (rate_hz), which first calls thread_setup (e.g. to give
-  // itself a real-time priority); error if it is running already.
+  // start: runs the publish thread (rate_hz, phase-locked to the samples' times; with
+  // Config::spin_us it wakes that long before each due tick and polls for its sample), which
+  // first calls thread_setup (e.g. to give itself a real-time priority); error if running.
   Status start(std::function<void()> thread_setup = {});
   // stop: ends and joins the thread; idempotent. The destructor stops too.
   void stop();

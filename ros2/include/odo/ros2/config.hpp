@@ -19,6 +19,8 @@ inline constexpr std::size_t kNameLengthMax = 255;  // frame ids and the namespa
 inline constexpr double kRateMinHz = 0.1;
 // The publish thread's SCHED_FIFO priority stays below the kernel's 99 (migration, watchdog).
 inline constexpr int kPriorityMax = 98;
+// The publish thread's early wake-up (spin_us): at most 2 ms, and at most half the publish period.
+inline constexpr int kSpinMaxUs = 2000;
 // kBuiltWithDds: this build has the DDS bridge (-DODO_ROS2=ON); without it the configuration is
 // still read and checked, and enabled = true is an error.
 inline constexpr bool kBuiltWithDds = ODO_ROS2_DDS != 0;
@@ -35,6 +37,10 @@ struct Config {
   std::vector<std::string> peers;        // unicast discovery peers ({} = multicast only)
   bool multicast = true;                 // SPDP multicast discovery (false: peers only)
   int priority = 0;  // SCHED_FIFO priority of the publish thread, 1..kPriorityMax; 0: normal
+  // Early wake-up of the publish thread [us]: it wakes this long before a due tick and polls the
+  // loop's buffer (a bounded busy wait) until that tick's sample is there, so that its own
+  // wake-up is not in the sample-to-receipt latency; 0: it sleeps until just after the tick.
+  int spin_us = 0;
 };
 
 // validate_domain_id: domain_id in [0, kDomainIdMax].
