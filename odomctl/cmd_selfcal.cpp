@@ -1,7 +1,9 @@
 // odomctl calib fit-fixes: self-calibration from absolute fixes offline (issue 18), with the
 // daemon's recorder and estimator on a replay count log and a CSV of fixes.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <numbers>
 #include <random>
@@ -143,6 +145,7 @@ struct SimulateOpts {
   int score_runs = 200;  // squares a direction of the systematic E_max,syst
   std::uint64_t seed = 1;
   bool json = false;
+  std::string plot;  // SVG of the convergence, empty: none
 };
 
 // SimDrive: the random excursions as one scenario and the fix moments (ticks in the final
@@ -175,7 +178,21 @@ struct SimOutcome {
   KinematicParams final;
   std::string log;
   int corrupted = 0;
+  std::vector<analysis::SelfCalFitPoint> history;  // every completed fit, in order
 };
+
+// record_fit: after a step of the estimator, its fit (if it ran one and the fit succeeded)
+// into `out.history`; collected here, on the command's thread, from the estimator's counters.
+void record_fit(const fw::SelfCalEstimator& est, fw::SelfCalCounters& seen, SimOutcome& out) {
+  fw::SelfCalCounters now = est.counters();
+  if (now.fits - now.fit_errors > seen.fits - seen.fit_errors && now.last) {
+    const calib::SelfCalResult& r = *now.last;
+    // The first fix is taken at the dock before any excursion.
+    const int driven = std::max(static_cast<int>(now.fixes_received) - 1, 0);
+    out.history.push_back({driven, r.estimate, r.sigma, now.accepted > seen.accepted});
+  }
+  seen = std::move(now);
+}
 
 // selfcal_setup: the estimator as the daemon would run it for these options.
 fw::SelfCalSetup selfcal_setup(const SimulateOpts& o, const Kinematics& believed) {
@@ -230,6 +247,7 @@ SimOutcome simulate_drive(const SimulateOpts& o, const SimDrive& d, std::mt19937
   fw::SelfCalEstimator est(selfcal_setup(o, believed), &store, lp->commands(), segments, rec, log);
   std::vector<calib::PoseFix> waiting;
   SimOutcome out;
+  fw::SelfCalCounters seen;
   std::size_t next = 0;
   lp->start();
   const TimeNs end = from_seconds(sim::scenario_duration(d.scenario) + 1.0);
@@ -244,21 +262,27 @@ SimOutcome simulate_drive(const SimulateOpts& o, const SimDrive& d, std::mt19937
       est.submit(waiting.front());
       waiting.erase(waiting.begin());
     }
-    if (lp->snapshot().tick % 5 == 0) est.step();
+    if (lp->snapshot().tick % 5 == 0) {
+      est.step();
+      record_fit(est, seen, out);
+    }
   }
   est.step();
+  record_fit(est, seen, out);
   out.counters = est.counters();
   out.final = est.in_use();
   out.log = log.str();
   return out;
 }
 
-void run_simulate(const SimulateOpts& o, int& exit_code) {
-  std::mt19937_64 rng(o.seed);
-  const SimDrive d = plan_drive(o, rng);
-  const SimOutcome r = simulate_drive(o, d, rng);
-  const calib::Factors truth = analysis::selfcal_truth();
-  const calib::Factors fin{r.final.c_l, r.final.c_r, r.final.wheelbase};
+// Scores: E_max,syst [m] of the nominal, self-calibrated and manually calibrated robot.
+struct Scores {
+  double e5[3];     // by the report's 5 + 5 squares
+  double e_sys[3];  // by score_runs + score_runs squares
+};
+
+// score: the three calibrations scored (NaN for the manual pass if its simulation failed).
+Scores score(const SimulateOpts& o, const calib::Factors& fin) {
   analysis::UmbmarkSimOptions uo;
   uo.noise = o.smooth ? analysis::UmbmarkNoise::kNone : analysis::UmbmarkNoise::kPaper;
   uo.seed = o.seed;
@@ -270,13 +294,56 @@ void run_simulate(const SimulateOpts& o, int& exit_code) {
       {1.0, 1.0, analysis::kSelfCalBn},
       fin,
       manual ? manual->passes[0].result.composed : calib::Factors{NAN, NAN, NAN}};
-  double e5[3], e_sys[3];
+  Scores sc;
   for (int i = 0; i < 3; ++i) {
     const bool ok = i < 2 || manual;
-    e5[i] = ok ? analysis::selfcal_e_max_syst(cal[i], !o.smooth) : NAN;
-    e_sys[i] = ok ? analysis::selfcal_e_max_syst(cal[i], !o.smooth, o.score_runs, 100000) : NAN;
+    sc.e5[i] = ok ? analysis::selfcal_e_max_syst(cal[i], !o.smooth) : NAN;
+    sc.e_sys[i] = ok ? analysis::selfcal_e_max_syst(cal[i], !o.smooth, o.score_runs, 100000) : NAN;
   }
+  return sc;
+}
+
+// write_plot: --plot, the convergence with E_max,syst (5 + 5 and score_runs + score_runs
+// squares: nominal, self-calibrated, one manual pass) as notes; false (said) when not written.
+bool write_plot(const SimulateOpts& o, const SimOutcome& r, const Scores& sc) {
+  const double *e5 = sc.e5, *e_sys = sc.e_sys;
+  std::ostringstream title, n5, nsys;
+  title << "odomctl selfcal simulate: " << o.excursions << " excursions, fixes sigma "
+        << o.sigma_xy * 1e3 << " mm / " << o.sigma_theta << " deg, " << o.outliers * 100
+        << " % corrupted, " << (o.smooth ? "smooth" : "rough") << " floor, seed " << o.seed;
+  n5 << std::setprecision(4) << "E_max,syst (5 + 5 squares): nominal " << e5[0] * 1e3
+     << " mm, self-calibrated " << e5[1] * 1e3 << " mm, one manual UMBmark pass " << e5[2] * 1e3
+     << " mm";
+  nsys << std::setprecision(4) << "E_max,syst (" << o.score_runs << " + " << o.score_runs
+       << " squares): nominal " << e_sys[0] * 1e3 << " mm, self-calibrated " << e_sys[1] * 1e3
+       << " mm, one manual UMBmark pass " << e_sys[2] * 1e3 << " mm";
+  std::ostringstream fits;
+  fits << r.history.size() << " fits, "
+       << std::count_if(r.history.begin(), r.history.end(),
+                        [](const analysis::SelfCalFitPoint& p) { return p.applied; })
+       << " applied";
+  const std::string svg = analysis::selfcal_svg(r.history, analysis::selfcal_truth(),
+                                                {fits.str(), n5.str(), nsys.str()}, title.str());
+  return write_output_file(o.plot, svg, "selfcal simulate");
+}
+
+void run_simulate(const SimulateOpts& o, int& exit_code) {
+  if (!output_paths_ok({o.plot}, "selfcal simulate")) {
+    exit_code = kExitBadInput;
+    return;
+  }
+  std::mt19937_64 rng(o.seed);
+  const SimDrive d = plan_drive(o, rng);
+  const SimOutcome r = simulate_drive(o, d, rng);
+  const calib::Factors truth = analysis::selfcal_truth();
+  const calib::Factors fin{r.final.c_l, r.final.c_r, r.final.wheelbase};
+  const Scores sc = score(o, fin);
+  const double *e5 = sc.e5, *e_sys = sc.e_sys;
   const double before = e5[0], after = e5[1], e_manual = e5[2];
+  if (!o.plot.empty() && !write_plot(o, r, sc)) {
+    exit_code = kExitFailed;
+    return;
+  }
   const fw::SelfCalCounters& c = r.counters;
   if (o.json) {
     nlohmann::json j{{"excursions", o.excursions},
@@ -284,6 +351,7 @@ void run_simulate(const SimulateOpts& o, int& exit_code) {
                      {"corrupted", r.corrupted},
                      {"rejected", c.fixes_rejected},
                      {"fits", c.fits},
+                     {"fit_errors", c.fit_errors},
                      {"applied", c.accepted},
                      {"c_l", fin.c_l},
                      {"c_r", fin.c_r},
@@ -351,6 +419,7 @@ void add_selfcal(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   c->add_option("--seed", o->seed, "random seed")->capture_default_str();
   c->add_flag("--json", o->json, "print one JSON object");
+  c->add_option("--plot", o->plot, "write an SVG of the estimate's convergence over the fits");
   c->callback([o, &exit_code] { run_simulate(*o, exit_code); });
 }
 

@@ -89,15 +89,6 @@ constexpr double kSize = 520.0, kMargin = 60.0, kFont = 11.0;
 constexpr const char* kCwColour = "#1f5fbf";
 constexpr const char* kCcwColour = "#c0392b";
 
-// tick_step: 1, 2 or 5 times a power of ten, giving 4 to 10 ticks over [-h, h].
-double tick_step(double h) {
-  const double raw = 2.0 * h / 8.0;
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * p >= raw) return m * p;
-  return 10.0 * p;
-}
-
 // marker: one run (with a tooltip `title`) or one legend sample (title empty) at (x, y) [px].
 void marker(std::ostringstream& s, double x, double y, int shape, const char* col,
             const std::string& title = {}) {
@@ -131,7 +122,7 @@ void marker(std::ostringstream& s, double x, double y, int shape, const char* co
 void axes(std::ostringstream& s, double h) {
   auto px = [&](double v) { return kMargin + kSize * (0.5 + 0.5 * v / h); };
   auto py = [&](double v) { return kMargin + kSize * (0.5 - 0.5 * v / h); };
-  const double step = tick_step(h);
+  const double step = tick_step(2.0 * h);
   const double first = std::ceil(-h / step) * step;
   s << std::setprecision(6);
   for (double v = first; v <= h + 1e-9 * step; v += step) {

@@ -2,6 +2,8 @@
 # The SVG plots (issue 20): ticks between the extremes on both axes, one legend line and one
 # marker shape per pass, and, rendered to PNG by rsvg-convert, no text or mark outside the
 # canvas. The rendering part is skipped (exit 77, after the other checks) without rsvg-convert.
+# The self-calibration's convergence plot (issue 18): one marker per fit and parameter, filled
+# for the applied ones, as many as --json counts; a bad --plot path refused before any work.
 set -u
 . "$(dirname "$0")/lib.sh"  # run, check, $tmp
 
@@ -11,6 +13,40 @@ run "$ODOMCTL" umbmark simulate --runs 2 --passes 1 --side 0.5 --plot "$tmp/u1.s
 check "simulate --side 0.5 --plot exit 0" $?
 run "$ODOMCTL" errormodel validate --runs 50 --plot "$tmp/e.svg" >/dev/null 2>&1
 check "errormodel validate --plot exit 0" $?
+run "$ODOMCTL" selfcal simulate --excursions 10 --min-fixes 3 --fit-every 1 --score-runs 5 \
+  --json --plot "$tmp/s.svg" >"$tmp/s.json" 2>"$tmp/s.err"
+check "selfcal simulate --plot exit 0" $?
+
+python3 - "$tmp/s.svg" "$tmp/s.json" <<'PY'
+import json, re, sys
+import xml.etree.ElementTree as ET
+s = open(sys.argv[1]).read()
+j = json.load(open(sys.argv[2]))
+root = ET.fromstring(s)  # well-formed XML
+assert root.tag == "{http://www.w3.org/2000/svg}svg", root.tag
+fits = j["fits"] - j["fit_errors"]
+assert fits >= 5, j  # --fit-every 1 from the 3rd of the 11 fixes: several fits
+for p in ("c_l", "c_r", "b"):
+    marks = [e for e in root.iter() if e.get("class") == "fit " + p]
+    assert len(marks) == fits, (p, len(marks), fits)
+    filled = [e for e in marks if e.get("fill") != "white"]
+    assert len(filled) == j["applied"], (p, len(filled), j["applied"])
+xt = re.findall(r'text-anchor="middle">(-?[0-9.e+-]+)</text>', s)
+yt = re.findall(r'text-anchor="end">(-?[0-9.e+-]+)</text>', s)
+assert len(xt) >= 4 and len(yt) >= 4, (xt, yt)
+for label in ("c_L", "c_R", "b (wheelbase)", "applied", "not applied", "[%]", "E_max,syst"):
+    assert label in s, label
+PY
+check "selfcal plot: valid SVG, one marker per fit and parameter, applied ones filled, ticks" $?
+
+# A bad --plot path: refused before the simulation (which at these sizes takes minutes), one
+# line on stderr naming the path, nothing on stdout, exit 2.
+timeout 20 ${CROSS_EMULATOR:-} "$ODOMCTL" selfcal simulate --excursions 1000 --score-runs 1000 \
+  --plot "$tmp/no/such/dir/s.svg" >"$tmp/bad.out" 2>"$tmp/bad.err"
+rc=$?
+[ $rc = 2 ] && [ ! -s "$tmp/bad.out" ] && [ "$(wc -l <"$tmp/bad.err")" = 1 ] &&
+  grep -q "^odomctl selfcal simulate: $tmp/no/such/dir/s.svg: cannot create" "$tmp/bad.err"
+check "selfcal simulate --plot bad path: exit 2 before any work, one line (rc $rc: $(cat "$tmp/bad.err"))" $?
 
 python3 - "$tmp/u3.svg" <<'PY'
 import re, sys
@@ -29,7 +65,7 @@ check "umbmark plot: ticks on both axes, every pass in the legend and with its o
 
 # Without a renderer: every unrotated text's extent, estimated at 0.55 em a character (DejaVu
 # Sans averages about 0.55 em; a renderer check follows below), lies inside the canvas.
-for f in u3 u1 e; do
+for f in u3 u1 e s; do
   python3 - "$tmp/$f.svg" <<'PY'
 import re, sys
 s = open(sys.argv[1]).read()
@@ -101,7 +137,7 @@ out = [(x, y) for y in range(H) for x in range(W)
 assert not out, "%d pixels outside the canvas, e.g. %s" % (len(out), out[:5])
 PY
 }
-for f in u3 u1 e; do
+for f in u3 u1 e s; do
   inside "$tmp/$f.svg"
   check "$f.svg: nothing drawn outside the canvas" $?
 done

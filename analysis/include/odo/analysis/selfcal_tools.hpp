@@ -2,6 +2,7 @@
 // recorded into segments by the loop's own recorder, and a CSV of absolute fixes.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <istream>
 #include <random>
@@ -59,5 +60,19 @@ sim::Scenario random_excursion(std::mt19937_64& rng, const Pose2& start);
 // runs (e.g. 200), which leaves the systematic error the report means.
 double selfcal_e_max_syst(const calib::Factors& f, bool rough, int runs = 5,
                           std::uint64_t floor_seed = 500);
+
+// SelfCalFitPoint: one completed fit of the estimator during `odomctl selfcal simulate`.
+struct SelfCalFitPoint {
+  int excursions = 0;             // excursions driven when the fit ran
+  calib::Factors estimate;        // c_L, c_R [-], b [m]
+  std::array<double, 3> sigma{};  // their standard deviations [-, -, m]
+  bool applied = false;           // accepted and posted to the loop
+};
+
+// selfcal_svg: the convergence plot: relative error [%] of c_L, c_R and b against `truth`
+// after each fit, with 1-sigma bars, filled markers for applied fits and open ones for the
+// rest; `notes` (e.g. E_max,syst before and after) as text lines under the plot.
+std::string selfcal_svg(const std::vector<SelfCalFitPoint>& fits, const calib::Factors& truth,
+                        const std::vector<std::string>& notes, const std::string& title);
 
 }  // namespace odo::analysis
