@@ -34,6 +34,10 @@ ODO_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 status=0
 summary=()
 n_pass=0 n_fail=0 n_skip=0  # over every ctest run, for the closing line
+failures=()  # "log: test (reason)" and a few lines of why, printed with the summary
+
+# CI keeps only the tail of this script's output, so a failed test must be named at the end too,
+# not only where ctest printed it an hour earlier.
 
 in_ci() { [[ ${CI:-} == true || ${CI:-} == 1 ]]; }
 
@@ -73,10 +77,21 @@ counted() {
     if [[ $skipped != 0 ]]; then  # name them: the reason is in each test's output above
       echo "skipped in $log:"; grep -E '\*\*\*Skipped' "$log" || true
     fi
+    if [[ $failed != 0 ]]; then note_failures "$log"; fi
   elif [[ $rc != 0 ]]; then
     n_fail=$((n_fail + 1))  # the run itself failed before any test reported
   fi
   return "$rc"
+}
+
+# note_failures LOG: adds each test ctest listed as failed in LOG to `failures`, with the first
+# lines of GoogleTest's "Failure" reports in LOG (at most 12, so the summary stays readable).
+note_failures() {
+  local log=$1 t
+  while IFS= read -r t; do failures+=("$log: ${t#"${t%%[![:space:]]*}"}"); done < <(
+    sed -n '/The following tests FAILED:/,$p' "$log" | grep -E '^[[:space:]]+[0-9]+ - ' || true)
+  while IFS= read -r t; do failures+=("    $t"); done < <(
+    grep -A3 -E ': Failure$|\*\*\*(Timeout|Exception)' "$log" | grep -v -e '^--$' -e '^[[:space:]]*$' | head -12 || true)
 }
 
 # gated STAGE LOG CMD...: `counted`, then the CI gate over what that run reported. Returns 0
@@ -207,6 +222,7 @@ main() {
   fi
   echo "=== summary ($(($(date +%s) - T_ALL)) s in all) ==="
   printf '%s\n' "${summary[@]}"
+  if ((${#failures[@]} > 0)); then echo "failed tests:"; printf '  %s\n' "${failures[@]}"; fi
   echo "all stages: $n_pass passed, $n_fail failed, $n_skip skipped"
   exit $status
 }
