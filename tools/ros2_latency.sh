@@ -9,8 +9,9 @@
 # A variant is a name, a colon and extra [ros2] lines ('\n' separates lines), e.g.
 #   --variant 'off:' --variant 'spin300:spin_us = 300'
 # and NAME@PATH runs the odometryd at PATH for that variant (A/B of two builds).
-# A name ending in "+pmqos" also holds /dev/cpu_dma_latency at 0 during the run (idle CPUs
-# poll instead of halting, as cyclictest does; needs root).
+# A name ending in "+pmqos" runs odometryd with [realtime] cpu_latency_us = 0: it holds
+# /dev/cpu_dma_latency at 0 while it runs (idle CPUs poll instead of halting, as under
+# cyclictest; needs root).
 # Columns: receiver n, p50, p99, max [ms]; the publisher's share (sample to the return of the
 # odom write, to 10 us); odom published / expected; odometryd CPU (user+sys,
 # /usr/bin/time) per published message [us]; the bridge's polls (spin_us): mean wait, how many
@@ -41,10 +42,9 @@ for f in "$bin" "$peer"; do
   [ -x "$f" ] || { echo "ros2_latency.sh: $f missing (cmake --build build/default --target odometryd ros2_fastdds_peer ros2_cyclone_peer)" >&2; exit 2; }
 done
 tmp=$(mktemp -d)
-peer_pid= qos_pid=
+peer_pid=
 cleanup() {
   [ -n "$peer_pid" ] && kill "$peer_pid" 2>/dev/null
-  [ -n "$qos_pid" ] && kill "$qos_pid" 2>/dev/null
   rm -rf "$tmp"
 }
 trap cleanup EXIT
@@ -60,7 +60,8 @@ for ((r = 1; r <= reps; r++)); do
   for v in "${variants[@]}"; do
     name=${v%%:*} extra=${v#*:} vbin=$bin
     if [[ $name == *@* ]]; then vbin=${name#*@} name=${name%%@*}; fi
-    run=$((run + 1))
+    run=$((run + 1)) qos=-1
+    if [[ $name == *+pmqos ]]; then qos=0; fi
     cat >"$tmp/lat.toml" <<TOML
 [loop]
 rate_hz = 1000
@@ -68,6 +69,7 @@ status_period = 0
 [realtime]
 priority = 80
 lock_memory = true
+cpu_latency_us = $qos
 [calibration]
 store = ""
 [can]
@@ -83,10 +85,6 @@ TOML
     printf '%b\n' "$extra" >>"$tmp/lat.toml"
     load=$(cut -d' ' -f1 /proc/loadavg)
     stat0=$(head -1 /proc/stat)
-    if [[ $name == *+pmqos ]]; then
-      python3 -c 'import os,struct,time; fd=os.open("/dev/cpu_dma_latency",os.O_WRONLY); os.write(fd,struct.pack("i",0)); time.sleep(1e6)' &
-      qos_pid=$!
-    fi
     chrt -f 10 "$peer" --domain "$domain" --odom 1 --idle 2 --quiet --skip 50 --timeout "$((secs + 30))" >"$tmp/peer.out" 2>&1 &
     peer_pid=$!
     /usr/bin/time -f '%U %S' -o "$tmp/time" "$vbin" --config "$tmp/lat.toml" --duration "$secs" --json --quiet >"$tmp/d.json" 2>"$tmp/d.err" || {
@@ -94,7 +92,6 @@ TOML
     wait "$peer_pid" || { echo "ros2_latency.sh: the peer failed:" >&2; cat "$tmp/peer.out" >&2; exit 1; }
     peer_pid=
     stat1=$(head -1 /proc/stat)
-    if [ -n "$qos_pid" ]; then kill "$qos_pid"; wait "$qos_pid" 2>/dev/null || true; qos_pid=; fi
     python3 - "$tmp/peer.out" "$tmp/d.json" "$tmp/time" "$run" "$name" "$load" "$secs" "$rate" "$stat0" "$stat1" <<'PY'
 import json, re, sys
 peer, dj, tm, run, name, load, secs, rate, st0, st1 = sys.argv[1:11]

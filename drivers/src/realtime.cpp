@@ -1,10 +1,15 @@
 #include "odo/drivers/realtime.hpp"
 
 #include <alloca.h>
+#include <fcntl.h>
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
 #include <sys/resource.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdint>
 
 #include <cerrno>
 #include <cstring>
@@ -144,6 +149,48 @@ RealtimeItem prefault(std::size_t bytes) {
   return it;
 }
 
+RealtimeItem hold_cpu_latency(int us) {
+  RealtimeItem it{"CPU wake-up latency (PM QoS)", RtOutcome::kOff, ""};
+  if (us < 0) {
+    it.detail = "off (cpu_latency_us = -1): idle CPUs may sleep as deep as the governor likes";
+    return it;
+  }
+  it.what = "CPU wake-up latency (PM QoS) " + std::to_string(us) + " us";
+  // The kernel keeps the request only while the file is open (Documentation/power/pm_qos_
+  // interface.rst), so the descriptor is held for the life of the process and never closed:
+  // the kernel drops the request when the process exits, however it exits.
+  static std::atomic<int> held{-1};
+  int fd = held.load();
+  if (fd < 0) {
+    fd = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+    if (fd < 0) {
+      const int e = errno;
+      it.outcome = (e == EACCES || e == EPERM) ? RtOutcome::kNotPermitted : RtOutcome::kFailed;
+      it.detail = "/dev/cpu_dma_latency: " + errno_text(e) +
+                  (it.outcome == RtOutcome::kNotPermitted
+                       ? " (needs write access: root, and DeviceAllow= under systemd's "
+                         "DevicePolicy=closed); idle CPUs keep their deep sleep states"
+                       : "");
+      return it;
+    }
+    int expected = -1;
+    // Another thread got there first: keep its descriptor (one request per process).
+    if (!held.compare_exchange_strong(expected, fd)) {
+      ::close(fd);
+      fd = expected;
+    }
+  }
+  // The binary form (a native-endian 32-bit integer): the text form needs a trailing parse.
+  const std::int32_t v = us;
+  if (::write(fd, &v, sizeof v) != static_cast<ssize_t>(sizeof v)) {
+    it.outcome = RtOutcome::kFailed;
+    it.detail = "/dev/cpu_dma_latency: write: " + errno_text(errno);
+    return it;
+  }
+  it.outcome = RtOutcome::kApplied;
+  return it;
+}
+
 }  // namespace
 
 int online_cpus() noexcept {
@@ -155,12 +202,13 @@ int online_cpus() noexcept {
 
 std::vector<RealtimeItem> apply_realtime(const RealtimeRequest& r) {
   std::vector<RealtimeItem> items;
-  items.reserve(4);
+  items.reserve(5);
   items.push_back(set_fifo(r.fifo_priority));
   // Lock before touching the stack so the touched pages stay resident.
   items.push_back(lock_memory(r.lock_memory));
   items.push_back(pin_cpu(r.cpu));
   items.push_back(prefault(r.prefault_stack));
+  items.push_back(hold_cpu_latency(r.cpu_latency_us));
   return items;
 }
 

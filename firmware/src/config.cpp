@@ -70,6 +70,7 @@ void read_realtime(TableReader t, RealtimeSection& s) {
   s.lock_memory = t.boolean("lock_memory", s.lock_memory);
   s.cpu = static_cast<int>(t.integer("cpu", s.cpu, -1, 1023));
   s.prefault_stack = static_cast<int>(t.integer("prefault_stack", s.prefault_stack, 0, 4194304));
+  s.cpu_latency_us = static_cast<int>(t.integer("cpu_latency_us", s.cpu_latency_us, -1, 1000000));
   s.required = t.boolean("required", s.required);
   t.finish();
 }

@@ -18,6 +18,7 @@ bool setup_realtime(const RealtimeSection& cfg, bool virtual_time, std::ostream&
   r.lock_memory = cfg.lock_memory;
   r.cpu = cfg.cpu;
   r.prefault_stack = static_cast<std::size_t>(cfg.prefault_stack);
+  r.cpu_latency_us = cfg.cpu_latency_us;
   bool ok = true;
   for (const drivers::RealtimeItem& it : drivers::apply_realtime(r))
     ok = report_realtime("realtime", it, cfg.required, log, err) && ok;

@@ -9,7 +9,7 @@ chmod 755 "$tmp"  # the unprivileged runs below must reach it
 # Each part is reported at start; --stats prints the timing table at exit.
 run "$ODOMETRYD" --duration 0.3 --quiet --stats >"$tmp/out" 2>"$tmp/err"
 check "plain run exit 0 (got $?)" $?
-for part in "SCHED_FIFO" "mlockall" "CPU affinity" "stack pre-fault"; do
+for part in "SCHED_FIFO" "mlockall" "CPU affinity" "stack pre-fault" "CPU wake-up latency"; do
   grep -q "odometryd: realtime: $part" "$tmp/out"; check "part '$part' reported" $?
 done
 grep -Eq "wake-up latency +[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+" "$tmp/out"
@@ -27,7 +27,7 @@ fi
 # The unprivileged user must reach the binary: the build tree may sit below a directory only
 # root can enter (a clone in /root, as on a fresh CI machine), so it runs a copy from $tmp.
 cp "$ODOMETRYD" "$tmp/odometryd" && chmod 755 "$tmp/odometryd"
-printf '[realtime]\npriority = 50\nlock_memory = true\n' >"$tmp/rt.toml"
+printf '[realtime]\npriority = 50\nlock_memory = true\ncpu_latency_us = 0\n' >"$tmp/rt.toml"
 printf '[realtime]\npriority = 50\nlock_memory = true\nrequired = true\n' >"$tmp/rtreq.toml"
 chmod 644 "$tmp"/*.toml
 "${unpriv[@]}" ${CROSS_EMULATOR:-} "$tmp/odometryd" --config "$tmp/rt.toml" --duration 0.3 --quiet \
@@ -38,6 +38,9 @@ check "unprivileged: SCHED_FIFO not permitted, said clearly" $?
 grep -Eq "mlockall: NOT APPLIED: (not permitted.*CAP_IPC_LOCK|.*(Address|Thread)Sanitizer).*; continuing" \
   "$tmp/out"
 check "unprivileged: mlockall not permitted, said clearly" $?
+grep -q "CPU wake-up latency (PM QoS) 0 us: NOT APPLIED: /dev/cpu_dma_latency: EACCES.*; continuing" \
+  "$tmp/out"
+check "unprivileged: the PM QoS request not permitted, said clearly" $?
 grep -q "odometryd: stopped after" "$tmp/out"; check "unprivileged: the loop ran" $?
 "${unpriv[@]}" ${CROSS_EMULATOR:-} "$tmp/odometryd" --config "$tmp/rtreq.toml" --duration 0.3 --quiet \
   >"$tmp/out" 2>"$tmp/err"

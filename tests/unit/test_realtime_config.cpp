@@ -11,9 +11,10 @@ TEST(RealtimeConfig, DefaultsAndValues) {
   EXPECT_TRUE(d.realtime.lock_memory);
   EXPECT_EQ(d.realtime.cpu, -1);
   EXPECT_FALSE(d.realtime.required);
+  EXPECT_EQ(d.realtime.cpu_latency_us, -1);  // off: holding it costs power
   auto c = parse_config(
       "[realtime]\npriority = 0\nlock_memory = false\ncpu = 1\nprefault_stack = 0\n"
-      "required = true\n",
+      "required = true\ncpu_latency_us = 0\n",
       "rt.toml");
   ASSERT_TRUE(c.ok()) << c.error().message;
   EXPECT_EQ(c->realtime.priority, 0);
@@ -21,6 +22,7 @@ TEST(RealtimeConfig, DefaultsAndValues) {
   EXPECT_EQ(c->realtime.cpu, 1);
   EXPECT_EQ(c->realtime.prefault_stack, 0);
   EXPECT_TRUE(c->realtime.required);
+  EXPECT_EQ(c->realtime.cpu_latency_us, 0);
 }
 
 TEST(RealtimeConfig, OutOfRangeAndUnknownKeysNameFileLineAndField) {
@@ -29,6 +31,11 @@ TEST(RealtimeConfig, OutOfRangeAndUnknownKeysNameFileLineAndField) {
   EXPECT_NE(c.error().message.find("rt.toml:4"), std::string::npos) << c.error().message;
   EXPECT_NE(c.error().message.find("priority"), std::string::npos) << c.error().message;
   EXPECT_NE(c.error().message.find("99"), std::string::npos) << c.error().message;
+  auto l = parse_config("[realtime]\ncpu_latency_us = -2\n", "rt.toml");
+  ASSERT_FALSE(l.ok());
+  EXPECT_NE(l.error().message.find("rt.toml:2"), std::string::npos) << l.error().message;
+  EXPECT_NE(l.error().message.find("cpu_latency_us"), std::string::npos) << l.error().message;
+  EXPECT_NE(l.error().message.find("1000000"), std::string::npos) << l.error().message;
   auto u = parse_config("[realtime]\nprio = 10\n", "rt.toml");
   ASSERT_FALSE(u.ok());
   EXPECT_NE(u.error().message.find("prio"), std::string::npos) << u.error().message;

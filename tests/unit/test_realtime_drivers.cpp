@@ -10,6 +10,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <thread>
@@ -25,7 +27,7 @@ using drivers::RtOutcome;
 
 TEST(Realtime, NothingRequestedIsReportedOff) {
   const auto items = drivers::apply_realtime({});
-  ASSERT_EQ(items.size(), 4u);
+  ASSERT_EQ(items.size(), 5u);
   for (const auto& it : items) {
     EXPECT_EQ(it.outcome, RtOutcome::kOff) << it.what;
     EXPECT_NE(it.detail.find("off"), std::string::npos) << it.detail;
@@ -46,6 +48,36 @@ TEST(Realtime, MissingCpuFailsWithTheReasonAndStackIsTouched) {
   // 1 << 40 was undefined and became 0, "off"): refused, no crash.
   huge.prefault_stack = std::numeric_limits<std::size_t>::max() / 2;
   EXPECT_EQ(drivers::apply_realtime(huge)[3].outcome, RtOutcome::kFailed);
+}
+
+// read_cpu_latency: the kernel's current PM QoS CPU latency target [us] (the smallest request
+// held by any process), or -1 when the device cannot be read.
+int read_cpu_latency() {
+  FILE* f = std::fopen("/dev/cpu_dma_latency", "rb");
+  if (f == nullptr) return -1;
+  std::int32_t v = -1;
+  const bool ok = std::fread(&v, sizeof v, 1, f) == 1;
+  std::fclose(f);
+  return ok ? v : -1;
+}
+
+TEST(Realtime, CpuLatencyRequestIsHeldOrReportedNotPermitted) {
+  drivers::RealtimeRequest r;
+  r.cpu_latency_us = 0;
+  const drivers::RealtimeItem item = drivers::apply_realtime(r)[4];
+  EXPECT_NE(item.what.find("PM QoS) 0 us"), std::string::npos) << item.what;
+  if (item.outcome == RtOutcome::kApplied) {
+    // Held after apply_realtime returned: the descriptor stays open for the process, and no
+    // request can be below 0, so the kernel's target is exactly 0 now.
+    EXPECT_EQ(read_cpu_latency(), 0);
+    // A second request from this process replaces the first (one descriptor per process).
+    r.cpu_latency_us = 0;
+    EXPECT_EQ(drivers::apply_realtime(r)[4].outcome, RtOutcome::kApplied);
+  } else {
+    // Not root, or a kernel without PM QoS: said with the device's name, and the reason.
+    EXPECT_NE(item.detail.find("/dev/cpu_dma_latency"), std::string::npos) << item.detail;
+    EXPECT_NE(item.outcome, RtOutcome::kOff);
+  }
 }
 
 TEST(Realtime, FifoIsAppliedOrReportedNotPermitted) {

@@ -220,6 +220,7 @@ struct RealtimeSection {
   bool lock_memory = true;      // mlockall(MCL_CURRENT | MCL_FUTURE)
   int cpu = -1;                 // pin the loop thread to this CPU; -1 = no pinning
   int prefault_stack = 262144;  // bytes of loop stack touched before the first tick, 0..4 MiB
+  int cpu_latency_us = -1;      // [us] PM QoS CPU wake-up latency held while running; -1 = off
   bool required = false;        // true: refuse to start when a requested part cannot be applied
 };
 
