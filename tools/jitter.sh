@@ -58,23 +58,12 @@ cpu = $cpu
 TOML
 domain=$((100 + $$ % 120))
 if [ -n "$peer" ]; then
-  cat >>"$tmp/jitter.toml" <<TOML
-[can]
-bus = "none"
-[ros2]
-enabled = true
-domain_id = $domain
-rate_hz = $ros2_rate
-interfaces = ["lo"]
-multicast = false
-peers = ["127.0.0.1"]
-spin_us = $ros2_spin
-TOML
+  . tools/ros2_loopback.sh  # ros2_loopback_toml, CYCLONEDDS_URI
+  { ros2_loopback_toml "$domain" "$ros2_rate"; echo "spin_us = $ros2_spin"; } >>"$tmp/jitter.toml"
 fi
 # start_peer: the DDS receiver beside the loop (--ros2), until odometryd stopped publishing.
 start_peer() {
-  CYCLONEDDS_URI='<CycloneDDS><Domain Id="any"><General><Interfaces><NetworkInterface name="lo"/></Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex><Peers><Peer address="127.0.0.1"/></Peers></Discovery></Domain></CycloneDDS>' \
-    "$peer" --domain "$domain" --odom 1 --idle 2 --quiet --skip 100 --timeout "$((secs + 30))" >"$tmp/peer.out" 2>&1 &
+  "$peer" --domain "$domain" --odom 1 --idle 2 --quiet --skip 100 --timeout "$((secs + 30))" >"$tmp/peer.out" 2>&1 &
   peer_pid=$!
 }
 

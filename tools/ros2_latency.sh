@@ -48,7 +48,7 @@ cleanup() {
   rm -rf "$tmp"
 }
 trap cleanup EXIT
-export CYCLONEDDS_URI='<CycloneDDS><Domain Id="any"><General><Interfaces><NetworkInterface name="lo"/></Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex><Peers><Peer address="127.0.0.1"/></Peers></Discovery></Domain></CycloneDDS>'
+. tools/ros2_loopback.sh  # ros2_loopback_toml, CYCLONEDDS_URI
 domain=$((100 + $$ % 120))
 
 echo "ros2_latency: $secs s per run, $reps reps, [ros2] rate_hz = $rate, receiver $(basename "$peer") at SCHED_FIFO 10"
@@ -72,16 +72,8 @@ lock_memory = true
 cpu_latency_us = $qos
 [calibration]
 store = ""
-[can]
-bus = "none"
-[ros2]
-enabled = true
-domain_id = $domain
-rate_hz = $rate
-interfaces = ["lo"]
-multicast = false
-peers = ["127.0.0.1"]
 TOML
+    ros2_loopback_toml "$domain" "$rate" >>"$tmp/lat.toml"
     printf '%b\n' "$extra" >>"$tmp/lat.toml"
     load=$(cut -d' ' -f1 /proc/loadavg)
     stat0=$(head -1 /proc/stat)
