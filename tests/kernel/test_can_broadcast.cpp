@@ -69,9 +69,14 @@ TEST(CanBroadcastVcan, CandumpDecodesTheDaemonsPoseSetPoseAndLinkDownUp) {
   std::this_thread::sleep_for(1500ms);
   EXPECT_EQ(run("cansend " + ifc + " 418#10270078ECFF1027"), 0);
   std::this_thread::sleep_for(1000ms);
+  // The outage as this test made it: from before `ip link set down` runs to after `ip link set
+  // up` returned (0.5 s plus two process start-ups, which a starved emulated VM stretches).
+  const auto down_begin = std::chrono::steady_clock::now();
   EXPECT_EQ(run("ip link set " + ifc + " down"), 0);
   std::this_thread::sleep_for(500ms);
   EXPECT_EQ(run("ip link set " + ifc + " up"), 0);
+  const double outage =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - down_begin).count();
   // candump (can-utils 2020.11) exits when its interface goes down ("read: Network is down"):
   // a second one appends to the capture from here on.
   const pid_t dump2 = spawn("exec candump -L " + ifc + " >> " + dir + "/capture.log");
@@ -123,6 +128,13 @@ TEST(CanBroadcastVcan, CandumpDecodesTheDaemonsPoseSetPoseAndLinkDownUp) {
   // missing in the capture (a gap of about 0.5 s), and frames again after the link came back.
   const auto drops = j["can"]["dropped_link_down"].get<std::uint64_t>();
   EXPECT_GT(drops, 20u);
+  // The daemon stopped dropping as soon as the link was up: its drops, at the 171 frames/s of
+  // the default rates (50 + 50 + 50 + 10 + 10 + 1), cover no more than the outage the test
+  // made, plus 0.25 s for the kernel's link-state change to reach the send path. Counted in
+  // the daemon's own frames, so a slow start of the second candump below does not enter it.
+  std::printf("outage made by the test %.3f s; dropped %llu frames = %.3f s at 171/s\n", outage,
+              static_cast<unsigned long long>(drops), static_cast<double>(drops) / 171.0);
+  EXPECT_LT(static_cast<double>(drops) / 171.0, outage + 0.25);
   EXPECT_GT(d["pose_groups"]["lost"].get<int>(), 10);
   double gap = 0.0, gap_end = 0.0;
   for (std::size_t i = 1; i < rows.size(); ++i) {
@@ -131,8 +143,11 @@ TEST(CanBroadcastVcan, CandumpDecodesTheDaemonsPoseSetPoseAndLinkDownUp) {
       gap_end = rows[i].t;
     }
   }
+  // The capture's gap also holds the start of the second candump (it exits with the link and
+  // is restarted after `ip link set up`): bounded by the outage plus that start, so only its
+  // lower end says something about the daemon. The upper end is the drop count's, above.
   EXPECT_GT(gap, 0.3);
-  EXPECT_LT(gap, 1.5);
+  std::printf("largest gap in the capture %.3f s\n", gap);
   EXPECT_GT(rows.back().t - gap_end, 1.0) << "broadcasting did not resume for long";
   // The loop kept its rate: 5 s at 100 Hz, every period ticked or counted as missed. Under the
   // VM's emulated CPU some periods are missed anyway (start-up, the emulator); a send that
