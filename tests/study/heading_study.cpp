@@ -141,7 +141,6 @@ class Study final : public loop::TickObserver {
       const double vo = g_q_blend * (std::fabs(dl) + std::fabs(dr));
       const bool flagged = (s.gyro.fusion_flags & kFusionGyroUsed) != 0;
       const double w = flagged || !ok ? 0.0 : vo / (vo + vg);
-      const double sc = 1.0 + g->model().scale_error;
       const double u[4] = {oracle, learnt / sc, learnt, oracle};
       // blendA*: the oracle gyro with odometry's noise estimated online: 1 s windows of straight
       // travel without a flagged tick; q_hat = max(0, sum (D^2 - N^2 T) / sum |d|) (starts at 0:
