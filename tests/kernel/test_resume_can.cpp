@@ -511,6 +511,8 @@ TEST(ResumeCanVcan, UnderSystemdAfterSigkillAndWatchdogRestartsResume) {
         << "[robot]\nwheel_diameter = " << kDiameter << "\ncounts_per_rev = " << kCountsPerRev
         << "\ngear_ratio = 1\nwheelbase = " << kWheelbase << "\n"
         << "[calibration]\nstore = \"\"\n[realtime]\npriority = 0\nlock_memory = false\n"
+        // The PM QoS request through the unit's DevicePolicy=closed (its DeviceAllow= line).
+        << "cpu_latency_us = 0\n"
         << "[encoder]\nbackend = \"can\"\n[can_encoder]\nbus = \"socketcan\"\ninterface = \"" << ifc
         << "\"\n"
         // A watchdog restart takes WatchdogSec (2 s) + the abort timeout (5 s) + RestartSec (1 s).
@@ -542,6 +544,7 @@ TEST(ResumeCanVcan, UnderSystemdAfterSigkillAndWatchdogRestartsResume) {
   const double first_start =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_EQ(count_of(log, "resume: fresh start (no-record)"), 1) << slurp(log);
+  EXPECT_EQ(count_of(log, "realtime: CPU wake-up latency (PM QoS) 0 us: applied"), 1) << slurp(log);
   kill(feeder, SIGUSR1);  // the robot starts moving
   const Kinematics k = [] {
     KinematicParams p;
