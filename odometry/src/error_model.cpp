@@ -167,13 +167,24 @@ Status check_error_model(const ErrorModelParams& k) {
   return Ok{};
 }
 
-ArcTerms arc_terms(double phi) noexcept {
-  const double z = phi * phi;
+namespace {
+
+// wide_basic_functions: the tiers beyond the shortest series (|phi| >= kShortestSeriesLimit, a
+// turn faster than 15 rad/s at 1 kHz): out of line, so that the ordinary tick's inlined
+// arc_terms stays small.
+[[gnu::noinline]] BasicFunctions wide_basic_functions(double phi, double z) noexcept {
   const double abs_phi = std::fabs(phi);
-  const BasicFunctions f = abs_phi < kShortestSeriesLimit ? series<kShortestTerms>(z)
-                           : abs_phi < kShortSeriesLimit  ? series<kShortTerms>(z)
-                           : abs_phi < kSeriesLimit       ? series<0>(z)
-                                                          : closed_form(phi);
+  return abs_phi < kShortSeriesLimit ? series<kShortTerms>(z)
+         : abs_phi < kSeriesLimit    ? series<0>(z)
+                                     : closed_form(phi);
+}
+
+// arc_terms_inline: arc_terms() inlined into its callers on the tick's path (a call returns
+// the fourteen terms through memory; inline they stay in registers). The same expressions.
+[[gnu::always_inline]] inline ArcTerms arc_terms_inline(double phi) noexcept {
+  const double z = phi * phi;
+  const BasicFunctions f = std::fabs(phi) < kShortestSeriesLimit ? series<kShortestTerms>(z)
+                                                                 : wide_basic_functions(phi, z);
   const double sinc = f.sinc, h = f.h;
   ArcTerms t;
   t.i_c = sinc;
@@ -191,6 +202,12 @@ ArcTerms arc_terms(double phi) noexcept {
   t.j_sy = 0.5 * t.i_s * t.i_s;
   t.j_sx = t.i_c * t.i_s - t.j_cy;
   return t;
+}
+
+}  // namespace
+
+ArcTerms arc_terms(double phi) noexcept {
+  return arc_terms_inline(phi);
 }
 
 namespace {
@@ -265,7 +282,7 @@ void propagate_arc(Cov3& cov, double sin_theta0, double cos_theta0, double d_lef
         std::isfinite(sin_theta0) && std::isfinite(cos_theta0))) {
     return;
   }
-  const ArcTerms t = arc_terms((d_right - d_left) / b);
+  const ArcTerms t = arc_terms_inline((d_right - d_left) / b);
   const Mat3 q = local_input_covariance(d_left, d_right, b, k, t);
   // Displacement of the arc: D (I_c, I_s) in the start frame.
   const double d = 0.5 * (d_left + d_right);
