@@ -128,6 +128,12 @@ inline double SimGyro::sample(double true_rate, bool& saturated) noexcept {
 }
 
 GyroSample SimGyro::read(TimeNs now) noexcept {
+  GyroSample s;
+  read_into(now, s);
+  return s;
+}
+
+void SimGyro::read_into(TimeNs now, GyroSample& s) noexcept {
   // The encoder's read of the same tick has usually moved the robot to `now` already.
   if (robot_.time() < now) robot_.advance_to(now);
   hist_head_ = (hist_head_ + 1) & (kHistory - 1);
@@ -137,7 +143,9 @@ GyroSample SimGyro::read(TimeNs now) noexcept {
     silent_until_ = now + silence_;
     silence_ = 0;
   }
-  GyroSample s;
+  // Every field of s is written below (close() sets rate_z, stamp and counters).
+  s.samples = 0;
+  s.flags = kGyroOk;
   double sum = 0.0;
   // Every sample whose motion ended at next_t_ is available delay_ later.
   while (next_t_ + delay_ <= now) {
@@ -175,7 +183,6 @@ GyroSample SimGyro::read(TimeNs now) noexcept {
     ++injected_.nan_reads;
     s.rate_z = std::numeric_limits<double>::quiet_NaN();
   }
-  return s;
 }
 
 }  // namespace odo::sim

@@ -63,6 +63,8 @@ class SimGyro final : public YawRateSource {
   // read: advances the robot to `now` and returns the mean of the samples that became
   // available since the previous read.
   GyroSample read(TimeNs now) noexcept override;
+  // read_into: read() written into `out` in place.
+  void read_into(TimeNs now, GyroSample& out) noexcept override;
   double full_scale() const noexcept override { return m_.full_scale; }
 
   // arm_silence: the device delivers no samples for `duration` [ns] from the next read on.
