@@ -188,7 +188,7 @@ void OdometryLoop::take_reference(const EncoderSample& s) noexcept {
 void OdometryLoop::integrate_fused(std::int64_t dl, std::int64_t dr, double dt,
                                    TimeNs stamp) noexcept {
   FusionInput& in = fused_in_;
-  in.gyro = gyro_->read(stamp);
+  gyro_->read_into(stamp, in.gyro);
   const Kinematics& k = odom_.kinematics();
   in.dt = dt;
   in.d_left = static_cast<double>(dl) * k.metres_per_count_left();

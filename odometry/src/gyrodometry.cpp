@@ -1,6 +1,7 @@
 #include "odo/odometry/gyrodometry.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <sstream>
 
@@ -86,7 +87,9 @@ Gyrodometry::Gyrodometry(const GyrodometryParams& p) : p_(p) {
   g_ = std::max(0.0, static_cast<double>(m_) - ticks);
   // The window, the two ticks beyond its old edge (J_old there), and odometry m ticks back.
   size_ = std::max(n_ + 2, m_ + 1);
-  ring_.assign(size_, Entry{});
+  // Capacity a power of two, so that an age's index is a subtraction and a mask.
+  mask_ = std::bit_ceil(size_) - 1;
+  ring_.assign(mask_ + 1, Entry{});
   const double t_w = static_cast<double>(n_) * p.tick;
   noise_term_ = p.k_sigma * p.noise.rate_noise_density * std::sqrt(t_w);
   gyro_var_ = p.noise.rate_noise_density * p.noise.rate_noise_density * t_w;
@@ -111,6 +114,7 @@ void Gyrodometry::update_b_res() noexcept {
 void Gyrodometry::reset() noexcept {
   std::fill(ring_.begin(), ring_.end(), Entry{});
   head_ = 0;
+  pass_ = 0;
   filled_ = 0;
   resum();
   in_interval_ = false;
@@ -194,7 +198,7 @@ inline void Gyrodometry::align(Entry& e) noexcept {
 [[gnu::always_inline]] inline Gyrodometry::Entry& Gyrodometry::push(const FusionInput& in,
                                                                     double odo, bool usable,
                                                                     double dt) noexcept {
-  head_ = head_ + 1 == size_ ? 0 : head_ + 1;
+  head_ = (head_ + 1) & mask_;
   if (filled_ < size_) ++filled_;
   // Written in place (not built and copied: 80 bytes a tick); align() sets the comparison fields.
   Entry& e = ring_[head_];
@@ -227,7 +231,8 @@ inline void Gyrodometry::align(Entry& e) noexcept {
   }
   // Re-sum every kResumWraps passes of the ring: the running sums' rounding stays far below a
   // count (1e-16 relative per addition, a few thousand additions), at 1/16 of the cost.
-  if (head_ == 0 && ++wraps_ % kResumWraps == 0) resum();
+  pass_ = pass_ + 1 == size_ ? 0 : pass_ + 1;
+  if (pass_ == 0 && ++wraps_ % kResumWraps == 0) resum();
   return e;
 }
 

@@ -93,23 +93,28 @@ SimGyro::SimGyro(SimRobot& robot, const GyroModel& m, std::uint64_t seed, TimeNs
 }
 
 // heading_at and sample run for every sample and are called from read() only: inline.
-inline double SimGyro::heading_at(TimeNs t) const noexcept {
-  // Newest first: the wanted time is almost always between the last two reads.
-  const Past* newer = &hist_[hist_head_];
-  for (std::size_t i = 1; i < hist_n_; ++i) {
-    const Past& older = hist_[(hist_head_ - i) & (kHistory - 1)];
+inline double SimGyro::heading_at(TimeNs t) noexcept {
+  // The newest read at or before t (age i >= 1; ages count back from the newest read, 0). Reads
+  // and samples keep their pace, so it is nearly always at the age found for the previous sample:
+  // the search starts there when no newer age can qualify (read times never decrease with
+  // recency, so age i - 1 after t rules out every newer one), else at age 1.
+  std::size_t i = hint_age_;
+  if (!(i < hist_n_ && (i == 1 || past(i - 1).t > t))) i = 1;
+  for (; i < hist_n_; ++i) {
+    const Past& older = past(i);
     if (older.t <= t) {
+      hint_age_ = i;
       // A sample at a read's time (the reads and samples on one clock): no interpolation (the
       // interpolation would add 0 * (newer - older) to it).
       if (older.t == t) return older.theta;
-      const double span = static_cast<double>(newer->t - older.t);
-      if (span <= 0.0) return newer->theta;
+      const Past& newer = past(i - 1);
+      const double span = static_cast<double>(newer.t - older.t);
+      if (span <= 0.0) return newer.theta;
       const double f = static_cast<double>(t - older.t) / span;
-      return older.theta + f * (newer->theta - older.theta);
+      return older.theta + f * (newer.theta - older.theta);
     }
-    newer = &older;
   }
-  return newer->theta;  // older than the history: the oldest known heading
+  return past(hist_n_ - 1).theta;  // older than the history: the oldest known heading
 }
 
 inline double SimGyro::sample(double true_rate, bool& saturated) noexcept {
@@ -128,6 +133,12 @@ inline double SimGyro::sample(double true_rate, bool& saturated) noexcept {
 }
 
 GyroSample SimGyro::read(TimeNs now) noexcept {
+  GyroSample s;
+  read_into(now, s);
+  return s;
+}
+
+void SimGyro::read_into(TimeNs now, GyroSample& s) noexcept {
   // The encoder's read of the same tick has usually moved the robot to `now` already.
   if (robot_.time() < now) robot_.advance_to(now);
   hist_head_ = (hist_head_ + 1) & (kHistory - 1);
@@ -137,7 +148,9 @@ GyroSample SimGyro::read(TimeNs now) noexcept {
     silent_until_ = now + silence_;
     silence_ = 0;
   }
-  GyroSample s;
+  // Every field of s is written below (close() sets rate_z, stamp and counters).
+  s.samples = 0;
+  s.flags = kGyroOk;
   double sum = 0.0;
   // Every sample whose motion ended at next_t_ is available delay_ later.
   while (next_t_ + delay_ <= now) {
@@ -175,7 +188,6 @@ GyroSample SimGyro::read(TimeNs now) noexcept {
     ++injected_.nan_reads;
     s.rate_z = std::numeric_limits<double>::quiet_NaN();
   }
-  return s;
 }
 
 }  // namespace odo::sim

@@ -68,6 +68,9 @@ class YawRateSource {
   virtual ~YawRateSource() = default;
   // read: everything the device delivered up to `now` [ns]; never blocks.
   virtual GyroSample read(TimeNs now) noexcept = 0;
+  // read_into: the same, written into `out` (the loop reads into its fusion input, which a
+  // returned sample would reach by a 64-byte copy); sources that can fill it in place override.
+  virtual void read_into(TimeNs now, GyroSample& out) noexcept { out = read(now); }
   // full_scale: the measuring range, |rate| [rad/s] at which samples saturate.
   virtual double full_scale() const noexcept = 0;
 };

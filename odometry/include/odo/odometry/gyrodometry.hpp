@@ -246,18 +246,19 @@ class Gyrodometry {
   // continue_interval: a further flagged tick replaces odometry's increment of m ticks ago by the
   // gyro's aligned one (err [rad]).
   void continue_interval(double odo, double err, double dt, FusedTick& out) noexcept;
-  // index: ring index of an age (0: the newest); age < ring size: one conditional wrap.
-  std::size_t index(std::size_t age) const noexcept {
-    return head_ >= age ? head_ - age : head_ + size_ - age;
-  }
+  // index: ring index of an age (0: the newest); age < size_ <= the ring's power-of-two
+  // capacity, so a mask wraps it.
+  std::size_t index(std::size_t age) const noexcept { return (head_ - age) & mask_; }
   Entry& at(std::size_t age) noexcept { return ring_[index(age)]; }
   const Entry& at(std::size_t age) const noexcept { return ring_[index(age)]; }
 
   GyrodometryParams p_;
   std::vector<Entry> ring_;
-  std::size_t size_ = 0;                   // ring_.size(), kept (a division by sizeof(Entry))
+  std::size_t size_ = 0;                   // ages the fusion reads (0 .. size_ - 1)
+  std::size_t mask_ = 0;                   // ring_.size() - 1 (the size a power of two >= size_)
   std::size_t head_ = 0;                   // index of the newest entry
-  std::size_t filled_ = 0;                 // entries in use (<= ring size)
+  std::size_t pass_ = 0;                   // pushes modulo size_ (the re-sum's schedule)
+  std::size_t filled_ = 0;                 // entries in use (<= size_)
   std::size_t n_ = 2;                      // ticks in the window
   std::size_t half_ = 1;                   // ticks in each half of the window (accelerations)
   std::size_t m_ = 0;                      // odometry's lag behind the newest gyro tick [ticks]
@@ -271,7 +272,7 @@ class Gyrodometry {
   double base_threshold_ = 0.0;  // q + k_sigma N sqrt(T_w) + B_res T_w [rad]: a lower bound of T
   double v_max_tick_ = 0.0;      // max_wheel_speed * tick [m]
   double dv_max_ = 0.0;          // max_wheel_accel * T_h^2 [m]
-  std::uint32_t wraps_ = 0;      // passes of the ring (for the periodic re-sum)
+  std::uint32_t wraps_ = 0;      // times pass_ wrapped (for the periodic re-sum)
   // Running sums over the window (re-summed from the ring every time it wraps).
   double sum_err_ = 0.0;                      // sum err of entries with err_ok
   double sum_odo_ = 0.0;                      // sum odo_cmp

@@ -63,6 +63,8 @@ class SimGyro final : public YawRateSource {
   // read: advances the robot to `now` and returns the mean of the samples that became
   // available since the previous read.
   GyroSample read(TimeNs now) noexcept override;
+  // read_into: read() written into `out` in place.
+  void read_into(TimeNs now, GyroSample& out) noexcept override;
   double full_scale() const noexcept override { return m_.full_scale; }
 
   // arm_silence: the device delivers no samples for `duration` [ns] from the next read on.
@@ -81,7 +83,7 @@ class SimGyro final : public YawRateSource {
  private:
   SimGyro(SimRobot& robot, const GyroModel& m, std::uint64_t seed, TimeNs stale_timeout);
   // heading_at: the true heading at time t [ns], interpolated in the history of reads.
-  double heading_at(TimeNs t) const noexcept;
+  double heading_at(TimeNs t) noexcept;
   // sample: one output word for the true rate [rad/s]; sets `saturated`.
   double sample(double true_rate, bool& saturated) noexcept;
 
@@ -113,6 +115,11 @@ class SimGyro final : public YawRateSource {
   double walk_ = 0.0;        // bias random walk so far [rad/s]
   std::array<Past, kHistory> hist_{};
   std::size_t hist_head_ = 0, hist_n_ = 0;
+  std::size_t hint_age_ = 1;  // age of the read heading_at found last
+  // past: the read of an age (0: the newest), age < kHistory.
+  const Past& past(std::size_t age) const noexcept {
+    return hist_[(hist_head_ - age) & (kHistory - 1)];
+  }
   GyroReadBook book_;
   TimeNs silence_ = 0, silent_until_ = -1;
   int saturate_left_ = 0, nan_left_ = 0;

@@ -66,6 +66,10 @@ class EpochGyro final : public YawRateSource {
     s.stamp += epoch_;
     return s;
   }
+  void read_into(TimeNs now, GyroSample& out) noexcept override {
+    inner_.read_into(now - epoch_, out);
+    out.stamp += epoch_;
+  }
   double full_scale() const noexcept override { return inner_.full_scale(); }
 
  private:
