@@ -34,10 +34,10 @@ ODO_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 status=0
 summary=()
 n_pass=0 n_fail=0 n_skip=0  # over every ctest run, for the closing line
-failures=()  # "log: test (reason)" and a few lines of why, printed with the summary
-
-# CI keeps only the tail of this script's output, so a failed test must be named at the end too,
-# not only where ctest printed it an hour earlier.
+# "log: test (reason)" and a few lines of why, printed with the summary: CI keeps only the tail
+# of this script's output, so a failed test must be named at the end too, not only where ctest
+# printed it an hour earlier.
+failures=()
 
 in_ci() { [[ ${CI:-} == true || ${CI:-} == 1 ]]; }
 

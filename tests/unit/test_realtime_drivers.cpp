@@ -71,7 +71,6 @@ TEST(Realtime, CpuLatencyRequestIsHeldOrReportedNotPermitted) {
     // request can be below 0, so the kernel's target is exactly 0 now.
     EXPECT_EQ(read_cpu_latency(), 0);
     // A second request from this process replaces the first (one descriptor per process).
-    r.cpu_latency_us = 0;
     EXPECT_EQ(drivers::apply_realtime(r)[4].outcome, RtOutcome::kApplied);
   } else {
     // Not root, or a kernel without PM QoS: said with the device's name, and the reason.
