@@ -22,6 +22,11 @@ class CountingEncoder final : public EncoderSource {
     return s;
   }
   int counter_bits() const noexcept override { return 32; }
+  // set_steps: counts per read from the next read on (the driver sets them between ticks).
+  void set_steps(std::int64_t step_left, std::int64_t step_right) noexcept {
+    step_l_ = step_left;
+    step_r_ = step_right;
+  }
 
  private:
   std::int64_t step_l_, step_r_;
