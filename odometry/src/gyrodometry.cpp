@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 // Covariance of a tick whose heading comes from the gyro (propagate_gyro_arc). In the frame of the
@@ -85,11 +86,13 @@ Gyrodometry::Gyrodometry(const GyrodometryParams& p) : p_(p) {
   const double ticks = p.gyro_delay / p.tick;
   m_ = static_cast<std::size_t>(std::ceil(ticks - 1e-9));
   g_ = std::max(0.0, static_cast<double>(m_) - ticks);
+  one_minus_g_ = 1.0 - g_;
   // The window, the two ticks beyond its old edge (J_old there), and odometry m ticks back.
   size_ = std::max(n_ + 2, m_ + 1);
   // Capacity a power of two, so that an age's index is a subtraction and a mask.
   mask_ = std::bit_ceil(size_) - 1;
   ring_.assign(mask_ + 1, Entry{});
+  resum_in_ = kResumWraps * size_;
   const double t_w = static_cast<double>(n_) * p.tick;
   noise_term_ = p.k_sigma * p.noise.rate_noise_density * std::sqrt(t_w);
   gyro_var_ = p.noise.rate_noise_density * p.noise.rate_noise_density * t_w;
@@ -114,7 +117,9 @@ void Gyrodometry::update_b_res() noexcept {
 void Gyrodometry::reset() noexcept {
   std::fill(ring_.begin(), ring_.end(), Entry{});
   head_ = 0;
-  pass_ = 0;
+  // The re-sum's schedule restarts its pass of the ring (not its count of passes): up to the
+  // next multiple of size_ pushes.
+  resum_in_ = (resum_in_ + size_ - 1) / size_ * size_;
   filled_ = 0;
   resum();
   in_interval_ = false;
@@ -124,10 +129,10 @@ void Gyrodometry::reset() noexcept {
 }
 
 double Gyrodometry::threshold() const noexcept {
-  // The two sensors' random errors are independent: their variances add (sum_var_ is never
+  // The two sensors' random errors are independent: their variances add (sums_.var is never
   // negative in exact arithmetic; the running sum's rounding could make it -1e-20).
-  const double random = p_.k_sigma * std::sqrt(gyro_var_ + std::max(0.0, sum_var_)) - noise_term_;
-  return base_threshold_ + random + p_.noise.scale_tolerance * std::fabs(sum_odo_) + edge_bounds();
+  const double random = p_.k_sigma * std::sqrt(gyro_var_ + std::max(0.0, sums_.var)) - noise_term_;
+  return base_threshold_ + random + p_.noise.scale_tolerance * std::fabs(sums_.odo) + edge_bounds();
 }
 
 double Gyrodometry::edge_bounds() const noexcept {
@@ -146,93 +151,109 @@ double Gyrodometry::edge_bounds() const noexcept {
   return e + std::min(by_old, by_new);
 }
 
-void Gyrodometry::add_to_window(const Entry& e) noexcept {
-  sum_odo_ += e.odo_cmp;
-  sum_var_ += e.var_cmp;
+void Gyrodometry::WindowSums::add(const Entry& e) noexcept {
+  odo += e.odo_cmp;
+  var += e.var_cmp;
   if (e.err_ok)
-    sum_err_ += e.err;
+    err += e.err;
   else
-    ++bad_;
+    ++bad;
 }
 
-void Gyrodometry::remove_from_window(const Entry& e) noexcept {
-  sum_odo_ -= e.odo_cmp;
-  sum_var_ -= e.var_cmp;
+void Gyrodometry::WindowSums::remove(const Entry& e) noexcept {
+  odo -= e.odo_cmp;
+  var -= e.var_cmp;
   if (e.err_ok)
-    sum_err_ -= e.err;
+    err -= e.err;
   else
-    --bad_;
+    --bad;
 }
 
 void Gyrodometry::resum() noexcept {
   // Re-add the window from the ring so that the running sums' rounding cannot accumulate.
-  sum_err_ = sum_odo_ = sum_var_ = 0.0;
-  sum_new_l_ = sum_new_r_ = sum_old_l_ = sum_old_r_ = 0.0;
-  bad_ = 0;
+  WindowSums s;
   for (std::size_t age = 0; age < std::min(filled_, n_); ++age) {
     const Entry& e = at(age);
-    add_to_window(e);
+    s.add(e);
     if (age < half_) {
-      sum_new_l_ += e.d_left;
-      sum_new_r_ += e.d_right;
+      s.new_l += e.d_left;
+      s.new_r += e.d_right;
     } else {
-      sum_old_l_ += e.d_left;
-      sum_old_r_ += e.d_right;
+      s.old_l += e.d_left;
+      s.old_r += e.d_right;
     }
   }
+  sums_ = s;
 }
 
-// align, push and limit_flags run on every tick and are called from this file only: inline, so
+// slide, push and limit_flags run on every tick and are called from this file only: inline, so
 // that step() pays no call (and register saves) for them.
-inline void Gyrodometry::align(Entry& e) noexcept {
-  // The newest entry is in the ring (age 0): its aligned gyro increment and odometry's of m ticks
-  // ago (see the top of gyrodometry.hpp). Comparable only when everything it reads is there.
+template <bool kFull>
+[[gnu::always_inline]] inline void Gyrodometry::slide(Entry& e) noexcept {
+  // The newest entry e is in the ring (age 0): its aligned gyro increment and odometry's of m
+  // ticks ago (see the top of gyrodometry.hpp). Comparable only when everything it reads is
+  // there; a full ring (kFull) holds it all.
   const Entry& prev = at(1);
-  const bool have = filled_ > std::max<std::size_t>(m_, 1);
-  e.odo_cmp = have ? at(m_).odo : 0.0;
-  e.var_cmp = have ? at(m_).var : 0.0;
-  e.err_ok = have && e.gyro_ok && (g_ == 0.0 || prev.gyro_ok);
-  e.err = e.err_ok ? (1.0 - g_) * e.gyro + g_ * prev.gyro - e.odo_cmp : 0.0;
+  const bool have = kFull || filled_ > std::max<std::size_t>(m_, 1);
+  if (have) {
+    const Entry& cmp = at(m_);
+    e.odo_cmp = cmp.odo;
+    e.var_cmp = cmp.var;
+  } else {
+    e.odo_cmp = e.var_cmp = 0.0;
+  }
+  // prev.gyro_ok first: it is nearly always true and decides without the comparison of g_.
+  e.err_ok = have && e.gyro_ok && (prev.gyro_ok || g_ == 0.0);
+  e.err = e.err_ok ? one_minus_g_ * e.gyro + g_ * prev.gyro - e.odo_cmp : 0.0;
+  // The sums in a local: the ring's stores could alias the members, which would be reloaded.
+  WindowSums s = sums_;
+  s.add(e);
+  s.new_l += e.d_left;
+  s.new_r += e.d_right;
+  if (kFull || filled_ > half_) {  // the entry now of age half_ moves from the newer half
+    const Entry& mid = at(half_);
+    s.new_l -= mid.d_left;
+    s.new_r -= mid.d_right;
+    s.old_l += mid.d_left;
+    s.old_r += mid.d_right;
+  }
+  if (kFull || filled_ > n_) {  // the entry now of age n leaves the window (older half)
+    const Entry& old = at(n_);
+    s.remove(old);
+    s.old_l -= old.d_left;
+    s.old_r -= old.d_right;
+  }
+  sums_ = s;
 }
 
 [[gnu::always_inline]] inline Gyrodometry::Entry& Gyrodometry::push(const FusionInput& in,
                                                                     double odo, bool usable,
                                                                     double dt) noexcept {
   head_ = (head_ + 1) & mask_;
-  if (filled_ < size_) ++filled_;
-  // Written in place (not built and copied: 80 bytes a tick); align() sets the comparison fields.
+  const bool full = filled_ == size_;
+  if (!full) ++filled_;
+  // Written in place (not built and copied: 80 bytes a tick); slide() sets the comparison fields.
   Entry& e = ring_[head_];
   e.odo = odo;
-  e.d_left = in.d_left;
-  e.d_right = in.d_right;
   // Chong-Kleeman: wheel variances k^2 |d|; the heading difference divides by b twice.
   e.var = (k2_left_ * std::fabs(in.d_left) + k2_right_ * std::fabs(in.d_right)) /
           (in.wheelbase * in.wheelbase);
+  e.d_left = in.d_left;
+  e.d_right = in.d_right;
   e.gyro_ok = usable;
   e.raw = usable ? (in.gyro.rate_z - bias_) * dt : 0.0;
   e.gyro = scale_ * e.raw;
   e.replaced = false;
-  align(e);
-  add_to_window(e);
-  sum_new_l_ += e.d_left;
-  sum_new_r_ += e.d_right;
-  if (filled_ > half_) {  // the entry now of age half_ moves from the newer to the older half
-    const Entry& mid = at(half_);
-    sum_new_l_ -= mid.d_left;
-    sum_new_r_ -= mid.d_right;
-    sum_old_l_ += mid.d_left;
-    sum_old_r_ += mid.d_right;
-  }
-  if (filled_ > n_) {  // the entry now of age n leaves the window (older half)
-    const Entry& old = at(n_);
-    remove_from_window(old);
-    sum_old_l_ -= old.d_left;
-    sum_old_r_ -= old.d_right;
-  }
+  if (full)
+    slide<true>(e);
+  else
+    slide<false>(e);
   // Re-sum every kResumWraps passes of the ring: the running sums' rounding stays far below a
   // count (1e-16 relative per addition, a few thousand additions), at 1/16 of the cost.
-  pass_ = pass_ + 1 == size_ ? 0 : pass_ + 1;
-  if (pass_ == 0 && ++wraps_ % kResumWraps == 0) resum();
+  if (--resum_in_ == 0) {
+    resum_in_ = kResumWraps * size_;
+    resum();
+  }
   return e;
 }
 
@@ -243,6 +264,7 @@ void Gyrodometry::update_bias(double rate, bool rate_ok, double dt) noexcept {
   // far, which becomes an exponential average of horizon bias_tau to follow the bias's drift.
   if (!rate_ok || still_for_ < p_.still_time) return;
   bias_time_ = std::min(bias_time_ + dt, p_.bias_tau);
+  bias_valid_ = bias_time_ >= p_.still_time;
   bias_ += (rate - bias_) * dt / bias_time_;
   update_b_res();
 }
@@ -262,19 +284,16 @@ void Gyrodometry::update_scale(double odo, double raw_gyro, double dt) noexcept 
   }
 }
 
-inline std::uint32_t Gyrodometry::limit_flags() const noexcept {
-  std::uint32_t f = 0;
-  const Entry& e = ring_[head_];
+inline std::uint32_t Gyrodometry::limit_flags(double abs_left, double abs_right) const noexcept {
   // Speeds per tick: one count of quantisation is m / tick (0.046 m/s for 0.23 mm at 200 Hz),
-  // far below any useful limit.
-  if (std::fabs(e.d_left) > v_max_tick_ || std::fabs(e.d_right) > v_max_tick_)
-    f |= kFusionSpeedLimit;
+  // far below any useful limit. The travels are finite (step() checked): max is the || of the two.
+  std::uint32_t f = std::max(abs_left, abs_right) > v_max_tick_ ? kFusionSpeedLimit : 0u;
   if (filled_ == size_) {
     // Accelerations from the mean speeds of the two halves of the window: a count per half is
     // 2 m / T_h^2 of acceleration (0.18 m/s^2 for 0.23 mm and T_h = 0.05 s), per tick it would be
     // 2 m / tick^2 = 18 m/s^2.
-    if (std::fabs(sum_new_l_ - sum_old_l_) > dv_max_ ||
-        std::fabs(sum_new_r_ - sum_old_r_) > dv_max_)
+    if (std::fabs(sums_.new_l - sums_.old_l) > dv_max_ ||
+        std::fabs(sums_.new_r - sums_.old_r) > dv_max_)
       f |= kFusionAccelLimit;
   }
   return f;
@@ -297,55 +316,68 @@ double Gyrodometry::begin_interval() noexcept {
 std::uint32_t Gyrodometry::disagree_flag() const noexcept {
   // Only full rings are compared (edge_bounds needs the ticks beyond the window's old edge);
   // T >= base_threshold_: most ticks are decided without the window-dependent terms.
-  const double abs_err = std::fabs(sum_err_);
+  const double abs_err = std::fabs(sums_.err);
   const bool flag =
-      bad_ == 0 && filled_ == size_ && abs_err > base_threshold_ && abs_err > threshold();
+      sums_.bad == 0 && filled_ == size_ && abs_err > base_threshold_ && abs_err > threshold();
   return flag ? kFusionDisagree : 0u;
 }
 
 FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
   FusedTick out;
-  if (!(std::isfinite(in.d_left) && std::isfinite(in.d_right) && in.wheelbase > 0.0 &&
-        std::isfinite(in.wheelbase))) {
-    return out;  // nothing sane to integrate (the loop never produces this)
-  }
-  const double dt = in.dt > 0.0 && std::isfinite(in.dt) ? in.dt : p_.tick;
+  // x - x is 0 for a finite x and NaN for an infinite or NaN one: one test for all three.
+  const double nonfinite =
+      (in.d_left - in.d_left) + (in.d_right - in.d_right) + (in.wheelbase - in.wheelbase);
+  // Nothing sane to integrate (the loop never produces this).
+  if (!(nonfinite == 0.0 && in.wheelbase > 0.0)) return out;
+  // A positive dt is finite when it does not exceed the largest double.
+  const double dt = in.dt > 0.0 && in.dt <= std::numeric_limits<double>::max() ? in.dt : p_.tick;
   const double odo = (in.d_right - in.d_left) / in.wheelbase;
   out.dtheta = out.dtheta_odo = odo;
   wheelbase_ = in.wheelbase;
+  // The flags in a local: out is the caller's memory, each |= would be a load and a store.
+  std::uint32_t flags = 0;
   const bool rate_ok = in.gyro.flags == kGyroOk && std::isfinite(in.gyro.rate_z);
   if (!rate_ok) {
-    out.flags |= kFusionGyroFault;
+    flags |= kFusionGyroFault;
     if (gyro_was_ok_) ++counters_.gyro_faults;
   }
   gyro_was_ok_ = rate_ok;
-  if (in.d_left == 0.0 && in.d_right == 0.0) {
-    out.flags |= kFusionStill;
+  const double abs_left = std::fabs(in.d_left), abs_right = std::fabs(in.d_right);
+  if (abs_left + abs_right == 0.0) {  // both travels 0: a sum of magnitudes is 0 only then
+    flags |= kFusionStill;
     update_bias(in.gyro.rate_z, rate_ok, dt);
   } else {
     still_for_ = 0.0;  // moving: a standstill starts over
   }
   const bool usable = rate_ok && bias_valid();
-  if (!bias_valid()) out.flags |= kFusionNoBias;
+  if (!bias_valid()) flags |= kFusionNoBias;
   const Entry& fresh = push(in, odo, usable, dt);
   if (!usable) {
     in_interval_ = false;  // a faulty gyro ends any flagged interval: odometry from here on
     hold_ = 0;
+    out.flags = flags;
     return out;
   }
   if (scale_estimation_ && !in_interval_ && fresh.err_ok)
-    update_scale(fresh.odo_cmp, (1.0 - g_) * fresh.raw + g_ * at(1).raw, dt);
-  const std::uint32_t limits = limit_flags();
+    update_scale(fresh.odo_cmp, one_minus_g_ * fresh.raw + g_ * at(1).raw, dt);
+  const std::uint32_t limits = limit_flags(abs_left, abs_right);
   const std::uint32_t why = limits | disagree_flag();
+  // Outside an interval hold_ is 0 (it is set with one and an interval ends only once it ran
+  // out), so a quiet tick there changes nothing: the common case, decided first.
+  if (why == 0 && !in_interval_) {
+    out.flags = flags;
+    return out;
+  }
   // A tick beyond the kinematic limits is odometry's age 0, but the gyro replaces odometry m
   // ticks late: the interval lasts at least until that tick has been replaced.
   const bool hold = in_interval_ && hold_ > 0;
   hold_ = limits != 0 ? m_ : (hold_ > 0 ? hold_ - 1 : 0);
   if (why == 0 && !hold) {
     in_interval_ = false;
+    out.flags = flags;
     return out;
   }
-  out.flags |= why | kFusionGyroUsed;
+  out.flags = flags | why | kFusionGyroUsed;
   if (!in_interval_) {
     open_interval(why, odo, dt, out);
   } else {
@@ -364,8 +396,8 @@ void Gyrodometry::open_interval(std::uint32_t why, double odo, double dt, FusedT
   const double c = begin_interval();
   out.dtheta = odo + c;
   interval_c_ = interval_ds_ = 0.0;
-  interval_l_ = sum_new_l_ + sum_old_l_;
-  interval_r_ = sum_new_r_ + sum_old_r_;
+  interval_l_ = sums_.new_l + sums_.old_l;
+  interval_r_ = sums_.new_r + sums_.old_r;
   out.ds = travel_step(c);
   // m ticks of gyro at once: white noise N^2 m dt, the bias error's (b_res m dt)^2.
   const double n2 = p_.noise.rate_noise_density * p_.noise.rate_noise_density;

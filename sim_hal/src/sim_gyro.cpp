@@ -74,8 +74,10 @@ Result<SimGyro> SimGyro::create(SimRobot& robot, const GyroModel& m, std::uint64
 
 SimGyro::SimGyro(SimRobot& robot, const GyroModel& m, std::uint64_t seed, TimeNs stale_timeout)
     : robot_(robot), m_(m), normal_(seed) {
-  raw_max_ = (std::int64_t{1} << (m.bits - 1)) - 1;
-  lsb_ = m.full_scale / static_cast<double>(raw_max_ + 1);
+  const std::int64_t raw_max = (std::int64_t{1} << (m.bits - 1)) - 1;
+  lsb_ = m.full_scale / static_cast<double>(raw_max + 1);
+  word_hi_ = static_cast<double>(raw_max);  // exact (at most 2^31 - 1), as is the - 1 below
+  word_lo_ = -word_hi_ - 1.0;
   period_ = from_seconds(1.0 / m.odr);
   delay_ = from_seconds(m.delay);
   // White rate noise of density N sampled at f: per-sample sigma N sqrt(f), so that the mean of
@@ -83,6 +85,7 @@ SimGyro::SimGyro(SimRobot& robot, const GyroModel& m, std::uint64_t seed, TimeNs
   sigma_ = m.noise_density * std::sqrt(1.0 / to_seconds(period_));
   walk_step_ = m.bias_walk * std::sqrt(to_seconds(period_));
   walk_step1_ = walk_step_ * std::sqrt(3.0);  // read()'s walk factor for one sample
+  gain_ = 1.0 + m.scale_error;
   inv_period_ = 1.0 / to_seconds(period_);
   next_t_ = robot.time() + period_;
   last_theta_ = robot.true_pose().theta;
@@ -117,16 +120,17 @@ inline double SimGyro::heading_at(TimeNs t) noexcept {
   return past(hist_n_ - 1).theta;  // older than the history: the oldest known heading
 }
 
+template <bool kFaults>
 inline double SimGyro::sample(double true_rate, bool& saturated) noexcept {
-  double r = (1.0 + m_.scale_error) * true_rate + m_.bias_offset + walk_ + sigma_ * normal_();
-  if (saturate_left_ > 0) {
+  double r = gain_ * true_rate + m_.bias_offset + walk_ + sigma_ * normal_();
+  if (kFaults && saturate_left_ > 0) {
     --saturate_left_;
     ++injected_.saturated_samples;
     r = 2.0 * m_.full_scale;
   }
   // Saturated to the word's range before rounding: the same as rounding and then saturating (the
   // ends are integers), and it keeps round_to_int's argument where it is exact. NaN passes.
-  const double hi = static_cast<double>(raw_max_), lo = -hi - 1.0;
+  const double hi = word_hi_, lo = word_lo_;
   const double q = round_to_int(std::min(std::max(r / lsb_, lo), hi));
   saturated = q >= hi || q <= lo;
   return q * lsb_;
@@ -139,12 +143,21 @@ GyroSample SimGyro::read(TimeNs now) noexcept {
 }
 
 void SimGyro::read_into(TimeNs now, GyroSample& s) noexcept {
+  // Without armed or running faults (nearly every read) their checks are left out.
+  if (faults_)
+    read_samples<true>(now, s);
+  else
+    read_samples<false>(now, s);
+}
+
+template <bool kFaults>
+inline void SimGyro::read_samples(TimeNs now, GyroSample& s) noexcept {
   // The encoder's read of the same tick has usually moved the robot to `now` already.
   if (robot_.time() < now) robot_.advance_to(now);
   hist_head_ = (hist_head_ + 1) & (kHistory - 1);
   hist_[hist_head_] = {robot_.time(), robot_.true_pose().theta};
   if (hist_n_ < kHistory) ++hist_n_;
-  if (silence_ > 0) {
+  if (kFaults && silence_ > 0) {
     silent_until_ = now + silence_;
     silence_ = 0;
   }
@@ -159,12 +172,12 @@ void SimGyro::read_into(TimeNs now, GyroSample& s) noexcept {
     last_theta_ = theta;
     const TimeNs avail = next_t_ + delay_;
     next_t_ += period_;
-    if (avail < silent_until_) {
+    if (kFaults && avail < silent_until_) {
       ++injected_.silent_samples;
       continue;
     }
     bool sat = false;
-    sum += sample(true_rate, sat);
+    sum += sample<kFaults>(true_rate, sat);
     ++s.samples;
     book_.last_stamp = avail;
     if (sat) {
@@ -175,19 +188,27 @@ void SimGyro::read_into(TimeNs now, GyroSample& s) noexcept {
   // The bias walks once per read by the samples' combined step (sigma K sqrt(n T_s)), drawn
   // uniform with that sigma (sqrt(3) (2u - 1)): summed over many reads it is the same Brownian
   // walk (central limit). u comes from the last sample's normal draw, from bits that draw did
-  // not use: no generator call of its own.
-  if (s.samples > 0 && walk_step_ > 0.0) {
-    const double u = normal_.spare_uniform();
-    const double step =
-        s.samples == 1 ? walk_step1_ : walk_step_ * std::sqrt(3.0 * static_cast<double>(s.samples));
-    walk_ += step * (2.0 * u - 1.0);
+  // not use: no generator call of its own. Without a walk (walk_step_ = 0: the model allows no
+  // negative K) it adds a zero to the +0 it starts from, which leaves +0.
+  double mean = 0.0;
+  if (s.samples == 1) {  // the usual read (samples and reads at one rate): sum / 1 is sum
+    walk_ += walk_step1_ * normal_.spare_signed();
+    mean = sum;
+  } else if (s.samples > 1) {
+    walk_ += walk_step_ * std::sqrt(3.0 * static_cast<double>(s.samples)) * normal_.spare_signed();
+    mean = sum / s.samples;
   }
-  book_.close(s, now, s.samples > 0 ? sum / s.samples : 0.0);
-  if (nan_left_ > 0) {
+  book_.close(s, now, mean);
+  if (kFaults && nan_left_ > 0) {
     --nan_left_;
     ++injected_.nan_reads;
     s.rate_z = std::numeric_limits<double>::quiet_NaN();
   }
+  // Faults stay checked while any is armed or a silence covers samples still to come (the next
+  // sample is available at next_t_ + delay_, later ones later).
+  if (kFaults)
+    faults_ =
+        silence_ > 0 || saturate_left_ > 0 || nan_left_ > 0 || next_t_ + delay_ < silent_until_;
 }
 
 }  // namespace odo::sim

@@ -193,13 +193,13 @@ class Gyrodometry {
   // threshold: T of the current window [rad] (see the top of this file).
   double threshold() const noexcept;
   // disagreement: E of the current window, sum of aligned gyro minus odometry increments [rad].
-  double disagreement() const noexcept { return sum_err_; }
+  double disagreement() const noexcept { return sums_.err; }
   // delay_ticks: m, odometry's lag in whole ticks behind the newest gyro tick.
   std::size_t delay_ticks() const noexcept { return m_; }
   // gyro_weight: g, the weight of the older gyro tick in an aligned increment.
   double gyro_weight() const noexcept { return g_; }
   double bias() const noexcept { return bias_; }  // [rad/s]
-  bool bias_valid() const noexcept { return bias_time_ >= p_.still_time; }
+  bool bias_valid() const noexcept { return bias_valid_; }
   double scale() const noexcept { return scale_; }  // multiplies the bias-corrected rate
   bool scale_valid() const noexcept { return scale_valid_; }
   bool in_interval() const noexcept { return in_interval_; }
@@ -208,18 +208,31 @@ class Gyrodometry {
   std::size_t window_ticks() const noexcept { return n_; }
 
  private:
+  // Entry: one tick. odo and var, and odo_cmp and var_cmp, are adjacent: a later entry copies
+  // the first pair as its second, and the window's sums add and remove the second pair together.
   struct Entry {
-    double odo = 0.0;   // odometry's heading increment of this tick [rad]
-    double gyro = 0.0;  // the gyro's (bias- and scale-corrected) increment of this tick [rad]
-    double raw = 0.0;   // the gyro's bias-corrected increment before the scale [rad]
+    double odo = 0.0;      // odometry's heading increment of this tick [rad]
+    double var = 0.0;      // odometry's heading variance of this tick [rad^2]
+    double odo_cmp = 0.0;  // odometry's increment m ticks before this one [rad]
+    double var_cmp = 0.0;  // its variance [rad^2]
     double d_left = 0.0, d_right = 0.0;
-    double var = 0.0;       // odometry's heading variance of this tick [rad^2]
-    double odo_cmp = 0.0;   // odometry's increment m ticks before this one [rad]
-    double var_cmp = 0.0;   // its variance [rad^2]
+    double gyro = 0.0;      // the gyro's (bias- and scale-corrected) increment of this tick [rad]
+    double raw = 0.0;       // the gyro's bias-corrected increment before the scale [rad]
     double err = 0.0;       // aligned gyro increment minus odo_cmp [rad]
     bool gyro_ok = false;   // this tick's gyro increment is usable
     bool err_ok = false;    // err was computed from usable increments
     bool replaced = false;  // err already integrated as a correction
+  };
+  // WindowSums: the window's running sums (re-summed from the ring every kResumWraps passes).
+  struct WindowSums {
+    double odo = 0.0;                      // sum odo_cmp
+    double var = 0.0;                      // sum var_cmp
+    double new_l = 0.0, new_r = 0.0;       // travels of the newer half [m]
+    double old_l = 0.0, old_r = 0.0;       // travels of the older half [m]
+    double err = 0.0;                      // sum err of entries with err_ok
+    std::size_t bad = 0;                   // entries without err_ok
+    void add(const Entry& e) noexcept;     // e enters the window
+    void remove(const Entry& e) noexcept;  // e leaves it
   };
   explicit Gyrodometry(const GyrodometryParams& p);
   // update_bias: a still tick of length dt [s] with the gyro's rate [rad/s] (usable if rate_ok).
@@ -233,12 +246,13 @@ class Gyrodometry {
   // push: this tick's entry (travels, odometry's increment odo [rad] and variance, the gyro's),
   // written in place as the newest, aligned and added to the window's sums.
   Entry& push(const FusionInput& in, double odo, bool usable, double dt) noexcept;
-  void align(Entry& e) noexcept;
-  void add_to_window(const Entry& e) noexcept;       // into the window's running sums
-  void remove_from_window(const Entry& e) noexcept;  // out of them (it left the window)
+  // slide: the window moves by the new entry e (aligned here); kFull: the ring was full before.
+  template <bool kFull>
+  void slide(Entry& e) noexcept;
   void resum() noexcept;
   double edge_bounds() const noexcept;
-  std::uint32_t limit_flags() const noexcept;
+  // limit_flags: kFusionSpeedLimit, kFusionAccelLimit for the newest tick's |d_L|, |d_R| [m].
+  std::uint32_t limit_flags(double abs_left, double abs_right) const noexcept;
   double begin_interval() noexcept;
   // open_interval: the first flagged tick: the window's odometry increments are replaced by the
   // gyro's (out.dtheta, out.var_heading [rad^2]); why: the kFusion* reasons.
@@ -257,12 +271,13 @@ class Gyrodometry {
   std::size_t size_ = 0;                   // ages the fusion reads (0 .. size_ - 1)
   std::size_t mask_ = 0;                   // ring_.size() - 1 (the size a power of two >= size_)
   std::size_t head_ = 0;                   // index of the newest entry
-  std::size_t pass_ = 0;                   // pushes modulo size_ (the re-sum's schedule)
+  std::size_t resum_in_ = 0;               // pushes until the next re-sum
   std::size_t filled_ = 0;                 // entries in use (<= size_)
   std::size_t n_ = 2;                      // ticks in the window
   std::size_t half_ = 1;                   // ticks in each half of the window (accelerations)
   std::size_t m_ = 0;                      // odometry's lag behind the newest gyro tick [ticks]
   double g_ = 0.0;                         // weight of the older gyro tick in an aligned increment
+  double one_minus_g_ = 1.0;               // 1 - g_, the newer gyro tick's weight
   double noise_term_ = 0.0;                // k_sigma N sqrt(T_w) [rad]
   double gyro_var_ = 0.0;                  // N^2 T_w [rad^2]
   double k2_left_ = 0.0, k2_right_ = 0.0;  // k_L^2, k_R^2 [m]
@@ -272,18 +287,12 @@ class Gyrodometry {
   double base_threshold_ = 0.0;  // q + k_sigma N sqrt(T_w) + B_res T_w [rad]: a lower bound of T
   double v_max_tick_ = 0.0;      // max_wheel_speed * tick [m]
   double dv_max_ = 0.0;          // max_wheel_accel * T_h^2 [m]
-  std::uint32_t wraps_ = 0;      // times pass_ wrapped (for the periodic re-sum)
-  // Running sums over the window (re-summed from the ring every time it wraps).
-  double sum_err_ = 0.0;                      // sum err of entries with err_ok
-  double sum_odo_ = 0.0;                      // sum odo_cmp
-  double sum_var_ = 0.0;                      // sum var_cmp
-  std::size_t bad_ = 0;                       // entries without err_ok
-  double sum_new_l_ = 0.0, sum_new_r_ = 0.0;  // travels of the newer half [m]
-  double sum_old_l_ = 0.0, sum_old_r_ = 0.0;  // travels of the older half [m]
+  WindowSums sums_;
   // Bias and scale.
   double still_for_ = 0.0;  // duration of the current run of zero travel [s]
   double bias_ = 0.0;
-  double bias_time_ = 0.0;  // seconds of standstill averaged into bias_ (capped at bias_tau)
+  double bias_time_ = 0.0;   // seconds of standstill averaged into bias_ (capped at bias_tau)
+  bool bias_valid_ = false;  // bias_time_ >= still_time (kept with bias_time_, read every tick)
   double scale_ = 1.0;
   bool scale_valid_ = false;
   bool scale_estimation_ = false;

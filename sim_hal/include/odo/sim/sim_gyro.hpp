@@ -68,11 +68,20 @@ class SimGyro final : public YawRateSource {
   double full_scale() const noexcept override { return m_.full_scale; }
 
   // arm_silence: the device delivers no samples for `duration` [ns] from the next read on.
-  void arm_silence(TimeNs duration) noexcept { silence_ = duration; }
+  void arm_silence(TimeNs duration) noexcept {
+    silence_ = duration;
+    faults_ = true;
+  }
   // arm_saturation: the next `samples` samples read +full scale.
-  void arm_saturation(int samples) noexcept { saturate_left_ = samples; }
+  void arm_saturation(int samples) noexcept {
+    saturate_left_ = samples;
+    faults_ = true;
+  }
   // arm_nan: the next `reads` reads return rate_z = NaN with no flag (a broken backend).
-  void arm_nan(int reads) noexcept { nan_left_ = reads; }
+  void arm_nan(int reads) noexcept {
+    nan_left_ = reads;
+    faults_ = true;
+  }
   const InjectedGyroFaults& injected() const noexcept { return injected_; }
   // bias: the true bias at the last sample [rad/s] (offset + random walk).
   double bias() const noexcept { return m_.bias_offset + walk_; }
@@ -84,8 +93,13 @@ class SimGyro final : public YawRateSource {
   SimGyro(SimRobot& robot, const GyroModel& m, std::uint64_t seed, TimeNs stale_timeout);
   // heading_at: the true heading at time t [ns], interpolated in the history of reads.
   double heading_at(TimeNs t) noexcept;
-  // sample: one output word for the true rate [rad/s]; sets `saturated`.
+  // sample: one output word for the true rate [rad/s]; sets `saturated`. kFaults: an armed
+  // saturation is applied.
+  template <bool kFaults>
   double sample(double true_rate, bool& saturated) noexcept;
+  // read_samples: read_into() with (kFaults) or without the fault injection's checks.
+  template <bool kFaults>
+  void read_samples(TimeNs now, GyroSample& s) noexcept;
 
   struct Past {
     TimeNs t;
@@ -106,9 +120,10 @@ class SimGyro final : public YawRateSource {
   GyroModel m_;
   ZigguratNormal normal_;
   double lsb_ = 0.0, sigma_ = 0.0, walk_step_ = 0.0;
-  double walk_step1_ = 0.0;  // walk_step_ sqrt(3): a read's walk factor for one sample
-  double inv_period_ = 0.0;  // 1 / sample period [1/s]
-  std::int64_t raw_max_ = 0;
+  double walk_step1_ = 0.0;               // walk_step_ sqrt(3): a read's walk factor for one sample
+  double gain_ = 1.0;                     // 1 + scale_error
+  double inv_period_ = 0.0;               // 1 / sample period [1/s]
+  double word_hi_ = 0.0, word_lo_ = 0.0;  // the output word's range [LSB]
   TimeNs period_ = 0, delay_ = 0;
   TimeNs next_t_ = 0;        // truth time of the next sample [ns]
   double last_theta_ = 0.0;  // true heading at the previous sample
@@ -123,6 +138,7 @@ class SimGyro final : public YawRateSource {
   GyroReadBook book_;
   TimeNs silence_ = 0, silent_until_ = -1;
   int saturate_left_ = 0, nan_left_ = 0;
+  bool faults_ = false;  // a fault is armed or under way: reads check for them
   InjectedGyroFaults injected_;
 };
 

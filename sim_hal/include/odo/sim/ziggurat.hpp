@@ -56,6 +56,11 @@ class ZigguratNormal {
   // spare_uniform: a uniform draw in (0, 1) on 2^25 levels from the 25 bits of the last normal
   // draw's first word that the normal did not use (independent of it), at no generator cost.
   double spare_uniform() const noexcept { return (static_cast<double>(spare_) + 0.5) * 0x1.0p-25; }
+  // spare_signed: 2 spare_uniform() - 1 in (-1, 1), bit for bit: every value is a multiple of
+  // 2^-25 below 2 in magnitude, so each step of either form is exact.
+  double spare_signed() const noexcept {
+    return (static_cast<double>(spare_) - 0x1.ffffffp23) * 0x1.0p-24;
+  }
 
  private:
   double tail(std::int32_t hz, std::size_t iz) noexcept;
