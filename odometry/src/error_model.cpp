@@ -130,16 +130,39 @@ inline double horner(const double (&c)[N], double z) noexcept {
   return r;
 }
 
+// Pair: two doubles that one SSE2 (or NEON) instruction processes at once. Every operation
+// acts on each lane exactly as the scalar operation would, rounding included, so evaluating two
+// series side by side gives the same bits as evaluating them one after the other.
+using Pair = double __attribute__((vector_size(16)));
+
+// horner_pair: horner<M> of c0 and of c1 (M > 0) at z, in the lanes of one pair.
+template <std::size_t M, std::size_t N0, std::size_t N1>
+inline Pair horner_pair(const double (&c0)[N0], const double (&c1)[N1], Pair z) noexcept {
+  static_assert(M > 0 && M <= N0 && M <= N1);
+  Pair r = {c0[M - 1], c1[M - 1]};
+  for (std::size_t i = M - 1; i-- > 0;) r = r * z + Pair{c0[i], c1[i]};
+  return r;
+}
+
 // The seven basic functions of the arc's swept angle.
 struct BasicFunctions {
   double sinc, h, g1, g2, g3, g4, g5;
 };
 
-// series: the basic functions at z = phi^2 from the first M Taylor coefficients (0: all).
+// series: the basic functions at z = phi^2 from the first M Taylor coefficients (0: all). A
+// truncated series evaluates six of them two at a time (the full ones differ in length).
 template <std::size_t M>
 inline BasicFunctions series(double z) noexcept {
-  return {horner<M>(kSinc, z), horner<M>(kH, z),  horner<M>(kG1, z), horner<M>(kG2, z),
-          horner<M>(kG3, z),   horner<M>(kG4, z), horner<M>(kG5, z)};
+  if constexpr (M == 0) {
+    return {horner<M>(kSinc, z), horner<M>(kH, z),  horner<M>(kG1, z), horner<M>(kG2, z),
+            horner<M>(kG3, z),   horner<M>(kG4, z), horner<M>(kG5, z)};
+  } else {
+    const Pair zz = {z, z};
+    const Pair sh = horner_pair<M>(kSinc, kH, zz);
+    const Pair g12 = horner_pair<M>(kG1, kG2, zz);
+    const Pair g34 = horner_pair<M>(kG3, kG4, zz);
+    return {sh[0], sh[1], g12[0], g12[1], g34[0], g34[1], horner<M>(kG5, z)};
+  }
 }
 
 // closed_form: the basic functions from sin and cos of phi (for |phi| >= kSeriesLimit).
