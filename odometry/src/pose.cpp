@@ -45,7 +45,10 @@ void PoseIntegrator::step_arc(double ds, double dth) noexcept {
   heading_.finish(pose_.theta, cm, sm, h.c, h.s);
 }
 
-void Odometry::update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
+// flatten: the integrator's step inlined into the tick's pose update (a call would spill the
+// values the update still needs around it; other callers keep the out-of-line step_arc).
+[[gnu::flatten]] void Odometry::update(std::int64_t dn_left, std::int64_t dn_right,
+                                       double dt) noexcept {
   const double d_l = static_cast<double>(dn_left) * k_.metres_per_count_left();  // Eq. 6.35
   const double d_r = static_cast<double>(dn_right) * k_.metres_per_count_right();
   integrate(d_l, d_r, (d_r - d_l) / k_.wheelbase(), 0.0, dt);
