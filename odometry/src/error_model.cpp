@@ -199,23 +199,24 @@ Status check_error_model(const ErrorModelParams& k) {
 namespace {
 
 // wide_basic_functions: the tiers beyond the shortest series (|phi| >= kShortestSeriesLimit, a
-// turn faster than 15 rad/s at 1 kHz): out of line, so that the ordinary tick's inlined
-// arc_terms stays small.
-[[gnu::noinline]] BasicFunctions wide_basic_functions(double phi, double z) noexcept {
+// turn faster than 15 rad/s at 1 kHz).
+inline BasicFunctions wide_basic_functions(double phi, double z) noexcept {
   const double abs_phi = std::fabs(phi);
   return abs_phi < kShortSeriesLimit ? series<kShortTerms>(z)
          : abs_phi < kSeriesLimit    ? series<0>(z)
                                      : closed_form(phi);
 }
 
-// arc_terms_inline: arc_terms() inlined into its callers on the tick's path (a call returns
-// the fourteen terms through memory; inline they stay in registers). The same expressions.
-[[gnu::always_inline]] inline ArcTerms arc_terms_inline(double phi) noexcept {
-  const double z = phi * phi;
-  const double abs_phi = std::fabs(phi);
-  const BasicFunctions f = abs_phi < kTinySeriesLimit       ? series<kTinyTerms>(z)
-                           : abs_phi < kShortestSeriesLimit ? series<kShortestTerms>(z)
-                                                            : wide_basic_functions(phi, z);
+// narrow_basic_functions: the two tiers below kShortestSeriesLimit.
+inline BasicFunctions narrow_basic_functions(double phi, double z) noexcept {
+  return std::fabs(phi) < kTinySeriesLimit ? series<kTinyTerms>(z) : series<kShortestTerms>(z);
+}
+
+// arc_terms_of: the fourteen terms from the basic functions f of phi (z = phi^2); inlined into
+// its callers on the tick's path (a call returns the terms through memory; inline they stay in
+// registers).
+[[gnu::always_inline]] inline ArcTerms arc_terms_of(double phi, double z,
+                                                    const BasicFunctions& f) noexcept {
   const double sinc = f.sinc, h = f.h;
   ArcTerms t;
   t.i_c = sinc;
@@ -238,7 +239,10 @@ namespace {
 }  // namespace
 
 ArcTerms arc_terms(double phi) noexcept {
-  return arc_terms_inline(phi);
+  const double z = phi * phi;
+  return arc_terms_of(phi, z,
+                      std::fabs(phi) < kShortestSeriesLimit ? narrow_basic_functions(phi, z)
+                                                            : wide_basic_functions(phi, z));
 }
 
 namespace {
@@ -294,6 +298,30 @@ inline void propagate_local_impl(Cov3& cov, double s0, double c0, double lx, dou
   cov = {n00, n01, n02, n01, n11, n12, n02, n12, n22};
 }
 
+// propagate_arc_terms: propagate_arc once the arc's terms t are known.
+[[gnu::always_inline]] inline void propagate_arc_terms(Cov3& cov, double sin_theta0,
+                                                       double cos_theta0, double d_left,
+                                                       double d_right, double b,
+                                                       const ErrorModelParams& k,
+                                                       const ArcTerms& t) noexcept {
+  const Mat3 q = local_input_covariance(d_left, d_right, b, k, t);
+  // Displacement of the arc: D (I_c, I_s) in the start frame.
+  const double d = 0.5 * (d_left + d_right);
+  propagate_local_impl(cov, sin_theta0, cos_theta0, d * t.i_c, d * t.i_s, q(0, 0), q(0, 1), q(0, 2),
+                       q(1, 1), q(1, 2), q(2, 2));
+}
+
+// propagate_arc_wide: propagate_arc for the tiers beyond the shortest series (|phi| >=
+// kShortestSeriesLimit; z = phi^2): out of line, so that the ordinary tick's copy needs no stack
+// frame (values live across a call would go to the stack).
+[[gnu::noinline]] void propagate_arc_wide(Cov3& cov, double sin_theta0, double cos_theta0,
+                                          double d_left, double d_right, double b,
+                                          const ErrorModelParams& k, double phi,
+                                          double z) noexcept {
+  propagate_arc_terms(cov, sin_theta0, cos_theta0, d_left, d_right, b, k,
+                      arc_terms_of(phi, z, wide_basic_functions(phi, z)));
+}
+
 }  // namespace
 
 Cov3 arc_input_covariance(double d_left, double d_right, double b,
@@ -320,12 +348,13 @@ void propagate_arc(Cov3& cov, double sin_theta0, double cos_theta0, double d_lef
   // the body, GCC splits the body off into a function of its own, which costs more than it saves.)
   const double phi = (d_right - d_left) / b;
   if (!(all_finite(d_left, d_right, b, sin_theta0, cos_theta0) && b > 0.0)) return;
-  const ArcTerms t = arc_terms_inline(phi);
-  const Mat3 q = local_input_covariance(d_left, d_right, b, k, t);
-  // Displacement of the arc: D (I_c, I_s) in the start frame.
-  const double d = 0.5 * (d_left + d_right);
-  propagate_local_impl(cov, sin_theta0, cos_theta0, d * t.i_c, d * t.i_s, q(0, 0), q(0, 1), q(0, 2),
-                       q(1, 1), q(1, 2), q(2, 2));
+  const double z = phi * phi;
+  if (std::fabs(phi) >= kShortestSeriesLimit) {
+    propagate_arc_wide(cov, sin_theta0, cos_theta0, d_left, d_right, b, k, phi, z);
+    return;
+  }
+  propagate_arc_terms(cov, sin_theta0, cos_theta0, d_left, d_right, b, k,
+                      arc_terms_of(phi, z, narrow_basic_functions(phi, z)));
 }
 
 void propagate_local(Cov3& cov, double sin_theta0, double cos_theta0, double lx, double ly,
