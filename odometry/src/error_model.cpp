@@ -209,7 +209,9 @@ inline BasicFunctions wide_basic_functions(double phi, double z) noexcept {
 
 // narrow_basic_functions: the two tiers below kShortestSeriesLimit.
 inline BasicFunctions narrow_basic_functions(double phi, double z) noexcept {
-  return std::fabs(phi) < kTinySeriesLimit ? series<kTinyTerms>(z) : series<kShortestTerms>(z);
+  if (std::fabs(phi) < kTinySeriesLimit) [[likely]]
+    return series<kTinyTerms>(z);
+  return series<kShortestTerms>(z);
 }
 
 // arc_terms_of: the fourteen terms from the basic functions f of phi (z = phi^2); inlined into
