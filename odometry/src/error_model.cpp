@@ -207,7 +207,8 @@ inline BasicFunctions wide_basic_functions(double phi, double z) noexcept {
                                      : closed_form(phi);
 }
 
-// narrow_basic_functions: the two tiers below kShortestSeriesLimit.
+// narrow_basic_functions: the two tiers below kShortestSeriesLimit. The tiny one is the ordinary
+// tick's ([[likely]]: its series fall through to the step instead of jumping there and back).
 inline BasicFunctions narrow_basic_functions(double phi, double z) noexcept {
   if (std::fabs(phi) < kTinySeriesLimit) [[likely]]
     return series<kTinyTerms>(z);
