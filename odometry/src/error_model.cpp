@@ -253,8 +253,10 @@ namespace {
 // local_input_covariance: Cov(U) in the arc's start frame plus the arc's displacement there.
 inline Mat3 local_input_covariance(double d_left, double d_right, double b,
                                    const ErrorModelParams& k, const ArcTerms& t) noexcept {
-  const double w_l = k.k_left * k.k_left * std::fabs(d_left);
-  const double w_r = k.k_right * k.k_right * std::fabs(d_right);
+  // (w_L, w_R) = (k_L^2 |d_L|, k_R^2 |d_R|) in one pair: the same products, lane by lane.
+  const Pair kk = Pair{k.k_left, k.k_right} * Pair{k.k_left, k.k_right};
+  const Pair w = kk * Pair{std::fabs(d_left), std::fabs(d_right)};
+  const double w_l = w[0], w_r = w[1];
   const double wp = w_l + w_r, wm = w_l - w_r;
   const double a = 0.5 * (d_left + d_right) / b;
   const double inv_b = 1.0 / b;
@@ -274,10 +276,12 @@ namespace {
 
 // all_finite: whether none of the five values is infinite or NaN, in one test instead of five:
 // x - x is +0 for a finite x and NaN otherwise, a sum with a NaN term is NaN and a sum of +0
-// terms is +0, so the sum equals 0 exactly when every value is finite. (Without
-// -ffinite-math-only the compiler may not fold x - x to 0.)
+// terms is +0, so the sum equals 0 exactly when every value is finite, in any order of its
+// terms (four of them taken in pairs here). (Without -ffinite-math-only the compiler may not
+// fold x - x to 0.)
 inline bool all_finite(double v0, double v1, double v2, double v3, double v4) noexcept {
-  return (v0 - v0) + (v1 - v1) + (v2 - v2) + (v3 - v3) + (v4 - v4) == 0.0;
+  const Pair p = (Pair{v0, v1} - Pair{v0, v1}) + (Pair{v3, v4} - Pair{v3, v4});
+  return p[0] + p[1] + (v2 - v2) == 0.0;
 }
 
 // propagate_local_impl: cov <- F cov F^T + R Q R^T for a step with displacement (lx, ly) and
