@@ -130,16 +130,39 @@ inline double horner(const double (&c)[N], double z) noexcept {
   return r;
 }
 
+// Pair: two doubles that one SSE2 (or NEON) instruction processes at once. Every operation
+// acts on each lane exactly as the scalar operation would, rounding included, so evaluating two
+// series side by side gives the same bits as evaluating them one after the other.
+using Pair = double __attribute__((vector_size(16)));
+
+// horner_pair: horner<M> of c0 and of c1 (M > 0) at z, in the lanes of one pair.
+template <std::size_t M, std::size_t N0, std::size_t N1>
+inline Pair horner_pair(const double (&c0)[N0], const double (&c1)[N1], Pair z) noexcept {
+  static_assert(M > 0 && M <= N0 && M <= N1);
+  Pair r = {c0[M - 1], c1[M - 1]};
+  for (std::size_t i = M - 1; i-- > 0;) r = r * z + Pair{c0[i], c1[i]};
+  return r;
+}
+
 // The seven basic functions of the arc's swept angle.
 struct BasicFunctions {
   double sinc, h, g1, g2, g3, g4, g5;
 };
 
-// series: the basic functions at z = phi^2 from the first M Taylor coefficients (0: all).
+// series: the basic functions at z = phi^2 from the first M Taylor coefficients (0: all). A
+// truncated series evaluates six of them two at a time (the full ones differ in length).
 template <std::size_t M>
 inline BasicFunctions series(double z) noexcept {
-  return {horner<M>(kSinc, z), horner<M>(kH, z),  horner<M>(kG1, z), horner<M>(kG2, z),
-          horner<M>(kG3, z),   horner<M>(kG4, z), horner<M>(kG5, z)};
+  if constexpr (M == 0) {
+    return {horner<M>(kSinc, z), horner<M>(kH, z),  horner<M>(kG1, z), horner<M>(kG2, z),
+            horner<M>(kG3, z),   horner<M>(kG4, z), horner<M>(kG5, z)};
+  } else {
+    const Pair zz = {z, z};
+    const Pair sh = horner_pair<M>(kSinc, kH, zz);
+    const Pair g12 = horner_pair<M>(kG1, kG2, zz);
+    const Pair g34 = horner_pair<M>(kG3, kG4, zz);
+    return {sh[0], sh[1], g12[0], g12[1], g34[0], g34[1], horner<M>(kG5, z)};
+  }
 }
 
 // closed_form: the basic functions from sin and cos of phi (for |phi| >= kSeriesLimit).
@@ -176,23 +199,27 @@ Status check_error_model(const ErrorModelParams& k) {
 namespace {
 
 // wide_basic_functions: the tiers beyond the shortest series (|phi| >= kShortestSeriesLimit, a
-// turn faster than 15 rad/s at 1 kHz): out of line, so that the ordinary tick's inlined
-// arc_terms stays small.
-[[gnu::noinline]] BasicFunctions wide_basic_functions(double phi, double z) noexcept {
+// turn faster than 15 rad/s at 1 kHz).
+inline BasicFunctions wide_basic_functions(double phi, double z) noexcept {
   const double abs_phi = std::fabs(phi);
   return abs_phi < kShortSeriesLimit ? series<kShortTerms>(z)
          : abs_phi < kSeriesLimit    ? series<0>(z)
                                      : closed_form(phi);
 }
 
-// arc_terms_inline: arc_terms() inlined into its callers on the tick's path (a call returns
-// the fourteen terms through memory; inline they stay in registers). The same expressions.
-[[gnu::always_inline]] inline ArcTerms arc_terms_inline(double phi) noexcept {
-  const double z = phi * phi;
-  const double abs_phi = std::fabs(phi);
-  const BasicFunctions f = abs_phi < kTinySeriesLimit       ? series<kTinyTerms>(z)
-                           : abs_phi < kShortestSeriesLimit ? series<kShortestTerms>(z)
-                                                            : wide_basic_functions(phi, z);
+// narrow_basic_functions: the two tiers below kShortestSeriesLimit. The tiny one is the ordinary
+// tick's ([[likely]]: its series fall through to the step instead of jumping there and back).
+inline BasicFunctions narrow_basic_functions(double phi, double z) noexcept {
+  if (std::fabs(phi) < kTinySeriesLimit) [[likely]]
+    return series<kTinyTerms>(z);
+  return series<kShortestTerms>(z);
+}
+
+// arc_terms_of: the fourteen terms from the basic functions f of phi (z = phi^2); inlined into
+// its callers on the tick's path (a call returns the terms through memory; inline they stay in
+// registers).
+[[gnu::always_inline]] inline ArcTerms arc_terms_of(double phi, double z,
+                                                    const BasicFunctions& f) noexcept {
   const double sinc = f.sinc, h = f.h;
   ArcTerms t;
   t.i_c = sinc;
@@ -215,7 +242,10 @@ namespace {
 }  // namespace
 
 ArcTerms arc_terms(double phi) noexcept {
-  return arc_terms_inline(phi);
+  const double z = phi * phi;
+  return arc_terms_of(phi, z,
+                      std::fabs(phi) < kShortestSeriesLimit ? narrow_basic_functions(phi, z)
+                                                            : wide_basic_functions(phi, z));
 }
 
 namespace {
@@ -223,6 +253,9 @@ namespace {
 // local_input_covariance: Cov(U) in the arc's start frame plus the arc's displacement there.
 inline Mat3 local_input_covariance(double d_left, double d_right, double b,
                                    const ErrorModelParams& k, const ArcTerms& t) noexcept {
+  // Not as a pair (-2 instructions on x86-64): where the compiler contracts a multiply and an
+  // add into one fused operation (aarch64), w_l + w_r and w_l - w_r become fma(k_L^2, |d_L|, ..)
+  // from scalars but not from a pair's lanes, which changes the bits there.
   const double w_l = k.k_left * k.k_left * std::fabs(d_left);
   const double w_r = k.k_right * k.k_right * std::fabs(d_right);
   const double wp = w_l + w_r, wm = w_l - w_r;
@@ -241,6 +274,16 @@ inline Mat3 local_input_covariance(double d_left, double d_right, double b,
 }  // namespace
 
 namespace {
+
+// all_finite: whether none of the five values is infinite or NaN, in one test instead of five:
+// x - x is +0 for a finite x and NaN otherwise, a sum with a NaN term is NaN and a sum of +0
+// terms is +0, so the sum equals 0 exactly when every value is finite, in any order of its
+// terms (four of them taken in pairs here). (Without -ffinite-math-only the compiler may not
+// fold x - x to 0.)
+inline bool all_finite(double v0, double v1, double v2, double v3, double v4) noexcept {
+  const Pair p = (Pair{v0, v1} - Pair{v0, v1}) + (Pair{v3, v4} - Pair{v3, v4});
+  return p[0] + p[1] + (v2 - v2) == 0.0;
+}
 
 // propagate_local_impl: cov <- F cov F^T + R Q R^T for a step with displacement (lx, ly) and
 // input covariance Q (its six distinct entries) in the frame of its start heading (s0, c0).
@@ -261,6 +304,30 @@ inline void propagate_local_impl(Cov3& cov, double s0, double c0, double lx, dou
   const double n12 = p12 + fc * p22 + s0 * q02 + c0 * q12;
   const double n22 = p22 + q22;
   cov = {n00, n01, n02, n01, n11, n12, n02, n12, n22};
+}
+
+// propagate_arc_terms: propagate_arc once the arc's terms t are known.
+[[gnu::always_inline]] inline void propagate_arc_terms(Cov3& cov, double sin_theta0,
+                                                       double cos_theta0, double d_left,
+                                                       double d_right, double b,
+                                                       const ErrorModelParams& k,
+                                                       const ArcTerms& t) noexcept {
+  const Mat3 q = local_input_covariance(d_left, d_right, b, k, t);
+  // Displacement of the arc: D (I_c, I_s) in the start frame.
+  const double d = 0.5 * (d_left + d_right);
+  propagate_local_impl(cov, sin_theta0, cos_theta0, d * t.i_c, d * t.i_s, q(0, 0), q(0, 1), q(0, 2),
+                       q(1, 1), q(1, 2), q(2, 2));
+}
+
+// propagate_arc_wide: propagate_arc for the tiers beyond the shortest series (|phi| >=
+// kShortestSeriesLimit; z = phi^2): out of line, so that the ordinary tick's copy needs no stack
+// frame (values live across a call would go to the stack).
+[[gnu::noinline]] void propagate_arc_wide(Cov3& cov, double sin_theta0, double cos_theta0,
+                                          double d_left, double d_right, double b,
+                                          const ErrorModelParams& k, double phi,
+                                          double z) noexcept {
+  propagate_arc_terms(cov, sin_theta0, cos_theta0, d_left, d_right, b, k,
+                      arc_terms_of(phi, z, wide_basic_functions(phi, z)));
 }
 
 }  // namespace
@@ -285,17 +352,17 @@ void propagate_arc(Cov3& cov, double theta0, double d_left, double d_right, doub
 void propagate_arc(Cov3& cov, double sin_theta0, double cos_theta0, double d_left, double d_right,
                    double b, const ErrorModelParams& k) noexcept {
   // A non-finite travel or wheelbase would poison the covariance for good; such a tick (which the
-  // loop never produces) adds nothing.
-  if (!(std::isfinite(d_left) && std::isfinite(d_right) && b > 0.0 && std::isfinite(b) &&
-        std::isfinite(sin_theta0) && std::isfinite(cos_theta0))) {
+  // loop never produces) adds nothing. (phi is computed first: with the test alone in front of
+  // the body, GCC splits the body off into a function of its own, which costs more than it saves.)
+  const double phi = (d_right - d_left) / b;
+  if (!(all_finite(d_left, d_right, b, sin_theta0, cos_theta0) && b > 0.0)) return;
+  const double z = phi * phi;
+  if (std::fabs(phi) >= kShortestSeriesLimit) {
+    propagate_arc_wide(cov, sin_theta0, cos_theta0, d_left, d_right, b, k, phi, z);
     return;
   }
-  const ArcTerms t = arc_terms_inline((d_right - d_left) / b);
-  const Mat3 q = local_input_covariance(d_left, d_right, b, k, t);
-  // Displacement of the arc: D (I_c, I_s) in the start frame.
-  const double d = 0.5 * (d_left + d_right);
-  propagate_local_impl(cov, sin_theta0, cos_theta0, d * t.i_c, d * t.i_s, q(0, 0), q(0, 1), q(0, 2),
-                       q(1, 1), q(1, 2), q(2, 2));
+  propagate_arc_terms(cov, sin_theta0, cos_theta0, d_left, d_right, b, k,
+                      arc_terms_of(phi, z, narrow_basic_functions(phi, z)));
 }
 
 void propagate_local(Cov3& cov, double sin_theta0, double cos_theta0, double lx, double ly,

@@ -45,16 +45,23 @@ void PoseIntegrator::step_arc(double ds, double dth) noexcept {
   heading_.finish(pose_.theta, cm, sm, h.c, h.s);
 }
 
-void Odometry::update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
+// flatten: the integrator's step inlined into the tick's pose update (a call would spill the
+// values the update still needs around it; other callers keep the out-of-line step_arc).
+[[gnu::flatten]] void Odometry::update(std::int64_t dn_left, std::int64_t dn_right,
+                                       double dt) noexcept {
   const double d_l = static_cast<double>(dn_left) * k_.metres_per_count_left();  // Eq. 6.35
   const double d_r = static_cast<double>(dn_right) * k_.metres_per_count_right();
-  integrate(d_l, d_r, (d_r - d_l) / k_.wheelbase(), 0.0, dt);
+  // update_fused() with ds_correction 0 adds 0.0 to the mean travel, which changes no bits here:
+  // x + 0.0 == x except for x = -0.0, and the mean is never -0.0 (a count of 0 gives +0.0, a
+  // finite x + (-x) is +0.0).
+  integrate(d_l, d_r, 0.5 * (d_l + d_r), (d_r - d_l) / k_.wheelbase(), dt);
 }
 
 void Odometry::update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
                             double ds_correction) noexcept {
-  integrate(static_cast<double>(dn_left) * k_.metres_per_count_left(),
-            static_cast<double>(dn_right) * k_.metres_per_count_right(), dtheta, ds_correction, dt);
+  const double d_l = static_cast<double>(dn_left) * k_.metres_per_count_left();
+  const double d_r = static_cast<double>(dn_right) * k_.metres_per_count_right();
+  integrate(d_l, d_r, 0.5 * (d_l + d_r) + ds_correction, dtheta, dt);
 }
 
 void Odometry::advance_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
@@ -68,12 +75,9 @@ void Odometry::advance_fused(std::int64_t dn_left, std::int64_t dn_right, double
   }
 }
 
-void Odometry::integrate(double d_l, double d_r, double dth, double ds_correction,
-                         double dt) noexcept {
+void Odometry::integrate(double d_l, double d_r, double ds, double dth, double dt) noexcept {
   d_left_ = d_l;
   d_right_ = d_r;
-  // Adding 0.0 keeps update()'s value (x + 0.0 == x, except -0.0 -> +0.0, which moves nothing).
-  const double ds = 0.5 * (d_l + d_r) + ds_correction;
   integ_.step_arc(ds, dth);
   distance_ += std::fabs(ds);
   if (dt > 0.0) {

@@ -182,8 +182,9 @@ class Odometry {
   const Cov3& covariance() const noexcept { return cov_.cov(); }
 
  private:
-  // integrate: one tick of wheel travels d_l, d_r [m] and heading change dth [rad].
-  void integrate(double d_l, double d_r, double dth, double ds_correction, double dt) noexcept;
+  // integrate: one tick of wheel travels d_l, d_r [m], centre travel ds [m] and heading change
+  // dth [rad].
+  void integrate(double d_l, double d_r, double ds, double dth, double dt) noexcept;
   Kinematics k_;
   PoseCovariance cov_;
   PoseIntegrator integ_;
