@@ -142,7 +142,7 @@ double Gyrodometry::edge_bounds() const noexcept {
   const Entry &gn1 = at(n_ - 1), &gn = at(n_), &gn2 = at(n_ + 1);
   double e = delay_per_tick_ * std::fabs(g0.gyro - gn.gyro);
   if (g_ == 0.0) return e;  // both points are tick boundaries: nothing is interpolated
-  const double p = 1.0 - g_;
+  const double p = one_minus_g_;
   e += p * std::fabs(g0.gyro - g1.gyro);  // the newest edge: only the older neighbour exists
   // The old edge: the tighter of the two bounds; a neighbour without a usable increment (its
   // stored 0 is no rate) leaves the other one.
