@@ -124,8 +124,7 @@ class BusPoseFeed final : public PoseFeed {
     auto bus =
         fw::open_can_listener(iface, {id(protocol::Msg::kPoseX), id(protocol::Msg::kPoseYTheta)});
     if (!bus) return std::move(bus).error();
-    return std::unique_ptr<PoseFeed>(
-        new BusPoseFeed(iface, std::move(bus).value(), PosePairer(base_id, node), node));
+    return std::unique_ptr<PoseFeed>(new BusPoseFeed(iface, std::move(bus).value(), base_id, node));
   }
 
   Result<Pose2> latest() override {
@@ -134,13 +133,16 @@ class BusPoseFeed final : public PoseFeed {
     CanFrame f{};
     while (bus_->receive(f)) {
     }
+    // A fresh pairer: the half pair it held is from before the drain, and the sequence number
+    // repeats (8 bits), so an old PoseX could complete a new PoseYTheta into a pose that never was.
+    PosePairer pairer(base_id_, node_);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(kWait);
     while (std::chrono::steady_clock::now() < deadline) {
       if (!bus_->receive(f)) {
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
         continue;
       }
-      if (auto p = pairer_.take(f)) return *p;
+      if (auto p = pairer.take(f)) return *p;
     }
     std::ostringstream m;
     m << iface_ << ": no pose frames of node " << node_ << " within " << kWait
@@ -149,12 +151,12 @@ class BusPoseFeed final : public PoseFeed {
   }
 
  private:
-  BusPoseFeed(std::string iface, std::unique_ptr<CanBus> bus, PosePairer pairer, int node)
-      : iface_(std::move(iface)), bus_(std::move(bus)), pairer_(pairer), node_(node) {}
+  BusPoseFeed(std::string iface, std::unique_ptr<CanBus> bus, std::uint32_t base_id, int node)
+      : iface_(std::move(iface)), bus_(std::move(bus)), base_id_(base_id), node_(node) {}
 
   std::string iface_;
   std::unique_ptr<CanBus> bus_;
-  PosePairer pairer_;
+  std::uint32_t base_id_;
   int node_;
 };
 

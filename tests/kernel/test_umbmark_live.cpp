@@ -9,6 +9,8 @@
 //    with `cansend`; a session that takes the interface from the daemon's config (--config)
 //    prints that pose as its start and end pose.
 //  - No broadcast: a scripted session stops with one line naming the interface and the wait.
+//  - A pair split by the emptying of the queue: the PoseYTheta left over is not joined to the
+//    PoseX of an earlier pair that had the same sequence number.
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <linux/can.h>
@@ -63,12 +65,10 @@ std::pair<CanFrame, CanFrame> pose_frames(const protocol::PoseMsg& p) {
   return f;
 }
 
-// Broadcaster: sends the current pose's two frames every 5 ms on a raw socket; set() returns
-// only when no frame of the previous pose can still be sent.
-class Broadcaster {
+// RawSender: writes frames on `ifc` through a raw CAN socket.
+class RawSender {
  public:
-  explicit Broadcaster(const std::string& ifc) {
-    fd_ = socket(PF_CAN, SOCK_RAW, CAN_RAW);
+  explicit RawSender(const std::string& ifc) : fd_(socket(PF_CAN, SOCK_RAW, CAN_RAW)) {
     ifreq ifr{};
     std::strncpy(ifr.ifr_name, ifc.c_str(), IFNAMSIZ - 1);
     ioctl(fd_, SIOCGIFINDEX, &ifr);
@@ -76,20 +76,9 @@ class Broadcaster {
     a.can_family = AF_CAN;
     a.can_ifindex = ifr.ifr_ifindex;
     ok_ = fd_ >= 0 && bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-    thread_ = std::thread([this] { run(); });
   }
-  ~Broadcaster() {
-    stop_ = true;
-    thread_.join();
-    close(fd_);
-  }
+  ~RawSender() { close(fd_); }
   bool ok() const { return ok_; }
-  void set(const protocol::PoseMsg& p) {
-    std::lock_guard<std::mutex> l(m_);
-    pose_ = p;
-  }
-
- private:
   void send(const CanFrame& f) {
     can_frame k{};
     k.can_id = f.id;
@@ -97,20 +86,43 @@ class Broadcaster {
     std::memcpy(k.data, f.data.data(), f.len);
     (void)!write(fd_, &k, sizeof k);
   }
+
+ private:
+  int fd_;
+  bool ok_ = false;
+};
+
+// Broadcaster: sends the current pose's two frames every 5 ms on a raw socket; set() returns
+// only when no frame of the previous pose can still be sent.
+class Broadcaster {
+ public:
+  explicit Broadcaster(const std::string& ifc) : out_(ifc) {
+    thread_ = std::thread([this] { run(); });
+  }
+  ~Broadcaster() {
+    stop_ = true;
+    thread_.join();
+  }
+  bool ok() const { return out_.ok(); }
+  void set(const protocol::PoseMsg& p) {
+    std::lock_guard<std::mutex> l(m_);
+    pose_ = p;
+  }
+
+ private:
   void run() {
     while (!stop_) {
       {
         std::lock_guard<std::mutex> l(m_);
         pose_.seq = static_cast<std::uint8_t>(pose_.seq + 1);
         const auto [fx, fy] = pose_frames(pose_);
-        send(fx);
-        send(fy);
+        out_.send(fx);
+        out_.send(fy);
       }
       std::this_thread::sleep_for(5ms);
     }
   }
-  int fd_ = -1;
-  bool ok_ = false;
+  RawSender out_;
   std::atomic<bool> stop_{false};
   std::mutex m_;
   protocol::PoseMsg pose_{};
@@ -145,29 +157,43 @@ const char* const kTape[2][5] = {{"1000", "800", "1012", "795", "1.5"},
 // drive_session: answers a running `umbmark record --runs 1` through the FIFO; before each Enter
 // it calls set_pose(k), and it waits for the session to print the pose it read before going on.
 // Returns false when the session did not get that far within 20 s.
+// Answers: the write end of a session's --answers FIFO, one line per say().
+class Answers {
+ public:
+  // Non-blocking open: a session that failed before opening its answers must not hang the test.
+  explicit Answers(const std::string& fifo) {
+    for (int i = 0; i < 200 && fd_ < 0; ++i, std::this_thread::sleep_for(50ms))
+      fd_ = open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+    if (fd_ >= 0) fcntl(fd_, F_SETFL, 0);
+  }
+  ~Answers() {
+    if (fd_ >= 0) close(fd_);
+  }
+  bool ok() const { return fd_ >= 0; }
+  void say(const std::string& line) { (void)!write(fd_, (line + "\n").data(), line.size() + 1); }
+
+ private:
+  int fd_ = -1;
+};
+
+// printed: whether the session's stdout file `out` shows "odometry at <when>" n times within 20 s.
+bool printed(const std::string& out, const char* when, std::size_t n) {
+  for (int i = 0; i < 400; ++i, std::this_thread::sleep_for(50ms))
+    if (count(slurp(out), std::string("odometry at ") + when) >= n) return true;
+  return false;
+}
+
 template <class SetPose>
 bool drive_session(const std::string& fifo, const std::string& out, SetPose set_pose) {
-  // Non-blocking open: a session that failed before opening its answers must not hang the test.
-  int fd = -1;
-  for (int i = 0; i < 200 && fd < 0; ++i, std::this_thread::sleep_for(50ms))
-    fd = open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
-  if (fd < 0) return false;
-  fcntl(fd, F_SETFL, 0);
-  struct Closer {
-    int fd;
-    ~Closer() { close(fd); }
-  } closer{fd};
+  Answers a(fifo);
+  if (!a.ok()) return false;
   int k = 0;
-  auto say = [&](const std::string& line) {
-    (void)!write(fd, (line + "\n").data(), line.size() + 1);
-  };
+  auto say = [&](const std::string& line) { a.say(line); };
   auto enter = [&](const char* when, std::size_t n) {
     set_pose(k++);
     std::this_thread::sleep_for(50ms);  // frames of the pose before are delivered by now
     say("");
-    for (int i = 0; i < 400; ++i, std::this_thread::sleep_for(50ms))
-      if (count(slurp(out), std::string("odometry at ") + when) >= n) return true;
-    return false;
+    return printed(out, when, n);
   };
   for (std::size_t run = 0; run < 2; ++run) {
     say(kTape[run][0]);
@@ -225,6 +251,51 @@ TEST(UmbmarkRecordLive, BusSessionWritesTheSameCsvAsTheLogSession) {
   const std::string out = slurp(dir + "/bus.out");
   EXPECT_NE(out.find("odometry at start: x 0.1000 m, y -0.0500 m"), std::string::npos) << out;
   EXPECT_NE(out.find("odometry at end: x -0.1745 m, y 0.0621 m"), std::string::npos) << out;
+}
+
+// The end pose's PoseX waits in the queue when Enter is pressed, so the session empties it away;
+// its PoseYTheta arrives after, with the sequence number of the pair the session took at the
+// start. Joining the two would give the start's x with the end's y and theta (the CI failure of
+// stop 27: its cw run had dx = 0); the session must wait for the next whole pair.
+TEST(UmbmarkRecordLive, APoseXEmptiedFromTheQueueIsNotJoinedToTheNextPoseYTheta) {
+  ODO_REQUIRE_VM();
+  const std::string ifc = "vcanu2", dir = "/tmp/odo_umb_split";
+  vcan_up(ifc);
+  run("rm -rf " + dir + " && mkdir -p " + dir);
+  ASSERT_EQ(mkfifo((dir + "/split.fifo").c_str(), 0600), 0);
+  RawSender tx(ifc);
+  ASSERT_TRUE(tx.ok());
+  const pid_t rec = spawn(record_cmd(dir, "split", "--can " + ifc));
+  {
+    Answers a(dir + "/split.fifo");
+    ASSERT_TRUE(a.ok()) << slurp(dir + "/split.err");
+    a.say(kTape[0][0]);
+    a.say(kTape[0][1]);
+    a.say("");
+    std::this_thread::sleep_for(300ms);  // the session has emptied its queue and waits
+    const protocol::PoseMsg start{0.1000, -0.0500, 0.0100, 7}, end{0.3000, 0.2000, 0.0500, 7};
+    const auto s = pose_frames(start);
+    tx.send(s.first);
+    tx.send(s.second);
+    ASSERT_TRUE(printed(dir + "/split.out", "start", 1)) << slurp(dir + "/split.err");
+    const auto e = pose_frames(end);
+    tx.send(e.first);  // queued now, emptied by the Enter below
+    std::this_thread::sleep_for(100ms);
+    a.say("");
+    std::this_thread::sleep_for(300ms);
+    tx.send(e.second);  // seq 7, like the PoseX the session joined at the start
+    auto next = end;
+    next.seq = 8;
+    const auto n = pose_frames(next);
+    tx.send(n.first);
+    tx.send(n.second);
+    ASSERT_TRUE(printed(dir + "/split.out", "end", 1)) << slurp(dir + "/split.err");
+  }
+  kill(-rec, SIGTERM);
+  wait_exit(rec);
+  const std::string out = slurp(dir + "/split.out");
+  EXPECT_NE(out.find("odometry at start: x 0.1000 m, y -0.0500 m"), std::string::npos) << out;
+  EXPECT_NE(out.find("odometry at end: x 0.3000 m, y 0.2000 m"), std::string::npos) << out;
 }
 
 TEST(UmbmarkRecordLive, ReadsTheRunningDaemonsPoseAndSaysWhenThereIsNone) {
