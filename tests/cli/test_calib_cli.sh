@@ -102,12 +102,14 @@ check "odometryd with store exit 0" $?
 grep -q "calibration $tmp/cal.bin (file): ok, sequence 4: c_l=0.99925" "$tmp/err"
 st=$?; check "odometryd reports the store: $(grep calibration "$tmp/err")" $st
 if [ -z "${CROSS_EMULATOR:-}" ]; then
-  "$ODOMETRYD" --config "$tmp/d.toml" --duration 4 >"$tmp/live" 2>&1 &
+  # Waits on the daemon's own lines, not on guessed sleeps (a slow start under the sanitizers
+  # must not make the signals land before the handlers, or after the daemon has stopped).
+  "$ODOMETRYD" --config "$tmp/d.toml" --duration 60 >"$tmp/live" 2>&1 &
   pid=$!
-  sleep 1
+  wait_text "$tmp/live" "odometryd: loop "
   run "$ODOMCTL" calib set "${S[@]}" --cl 0.997 >/dev/null
   kill -HUP $pid
-  sleep 1
+  wait_text "$tmp/live" "SIGHUP: calibration"
   kill -INT $pid; wait $pid
   check "odometryd survives SIGHUP and stops cleanly" $?
   grep -q "SIGHUP: calibration .*ok, sequence 5: c_l=0.997" "$tmp/live"

@@ -7,10 +7,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 
 namespace odo::test {
 
@@ -38,6 +40,18 @@ inline pid_t spawn(const std::string& cmd) {
     _exit(127);
   }
   return pid;
+}
+
+// wait_for_text: whether the file `path` holds `text` within `seconds` (polled every 20 ms).
+// Tests wait on a line the program prints once it is ready instead of sleeping a guess: under
+// TCG on a loaded host a start has taken over 3 s.
+inline bool wait_for_text(const std::string& path, const std::string& text, double seconds = 30.0) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  for (;;) {
+    if (slurp(path).find(text) != std::string::npos) return true;
+    if (std::chrono::steady_clock::now() >= end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
 }
 
 // run: a shell command in the guest; returns its exit status.

@@ -65,8 +65,9 @@ TEST(CanBroadcastVcan, CandumpDecodesTheDaemonsPoseSetPoseAndLinkDownUp) {
       spawn(std::string("exec ") + ODOMETRYD_PATH + " --config " + dir +
             "/odometryd.toml --duration 5 --json > " + dir + "/out.json 2> " + dir + "/err.txt");
   // Set pose x = 10 m, y = -5 m, theta = 1 rad: x raw 10000 = 0x002710, y raw -5000 = 0xFFEC78,
-  // theta raw 10000 = 0x2710, little-endian; id 0x400 + 16 * 1 + 8.
-  std::this_thread::sleep_for(1500ms);
+  // theta raw 10000 = 0x2710, little-endian; id 0x400 + 16 * 1 + 8. Sent once the daemon says
+  // its loop runs (its CAN socket is bound before that line), not after a guessed sleep.
+  ASSERT_TRUE(wait_for_text(dir + "/err.txt", "odometryd: loop ")) << slurp(dir + "/err.txt");
   EXPECT_EQ(run("cansend " + ifc + " 418#10270078ECFF1027"), 0);
   std::this_thread::sleep_for(1000ms);
   // The outage as this test made it: from before `ip link set down` runs to after `ip link set

@@ -163,7 +163,11 @@ TEST(Watchdog, PingsOnlyWhileTheLoopAdvancesThenStopping) {
   EXPECT_EQ(alive.front().rfind("READY=1", 0), 0u) << alive.front();
   EXPECT_GE(count(alive, "WATCHDOG=1"), 5);
   stall = true;
-  std::this_thread::sleep_for(std::chrono::milliseconds(60));  // a ping in flight may still go
+  // The first check after the stall may still see progress and ping: wait for the check that
+  // saw none (not a fixed 60 ms: under qemu-user the watchdog thread can wake much later).
+  for (int i = 0; i < 5000 && wd->stalls() == 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_GE(wd->stalls(), 1u);
   const auto drained = sock.receive_for(10);
   const auto stalled = sock.receive_for(400);
   EXPECT_EQ(count(stalled, "WATCHDOG=1"), 0);  // the stuck loop gets no more pings
