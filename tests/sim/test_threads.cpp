@@ -7,7 +7,9 @@
 #include <atomic>
 #include <chrono>
 #include <fstream>
+#include <mutex>
 #include <sstream>
+#include <string>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -65,6 +67,39 @@ TEST(Threads, SetPoseRequestsAreNeverTorn) {
   EXPECT_EQ(run.loop->odometry().pose().y, -static_cast<double>(accepted));
 }
 
+// LockedText: an ostream sink that keeps what is written to it, readable from another thread
+// while the daemon writes (an ostringstream would be a data race there).
+class LockedText final : public std::streambuf {
+ public:
+  std::string text() const {
+    std::lock_guard<std::mutex> l(m_);
+    return text_;
+  }
+
+ protected:
+  int overflow(int c) override {
+    if (c == traits_type::eof()) return traits_type::not_eof(c);
+    std::lock_guard<std::mutex> l(m_);
+    text_.push_back(static_cast<char>(c));
+    return c;
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    std::lock_guard<std::mutex> l(m_);
+    text_.append(s, static_cast<std::size_t>(n));
+    return n;
+  }
+
+ private:
+  mutable std::mutex m_;
+  std::string text_;
+};
+
+std::size_t status_lines(const std::string& e) {
+  std::size_t lines = 0;
+  for (auto p = e.find("  rate="); p != std::string::npos; p = e.find("  rate=", p + 1)) ++lines;
+  return lines;
+}
+
 TEST(Threads, DaemonRealTimeWithStatusThreadStopsOnFlag) {
   // odometryd's own code path in real time: loop thread on CLOCK_MONOTONIC, status thread every
   // 50 ms, stopped from outside through the flag the signal handler sets.
@@ -74,21 +109,27 @@ TEST(Threads, DaemonRealTimeWithStatusThreadStopsOnFlag) {
   o.config_path = cfg;
   o.json = true;
   std::atomic<bool> stop{false};
-  std::ostringstream out, err;
+  std::ostringstream out;
+  LockedText err_text;
+  std::ostream err(&err_text);
   int rc = -1;
   std::thread daemon([&] { rc = fw::run_daemon(o, stop, out, err); });
-  // 2 s of wall time: under qemu-user beside another test, the daemon's start-up (config, store,
-  // threads) took most of an earlier 0.7 s and the loop ran only 25-32 ticks (armhf, 2026-11-24).
-  std::this_thread::sleep_for(std::chrono::seconds(2));
+  // At least 2 s of wall time, and on until the status thread has printed 6 lines (0.3 s of
+  // running loop), at most 60 s: under qemu-user beside another test the daemon's start-up
+  // (config, store, threads) took most of an earlier 0.7 s and the loop ran only 25-32 ticks
+  // (armhf, 2026-11-24); a fixed time is only a guess at how long a start takes.
+  const auto t0 = std::chrono::steady_clock::now();
+  for (auto t = t0; t - t0 < std::chrono::seconds(60); t = std::chrono::steady_clock::now()) {
+    if (t - t0 >= std::chrono::seconds(2) && status_lines(err_text.text()) >= 6) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   stop = true;
   daemon.join();
-  ASSERT_EQ(rc, 0) << err.str();
+  const std::string e = err_text.text();
+  ASSERT_EQ(rc, 0) << e;
   const auto j = nlohmann::json::parse(out.str());
   EXPECT_GT(j["ticks"].get<std::uint64_t>(), 40u);  // >= 0.2 s at 200 Hz even on a busy machine
-  std::size_t lines = 0;
-  const std::string e = err.str();
-  for (auto p = e.find("  rate="); p != std::string::npos; p = e.find("  rate=", p + 1)) ++lines;
-  EXPECT_GE(lines, 3u) << e;
+  EXPECT_GE(status_lines(e), 3u) << e;
 }
 
 }  // namespace
