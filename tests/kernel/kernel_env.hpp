@@ -42,16 +42,22 @@ inline pid_t spawn(const std::string& cmd) {
   return pid;
 }
 
-// wait_for_text: whether the file `path` holds `text` within `seconds` (polled every 20 ms).
-// Tests wait on a line the program prints once it is ready instead of sleeping a guess: under
-// TCG on a loaded host a start has taken over 3 s.
-inline bool wait_for_text(const std::string& path, const std::string& text, double seconds = 30.0) {
+// wait_until: whether `done()` becomes true within `seconds` (asked every 20 ms). Tests wait on
+// what the program prints once it is ready instead of sleeping a guess: under TCG on a loaded
+// host a start has taken over 3 s.
+template <class Done>
+bool wait_until(Done done, double seconds) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   for (;;) {
-    if (slurp(path).find(text) != std::string::npos) return true;
+    if (done()) return true;
     if (std::chrono::steady_clock::now() >= end) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+}
+
+// wait_for_text: whether the file `path` holds `text` within `seconds`.
+inline bool wait_for_text(const std::string& path, const std::string& text, double seconds = 30.0) {
+  return wait_until([&] { return slurp(path).find(text) != std::string::npos; }, seconds);
 }
 
 // run: a shell command in the guest; returns its exit status.

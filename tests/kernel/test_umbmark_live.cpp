@@ -154,9 +154,6 @@ const std::vector<protocol::PoseMsg> kPoses = {{0.1000, -0.0500, 0.0100, 0},
 const char* const kTape[2][5] = {{"1000", "800", "1012", "795", "1.5"},
                                  {"1000", "800", "990", "808", "-2.0"}};
 
-// drive_session: answers a running `umbmark record --runs 1` through the FIFO; before each Enter
-// it calls set_pose(k), and it waits for the session to print the pose it read before going on.
-// Returns false when the session did not get that far within 20 s.
 // Answers: the write end of a session's --answers FIFO, one line per say().
 class Answers {
  public:
@@ -183,30 +180,30 @@ bool shows(const std::string& out, const char* when, std::size_t n) {
 
 // printed: whether the session's stdout file `out` shows "odometry at <when>" n times within 20 s.
 bool printed(const std::string& out, const char* when, std::size_t n) {
-  for (int i = 0; i < 400; ++i, std::this_thread::sleep_for(50ms))
-    if (shows(out, when, n)) return true;
-  return false;
+  return wait_until([&] { return shows(out, when, n); }, 20.0);
 }
 
+// drive_session: answers a running `umbmark record --runs 1` through the FIFO; before each Enter
+// it calls set_pose(k), and it waits for the session to print the pose it read before going on.
+// Returns false when the session did not get that far within 20 s.
 template <class SetPose>
 bool drive_session(const std::string& fifo, const std::string& out, SetPose set_pose) {
   Answers a(fifo);
   if (!a.ok()) return false;
   int k = 0;
-  auto say = [&](const std::string& line) { a.say(line); };
   auto enter = [&](const char* when, std::size_t n) {
     set_pose(k++);
     std::this_thread::sleep_for(50ms);  // frames of the pose before are delivered by now
-    say("");
+    a.say("");
     return printed(out, when, n);
   };
   for (std::size_t run = 0; run < 2; ++run) {
-    say(kTape[run][0]);
-    say(kTape[run][1]);
+    a.say(kTape[run][0]);
+    a.say(kTape[run][1]);
     if (!enter("start", run + 1) || !enter("end", run + 1)) return false;
-    say(kTape[run][2]);
-    say(kTape[run][3]);
-    say(kTape[run][4]);
+    a.say(kTape[run][2]);
+    a.say(kTape[run][3]);
+    a.say(kTape[run][4]);
   }
   return true;
 }

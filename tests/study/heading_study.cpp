@@ -34,11 +34,11 @@
 // perfect heading (true+gd) reaches the 100x measure (median); the gyro alone with the oracle's
 // bias and scale (gyro*) and the oracle blend (blend*) do not (median < 100x).
 #include <algorithm>
-#include <iterator>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <string>
 #include <vector>
 
