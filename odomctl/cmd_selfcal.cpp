@@ -133,7 +133,7 @@ void run_fit_fixes(const FitFixesOpts& o, int& exit_code) {
   exit_code = kExitOk;
 }
 
-struct SimulateOpts {
+struct SelfcalOpts {
   int excursions = 20;
   double sigma_xy = 0.005;   // [m]
   double sigma_theta = 0.5;  // [deg]
@@ -155,7 +155,7 @@ struct SimDrive {
   std::vector<TimeNs> fix_times;
 };
 
-SimDrive plan_drive(const SimulateOpts& o, std::mt19937_64& rng) {
+SimDrive plan_drive(const SelfcalOpts& o, std::mt19937_64& rng) {
   SimDrive d;
   d.scenario.push_back({0.5, 0.0, 0.0});
   d.fix_times.push_back(from_seconds(0.3));
@@ -195,7 +195,7 @@ void record_fit(const fw::SelfCalEstimator& est, fw::SelfCalCounters& seen, SimO
 }
 
 // selfcal_setup: the estimator as the daemon would run it for these options.
-fw::SelfCalSetup selfcal_setup(const SimulateOpts& o, const Kinematics& believed) {
+fw::SelfCalSetup selfcal_setup(const SelfcalOpts& o, const Kinematics& believed) {
   fw::SelfCalSetup setup;
   setup.cfg.enabled = true;
   setup.cfg.min_fixes = o.min_fixes > 0 ? o.min_fixes : o.excursions + 1;
@@ -208,7 +208,7 @@ fw::SelfCalSetup selfcal_setup(const SimulateOpts& o, const Kinematics& believed
 
 // make_fix: a fix of the true pose at `now` with the options' noise; when `may_corrupt`, with
 // probability --outliers a wrong landmark match 0.5-5 m off (counted in `corrupted`).
-calib::PoseFix make_fix(const SimulateOpts& o, const Pose2& truth, TimeNs now, bool may_corrupt,
+calib::PoseFix make_fix(const SelfcalOpts& o, const Pose2& truth, TimeNs now, bool may_corrupt,
                         std::mt19937_64& rng, int& corrupted) {
   std::normal_distribution<double> n01;
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -229,7 +229,7 @@ calib::PoseFix make_fix(const SimulateOpts& o, const Pose2& truth, TimeNs now, b
 }
 
 // simulate_drive: the daemon's loop, recorder and estimator on the simulated LabMate.
-SimOutcome simulate_drive(const SimulateOpts& o, const SimDrive& d, std::mt19937_64& rng) {
+SimOutcome simulate_drive(const SelfcalOpts& o, const SimDrive& d, std::mt19937_64& rng) {
   const Kinematics believed = analysis::selfcal_kinematics({1.0, 1.0, analysis::kSelfCalBn});
   sim::VirtualClock clock;
   auto robot = *sim::SimRobot::create(sim::labmate_geometry(analysis::kSelfCalDn), d.scenario);
@@ -282,7 +282,7 @@ struct Scores {
 };
 
 // score: the three calibrations scored (NaN for the manual pass if its simulation failed).
-Scores score(const SimulateOpts& o, const calib::Factors& fin) {
+Scores score(const SelfcalOpts& o, const calib::Factors& fin) {
   analysis::UmbmarkSimOptions uo;
   uo.noise = o.smooth ? analysis::UmbmarkNoise::kNone : analysis::UmbmarkNoise::kPaper;
   uo.seed = o.seed;
@@ -305,7 +305,7 @@ Scores score(const SimulateOpts& o, const calib::Factors& fin) {
 
 // write_plot: --plot, the convergence with E_max,syst (5 + 5 and score_runs + score_runs
 // squares: nominal, self-calibrated, one manual pass) as notes; false (said) when not written.
-bool write_plot(const SimulateOpts& o, const SimOutcome& r, const Scores& sc) {
+bool write_plot(const SelfcalOpts& o, const SimOutcome& r, const Scores& sc) {
   const double *e5 = sc.e5, *e_sys = sc.e_sys;
   std::ostringstream title, n5, nsys;
   title << "odomctl selfcal simulate: " << o.excursions << " excursions, fixes sigma "
@@ -327,7 +327,7 @@ bool write_plot(const SimulateOpts& o, const SimOutcome& r, const Scores& sc) {
   return write_output_file(o.plot, svg, "selfcal simulate");
 }
 
-void run_simulate(const SimulateOpts& o, int& exit_code) {
+void run_simulate(const SelfcalOpts& o, int& exit_code) {
   if (!output_paths_ok({o.plot}, "selfcal simulate")) {
     exit_code = kExitBadInput;
     return;
@@ -389,7 +389,7 @@ void run_simulate(const SimulateOpts& o, int& exit_code) {
 void add_selfcal(CLI::App& app, int& exit_code) {
   CLI::App* sc = app.add_subcommand("selfcal", "self-calibration from absolute fixes");
   sc->require_subcommand(1);
-  auto o = std::make_shared<SimulateOpts>();
+  auto o = std::make_shared<SelfcalOpts>();
   CLI::App* c = sc->add_subcommand(
       "simulate", "random excursions from a dock with fixes, through the daemon's estimator");
   c->add_option("--excursions", o->excursions, "excursions, 1..1000")

@@ -5,7 +5,6 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
-#include <numbers>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -21,8 +20,6 @@ namespace odo::ctl {
 namespace {
 
 using nlohmann::json;
-
-constexpr double kDeg = 180.0 / std::numbers::pi;
 
 json opt(const std::optional<double>& v) {
   return v ? json(*v) : json(nullptr);

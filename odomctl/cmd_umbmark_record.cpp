@@ -11,7 +11,6 @@
 #include <iostream>
 #include <map>
 #include <memory>
-#include <numbers>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -34,7 +33,6 @@ namespace {
 using calib::Direction;
 using calib::UmbmarkRun;
 
-constexpr double kDeg = 180.0 / std::numbers::pi;
 constexpr const char* kCmd = "umbmark record";
 
 struct RecordOpts {
