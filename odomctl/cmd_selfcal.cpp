@@ -75,10 +75,10 @@ bool fit_input(const FitFixesOpts& o, calib::FixTrack& track, calib::SelfCalConf
   return true;
 }
 
-void print_result(const calib::SelfCalResult& r, bool json) {
+void print_result(const calib::SelfCalResult& r, bool as_json) {
   std::vector<int> rejected;  // fix numbers, 1 = the first data row of FIXES.csv
   for (int i : r.rejected) rejected.push_back(i + 1);
-  if (json) {
+  if (as_json) {
     nlohmann::json j{{"c_l", r.estimate.c_l},
                      {"c_r", r.estimate.c_r},
                      {"wheelbase", r.estimate.wheelbase},
