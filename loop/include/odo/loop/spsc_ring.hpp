@@ -35,7 +35,7 @@ class SpscRing {
       dropped_.fetch_add(1, std::memory_order_relaxed);
       return false;
     }
-    buf_[h & mask_] = v;
+    slot(h) = v;
     head_.store(h + 1, std::memory_order_release);
     return true;
   }
@@ -50,7 +50,7 @@ class SpscRing {
   bool pop(T& out) noexcept {
     const std::uint64_t t = tail_.load(std::memory_order_relaxed);
     if (t == head_.load(std::memory_order_acquire)) return false;
-    out = buf_[t & mask_];
+    out = slot(t);
     tail_.store(t + 1, std::memory_order_release);
     return true;
   }
@@ -59,6 +59,10 @@ class SpscRing {
   std::uint64_t dropped() const noexcept { return dropped_.load(std::memory_order_relaxed); }
 
  private:
+  // slot: the value of running index i. The 64-bit indices never wrap in practice; the masked
+  // index is below the capacity, which is a size_t, so the narrowing on 32-bit targets is exact.
+  T& slot(std::uint64_t i) noexcept { return buf_[static_cast<std::size_t>(i & mask_)]; }
+
   std::vector<T> buf_;
   std::size_t mask_ = 0;
   alignas(64) std::atomic<std::uint64_t> head_{0};  // next write (producer)
