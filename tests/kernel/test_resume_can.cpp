@@ -475,9 +475,9 @@ std::string sh_output(const std::string& cmd) {
 // namespace in the VM (unshare; the harness's own init is busybox) and starts the project's
 // unit, firmware/systemd/odometryd.service as shipped (hardening, ProcSubset=pid, WatchdogSec=2s,
 // Restart=on-failure, RuntimeDirectoryPreserve=restart, Environment=ODOMETRYD_BOOT_ID=%b) with
-// ExecStart pointed at the built binary and a test drop-in (no default dependencies: nothing
-// else of a boot is started; stdout to a file). The CAN backend is fed as above. The daemon is
-// killed with SIGKILL, then hung with SIGSTOP so that the watchdog fires; systemd restarts it
+// the built binary installed at its ExecStart path and a test drop-in (no default dependencies:
+// nothing else of a boot is started; stdout to a file). The CAN backend is fed as above. The daemon
+// is killed with SIGKILL, then hung with SIGSTOP so that the watchdog fires; systemd restarts it
 // both times and both restarts resume from the state file in /run/odometryd, continuing the
 // stored pose by the gap's counts; the record carries the kernel's boot id (from %b: the unit
 // hides /proc/sys).
@@ -489,9 +489,12 @@ TEST(ResumeCanVcan, UnderSystemdAfterSigkillAndWatchdogRestartsResume) {
   run("rm -rf " + dir + " /run/odometryd && mkdir -p " + dir + " /etc/odometryd " + unit_dir +
       "/odometryd.service.d");
   const std::string log = dir + "/odometryd.log", manager = dir + "/systemd.log";
-  ASSERT_EQ(run(std::string("sed 's|^ExecStart=/usr/bin/odometryd |ExecStart=") + ODOMETRYD_PATH +
-                " |' " + ODO_SOURCE_DIR + "/firmware/systemd/odometryd.service > " + unit_dir +
-                "/odometryd.service"),
+  // The built binary goes where the package puts it, /usr/bin (in the VM, / is a throwaway
+  // overlay): the unit's ProtectHome=yes hides /root and /home from the service, and a clone
+  // often lives there (a fresh CI chroot's /root/repo), where systemd could not exec the binary
+  // (status 203/EXEC). The unit is then the shipped file, unchanged.
+  ASSERT_EQ(run(std::string("install -m 0755 ") + ODOMETRYD_PATH + " /usr/bin/odometryd && cp " +
+                ODO_SOURCE_DIR + "/firmware/systemd/odometryd.service " + unit_dir + "/"),
             0);
   {
     std::ofstream d(unit_dir + "/odometryd.service.d/test.conf");
