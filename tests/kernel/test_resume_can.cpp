@@ -448,18 +448,6 @@ int count_of(const std::string& path, const std::string& what) {
   return n;
 }
 
-// wait_until: polls `done` every 50 ms for at most `limit` seconds.
-template <class F>
-bool wait_until(double limit, F done) {
-  const auto t0 = std::chrono::steady_clock::now();
-  while (!done()) {
-    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() > limit)
-      return false;
-    std::this_thread::sleep_for(50ms);
-  }
-  return true;
-}
-
 std::string sh_output(const std::string& cmd) {
   std::string out;
   if (std::FILE* p = popen(cmd.c_str(), "r")) {
@@ -536,13 +524,15 @@ TEST(ResumeCanVcan, UnderSystemdAfterSigkillAndWatchdogRestartsResume) {
   // systemctl must run in the namespace (systemd refuses a peer whose pid it cannot see), and
   // the harness runs its command in a chroot, where systemctl does nothing unless told.
   std::string systemctl;
-  ASSERT_TRUE(wait_until(30, [&] {
-    const std::string child = sh_output("cat /proc/" + std::to_string(sd) + "/task/*/children");
-    if (child.empty()) return false;
-    systemctl = "nsenter -t " + child + " -p -m -r -w env SYSTEMD_IGNORE_CHROOT=1 systemctl ";
-    return true;
-  }));
-  ASSERT_TRUE(wait_until(120, [&] { return count_of(log, "odometryd: resume: ") >= 1; }))
+  ASSERT_TRUE(wait_until(
+      [&] {
+        const std::string child = sh_output("cat /proc/" + std::to_string(sd) + "/task/*/children");
+        if (child.empty()) return false;
+        systemctl = "nsenter -t " + child + " -p -m -r -w env SYSTEMD_IGNORE_CHROOT=1 systemctl ";
+        return true;
+      },
+      30));
+  ASSERT_TRUE(wait_until([&] { return count_of(log, "odometryd: resume: ") >= 1; }, 120))
       << slurp(manager) << slurp(log);
   const double first_start =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -571,7 +561,7 @@ TEST(ResumeCanVcan, UnderSystemdAfterSigkillAndWatchdogRestartsResume) {
   auto hit = [&](const char* signal, int nth) {
     std::this_thread::sleep_for(800ms);  // in motion
     ASSERT_EQ(run(systemctl + "kill --signal=" + signal + " odometryd.service"), 0);
-    ASSERT_TRUE(wait_until(60, [&] { return count_of(log, "odometryd: resume: ") >= nth; }))
+    ASSERT_TRUE(wait_until([&] { return count_of(log, "odometryd: resume: ") >= nth; }, 60))
         << slurp(manager) << slurp(log);
     auto rec = fw::read_state_file("/run/odometryd/state.stopped");
     ASSERT_TRUE(rec.ok()) << rec.error().message;
