@@ -21,6 +21,16 @@ wait_pane() {
   done
   echo "timeout waiting for '$1' in the pane:"; cat "$tmp/pane"; return 1
 }
+# wait_gone: until the session has ended (Ctrl-C ends odomctl and the pane's shell with it; at
+# most 20 s).
+wait_gone() {
+  local i
+  for i in $(seq 200); do
+    tm has-session -t t 2>/dev/null || return 0
+    sleep 0.1
+  done
+  echo "timeout waiting for the session to end"; return 1
+}
 # type TEXT: the keys of TEXT and Enter.
 type_() { tm send-keys -t t -l -- "$1"; tm send-keys -t t Enter; }
 
@@ -50,8 +60,8 @@ wait_pane "Run 2 of 10" &&
   grep -q "cw  n 1, centre of gravity x +12.0 mm, y +3.0 mm" "$tmp/pane"
 check "record: return error and running centre of gravity on screen" $?
 # Interrupted with Ctrl-C in the next run: the saved run stays, the rerun resumes at run 2.
-tm send-keys -t t C-c && sleep 1
-grep -q "^cw,0.0120,0.0030,,0$" "$tmp/runs.csv" && [ "$(wc -l <"$tmp/runs.csv")" = 2 ]
+tm send-keys -t t C-c && wait_gone &&
+  grep -q "^cw,0.0120,0.0030,,0$" "$tmp/runs.csv" && [ "$(wc -l <"$tmp/runs.csv")" = 2 ]
 check "record: Ctrl-C keeps the saved run: $(tr '\n' '|' <"$tmp/runs.csv")" $?
 tm kill-session -t t 2>/dev/null
 tm new-session -d -s t -x 120 -y 60 \
@@ -61,10 +71,12 @@ wait_pane "Run 2 of 10: cw" && grep -q "1 already in runs.csv" "$tmp/pane"
 check "record resumes at run 2 in a terminal" $?
 tm kill-session -t t 2>/dev/null
 
-# simulate's progress: one line rewritten in place (\r), raw bytes of the pane's output.
-tm new-session -d -s t -x 120 -y 20 "sleep 1; ${CROSS_EMULATOR:-} $ODOMCTL umbmark simulate --runs 10 --passes 2 >/dev/null; echo done; sleep 30"
-tm pipe-pane -o -t t "cat >$tmp/raw"
-wait_pane "^done"
+# simulate's progress: one line rewritten in place (\r), raw bytes of the pane's output. The
+# pane waits on a tmux channel until the pipe is attached (a fixed sleep raced it), and the
+# bytes are counted once `cat` has written the final line too (the pane shows it first).
+tm new-session -d -s t -x 120 -y 20 "tmux wait-for piped; ${CROSS_EMULATOR:-} $ODOMCTL umbmark simulate --runs 10 --passes 2 >/dev/null; echo done; sleep 30"
+tm pipe-pane -o -t t "cat >$tmp/raw" && tm wait-for -S piped
+wait_pane "^done" && wait_text "$tmp/raw" "60 squares driven"
 updates=$(grep -a -o "/60 squares, [0-9]* s left" "$tmp/raw" | wc -l)
 lines=$(grep -a -c "squares, " "$tmp/raw")
 [ "$updates" -ge 2 ] && [ "$lines" -le 1 ] && grep -q "umbmark simulate: 60 squares driven" "$tmp/pane" &&
