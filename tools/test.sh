@@ -85,13 +85,14 @@ counted() {
 }
 
 # note_failures LOG: adds each test ctest listed as failed in LOG to `failures`, with the first
-# lines of GoogleTest's "Failure" reports in LOG (at most 12, so the summary stays readable).
+# lines of GoogleTest's "Failure" reports and of the script tests' "FAIL: <check>" lines in LOG
+# (at most 12, so the summary stays readable: CI shows only the tail of the run).
 note_failures() {
   local log=$1 t
   while IFS= read -r t; do failures+=("$log: ${t#"${t%%[![:space:]]*}"}"); done < <(
     sed -n '/The following tests FAILED:/,$p' "$log" | grep -E '^[[:space:]]+[0-9]+ - ' || true)
   while IFS= read -r t; do failures+=("    $t"); done < <(
-    grep -A3 -E ': Failure$|\*\*\*(Timeout|Exception)' "$log" | grep -v -e '^--$' -e '^[[:space:]]*$' | head -12 || true)
+    grep -A3 -E ': Failure$|\*\*\*(Timeout|Exception)|^FAIL: ' "$log" | grep -v -e '^--$' -e '^[[:space:]]*$' | head -12 || true)
 }
 
 # gated STAGE LOG CMD...: `counted`, then the CI gate over what that run reported. Returns 0

@@ -75,13 +75,15 @@ check "CI, test skipped: the reason is printed" \
 out=$(stage "" "$tmp/fake-vm-run.sh")
 check "no CI, test skipped: ok, 1 passed, 0 failed, 1 skipped" \
   "$(echo "$out" | grep -q '^kernel: ok' && echo "$out" | grep -qx 'all stages: 1 passed, 0 failed, 1 skipped'; echo $?)"
-# 5. A failing test is named in the summary, with its GoogleTest failure report: CI shows only
-# the tail of the run.
+# 5. A failing test is named in the summary, with its GoogleTest failure report or a script's
+# failed check: CI shows only the tail of the run.
 cat >"$tmp/w/build/default/CTestTestfile.cmake" <<'CT'
 add_test(k_pass "/bin/true")
 set_tests_properties(k_pass PROPERTIES LABELS kernel)
 add_test(k_fail "/bin/sh" "-c" "printf 'x.cpp:7: Failure\\nExpected: gap < 1.5\\n'; exit 1")
 set_tests_properties(k_fail PROPERTIES LABELS kernel)
+add_test(k_script "/bin/sh" "-c" "echo 'FAIL: pane shows the prompt'; exit 1")
+set_tests_properties(k_script PROPERTIES LABELS kernel)
 CT
 out=$(cd "$tmp/w" && CI=true ODO_VM_RUN="$tmp/fake-vm-run.sh" bash -c '
   . "$0"/tools/test.sh
@@ -91,6 +93,8 @@ echo "$out"
 check "failed test named with its log" \
   "$(echo "$out" | grep -qE '^build/default/kernel.log: 2 - k_fail \(Failed\)$'; echo $?)"
 check "its failure report follows" "$(echo "$out" | grep -q 'Expected: gap < 1.5'; echo $?)"
+check "a script test's failed check follows" \
+  "$(echo "$out" | grep -q 'FAIL: pane shows the prompt'; echo $?)"
 
 # 6. Under CI, a stage that ran no test at all fails.
 rm "$tmp/w/build/default/CTestTestfile.cmake"
