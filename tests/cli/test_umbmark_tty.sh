@@ -11,6 +11,9 @@ fi
 sock="odo-tty-$$"
 tm() { tmux -L "$sock" -f /dev/null "$@"; }
 trap 'tm kill-server 2>/dev/null; rm -rf "$tmp"' EXIT
+# A session that outlives the test's own: tmux exits once its last session ends, and a client
+# started meanwhile can reach the exiting server and fail; one server serves the whole script.
+tm new-session -d -s keep "sleep 600"
 # wait_pane TEXT: until the visible pane holds TEXT (at most 20 s).
 wait_pane() {
   local i
