@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "gpiod_util.hpp"
+#include "odo/drivers/monotonic_clock.hpp"
 #include "odo/drivers/quad_tracker.hpp"
 
 namespace odo::drivers {
@@ -30,12 +31,6 @@ struct Event {
   bool rising = false;
   bool done = false;  // consumed as part of an earlier same-timestamp group
 };
-
-TimeNs monotonic_now() noexcept {
-  timespec t{};
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return static_cast<TimeNs>(t.tv_sec) * kNsPerSecond + t.tv_nsec;
-}
 
 // The published state of one wheel: written by the event thread, read by the loop.
 struct WheelAtomics {

@@ -6,10 +6,14 @@
 
 namespace odo::drivers {
 
-TimeNs MonotonicClock::now() noexcept {
+TimeNs monotonic_now() noexcept {
   timespec ts{};
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return static_cast<TimeNs>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
+}
+
+TimeNs MonotonicClock::now() noexcept {
+  return monotonic_now();
 }
 
 void MonotonicClock::sleep_until(TimeNs deadline) noexcept {

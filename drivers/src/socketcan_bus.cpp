@@ -6,22 +6,17 @@
 #include <net/if.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
-#include <time.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 
+#include "odo/drivers/monotonic_clock.hpp"
+
 namespace odo::drivers {
 namespace {
 
 static_assert(sizeof(can_filter) == 2 * sizeof(std::uint32_t), "can_filter is two canid_t");
-
-std::int64_t monotonic_ns() noexcept {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 }  // namespace
 
@@ -136,7 +131,7 @@ Result<std::unique_ptr<SocketCanBus>> SocketCanBus::open(const SocketCanOptions&
 
 bool SocketCanBus::try_reopen() noexcept {
   if (fd_ >= 0) return true;
-  const std::int64_t now = monotonic_ns();
+  const std::int64_t now = monotonic_now();
   if (now < next_reopen_ns_) return false;
   next_reopen_ns_ = now + static_cast<std::int64_t>(opts_.reopen_period * 1e9);
   const char* stage = "";
@@ -171,7 +166,7 @@ CanTx SocketCanBus::send(const CanFrame& f) noexcept {
         // The interface vanished (or came back with a new index): re-open it by name after
         // one retry period.
         close_socket();
-        next_reopen_ns_ = monotonic_ns() + static_cast<std::int64_t>(opts_.reopen_period * 1e9);
+        next_reopen_ns_ = monotonic_now() + static_cast<std::int64_t>(opts_.reopen_period * 1e9);
       }
       break;
     default:
@@ -191,7 +186,7 @@ bool SocketCanBus::receive(CanFrame& out) noexcept {
       // ENODEV after the interface vanished: re-open later.
       if (errno_means_vanished(errno)) {
         close_socket();
-        next_reopen_ns_ = monotonic_ns() + static_cast<std::int64_t>(opts_.reopen_period * 1e9);
+        next_reopen_ns_ = monotonic_now() + static_cast<std::int64_t>(opts_.reopen_period * 1e9);
       }
       return false;
     }
@@ -200,7 +195,7 @@ bool SocketCanBus::receive(CanFrame& out) noexcept {
     out.len = cf.can_dlc > 8 ? 8 : cf.can_dlc;
     out.data = {};
     std::memcpy(out.data.data(), cf.data, out.len);
-    out.stamp = monotonic_ns();
+    out.stamp = monotonic_now();
     ++counters_.received;
     return true;
   }

@@ -1,19 +1,9 @@
 // The parts of the bridge that need no DDS: the clock offset of the time stamps and the Cyclone
 // DDS configuration text (built with -DODO_ROS2=OFF too).
-#include <time.h>
-
+#include "clock.hpp"
 #include "odo/ros2/bridge.hpp"
 
 namespace odo::ros2 {
-namespace {
-
-TimeNs now_ns(clockid_t id) {
-  timespec ts{};
-  clock_gettime(id, &ts);
-  return static_cast<TimeNs>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
-}
-
-}  // namespace
 
 TimeNs realtime_minus_monotonic() {
   const TimeNs m0 = now_ns(CLOCK_MONOTONIC);

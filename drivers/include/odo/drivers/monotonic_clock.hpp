@@ -6,6 +6,9 @@
 
 namespace odo::drivers {
 
+// monotonic_now: CLOCK_MONOTONIC now [ns]; the drivers' time stamps are on this clock.
+TimeNs monotonic_now() noexcept;
+
 class MonotonicClock final : public Clock {
  public:
   TimeNs now() noexcept override;
