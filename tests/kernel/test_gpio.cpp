@@ -20,16 +20,6 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// wait_for: polls `done` every 5 ms until it holds or `limit` passes; returns its last value.
-bool wait_for(const std::function<bool()>& done, std::chrono::milliseconds limit) {
-  const auto end = std::chrono::steady_clock::now() + limit;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > end) return false;
-    std::this_thread::sleep_for(5ms);
-  }
-  return true;
-}
-
 // FlowControl: the v1 uAPI of libgpiod 1.6 labels an edge rising or falling from the line level
 // when the kernel's IRQ thread runs, and queues 16 events per line. On one emulated vCPU shared
 // with the writer, a second edge of a line can come before that thread ran (a mislabelled
@@ -93,7 +83,7 @@ TEST(GpioQuadratureKernel, ThousandsOfEdgesBothDirectionsCountExactly) {
     if (i < 500) right.step(+1);
   }
   const std::uint64_t edges = 3000 + 1200 + 2000 + 500;
-  ASSERT_TRUE(wait_for([&] { return e.wheel(0).edges + e.wheel(1).edges >= edges; }, 20s))
+  ASSERT_TRUE(wait_until([&] { return e.wheel(0).edges + e.wheel(1).edges >= edges; }, 20))
       << "edges seen " << e.wheel(0).edges + e.wheel(1).edges << " of " << edges;
   std::this_thread::sleep_for(100ms);  // nothing more may arrive
   const EncoderSample s = e.read(0);
@@ -113,11 +103,11 @@ TEST(GpioQuadratureKernel, IndexLineLatchesTheCount) {
   FlowControl flow{[&] { return e.wheel(0).received; }};
   QuadWriter left{sim, 0, 1, &flow};
   for (int i = 0; i < 37; ++i) left.step(+1);
-  ASSERT_TRUE(wait_for([&] { return e.wheel(0).count == 37; }, 5s));
+  ASSERT_TRUE(wait_until([&] { return e.wheel(0).count == 37; }, 5));
   ASSERT_TRUE(sim.pull(4, true));  // index pulse
   ASSERT_TRUE(sim.pull(4, false));
   for (int i = 0; i < 5; ++i) left.step(+1);
-  ASSERT_TRUE(wait_for([&] { return e.wheel(0).count == 42; }, 5s));
+  ASSERT_TRUE(wait_until([&] { return e.wheel(0).count == 42; }, 5));
   EXPECT_EQ(e.wheel(0).index_pulses, 1u);
   EXPECT_EQ(e.wheel(0).index_count, 37);
 }
@@ -137,7 +127,7 @@ TEST(GpioQuadratureKernel, LostEventsAreDetectedAndNotCounted) {
   left.step(+1);
   left.step(+1);
   e.hold(false);
-  ASSERT_TRUE(wait_for([&] { return e.wheel(0).count == 2; }, 5s));
+  ASSERT_TRUE(wait_until([&] { return e.wheel(0).count == 2; }, 5));
   EXPECT_EQ(e.wheel(0).invalid, 0u);
 
   // Injection: A toggles 41 times while the reader is held. The kernel keeps 16 events and
@@ -180,7 +170,7 @@ TEST(GpioQuadratureKernel, LostEventsAreDetectedAndNotCounted) {
   FlowControl flow{[&] { return e.wheel(0).received; }, e.wheel(0).received};
   left.flow = &flow;
   for (int i = 0; i < 100; ++i) left.step(+1);
-  ASSERT_TRUE(wait_for([&] { return e.wheel(0).count == base + 100; }, 5s))
+  ASSERT_TRUE(wait_until([&] { return e.wheel(0).count == base + 100; }, 5))
       << "count " << e.wheel(0).count << " expected " << base + 100;
   EXPECT_EQ(e.wheel(0).invalid, inv);
 }
