@@ -63,12 +63,9 @@ rec_pid=$!
 exec 3>"$tmp/answers"
 # wait_for N TEXT: until the session's transcript holds TEXT N times (the session has read
 # the pose before the log is replaced by the next daemon run).
+seen() { [ "$(grep -c -- "$2" "$tmp/session")" -ge "$1" ]; }
 wait_for() {
-  local i
-  for i in $(seq 600); do
-    [ "$(grep -c -- "$2" "$tmp/session")" -ge "$1" ] && return 0
-    sleep 0.1
-  done
+  poll 60 seen "$1" "$2" && return 0
   echo "timeout waiting for '$2' x$1"; return 1
 }
 n=0

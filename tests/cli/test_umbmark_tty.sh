@@ -15,23 +15,16 @@ trap 'tm kill-server 2>/dev/null; rm -rf "$tmp"' EXIT
 # started meanwhile can reach the exiting server and fail; one server serves the whole script.
 tm new-session -d -s keep "sleep 600"
 # wait_pane TEXT: until the visible pane holds TEXT (at most 20 s).
+pane_has() { tm capture-pane -p -t t >"$tmp/pane" 2>/dev/null; grep -q -- "$1" "$tmp/pane"; }
 wait_pane() {
-  local i
-  for i in $(seq 200); do
-    tm capture-pane -p -t t >"$tmp/pane" 2>/dev/null
-    grep -q -- "$1" "$tmp/pane" && return 0
-    sleep 0.1
-  done
+  poll 20 pane_has "$1" && return 0
   echo "timeout waiting for '$1' in the pane:"; cat "$tmp/pane"; return 1
 }
 # wait_gone: until the session has ended (Ctrl-C ends odomctl and the pane's shell with it; at
 # most 20 s).
+no_session() { ! tm has-session -t t 2>/dev/null; }
 wait_gone() {
-  local i
-  for i in $(seq 200); do
-    tm has-session -t t 2>/dev/null || return 0
-    sleep 0.1
-  done
+  poll 20 no_session && return 0
   echo "timeout waiting for the session to end"; return 1
 }
 # type TEXT: the keys of TEXT and Enter.
