@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "odo/analysis/replay.hpp"
+#include "odo/hal/angle.hpp"
 
 namespace odo::ctl {
 
@@ -59,8 +60,8 @@ void run_replay(const ReplayOpts& o, int& exit_code) {
     std::cout << "samples   " << r->samples << "\n"
               << "x         " << r->pose.x << " m\n"
               << "y         " << r->pose.y << " m\n"
-              << "theta     " << r->pose.theta << " rad (cumulative, "
-              << r->pose.theta * 180.0 / 3.14159265358979323846 << " deg)\n"
+              << "theta     " << r->pose.theta << " rad (cumulative, " << r->pose.theta * kDegPerRad
+              << " deg)\n"
               << "distance  " << r->distance << " m\n";
     if (r->fused)
       std::cout << "gyro      fused: " << r->fusion.disagreements << " disagreements, "

@@ -16,6 +16,7 @@
 #include "odo/analysis/umbmark_tools.hpp"
 #include "odo/calibration/selfcal.hpp"
 #include "odo/firmware/selfcal_estimator.hpp"
+#include "odo/hal/angle.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/sim/floor.hpp"
 #include "odo/sim/sim_encoder.hpp"
@@ -212,7 +213,7 @@ calib::PoseFix make_fix(const SelfcalOpts& o, const Pose2& truth, TimeNs now, bo
                         std::mt19937_64& rng, int& corrupted) {
   std::normal_distribution<double> n01;
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const double sth = o.sigma_theta * std::numbers::pi / 180.0;
+  const double sth = o.sigma_theta * kRadPerDeg;
   calib::PoseFix f{now,
                    truth.x + o.sigma_xy * n01(rng),
                    truth.y + o.sigma_xy * n01(rng),

@@ -67,10 +67,12 @@ void print_compute(std::ostream& out, const calib::UmbmarkResult& r, double whee
       << "centre of gravity ccw x " << r.ccw.x * 1e3 << " mm, y " << r.ccw.y * 1e3 << " mm, r_cg "
       << r.ccw.r * 1e3 << " mm\n"
       << "E_max,syst           " << r.e_max_syst * 1e3 << " mm\n"
-      << std::setprecision(4) << "alpha (Type A)       " << r.ab.alpha * kDeg
-      << " deg per corner (x: " << r.ab.alpha_x * kDeg << ", y: " << r.ab.alpha_y * kDeg << ")\n"
-      << "beta (Type B)        " << r.ab.beta * kDeg << " deg per leg (x: " << r.ab.beta_x * kDeg
-      << ", y: " << r.ab.beta_y * kDeg << ")\n";
+      << std::setprecision(4) << "alpha (Type A)       " << r.ab.alpha * kDegPerRad
+      << " deg per corner (x: " << r.ab.alpha_x * kDegPerRad << ", y: " << r.ab.alpha_y * kDegPerRad
+      << ")\n"
+      << "beta (Type B)        " << r.ab.beta * kDegPerRad
+      << " deg per leg (x: " << r.ab.beta_x * kDegPerRad << ", y: " << r.ab.beta_y * kDegPerRad
+      << ")\n";
   if (r.radius) {
     out << std::setprecision(1) << "R                    " << *r.radius << " m\n";
   } else {
@@ -94,7 +96,7 @@ void print_compute(std::ostream& out, const calib::UmbmarkResult& r, double whee
                         : "not worthwhile (E_max,syst <= 3 x SEM)")
       << "\n";
   if (r.eps_theta_nonsys) {
-    out << std::setprecision(3) << "eps_theta,nonsys     " << *r.eps_theta_nonsys * kDeg
+    out << std::setprecision(3) << "eps_theta,nonsys     " << *r.eps_theta_nonsys * kDegPerRad
         << " deg (extended UMBmark)\n";
   }
 }
@@ -267,8 +269,9 @@ json gyro_comparison_json(const analysis::UmbmarkGyroComparison& g) {
 
 void print_gyro_comparison(const analysis::UmbmarkGyroComparison& g, const std::string& cls) {
   std::cout << std::setprecision(3) << "gyro (" << cls
-            << ", exact reference): eps_theta,nonsys plain " << g.eps_plain.value_or(0.0) * kDeg
-            << " deg, fused " << g.eps_fused.value_or(0.0) * kDeg << " deg\n"
+            << ", exact reference): eps_theta,nonsys plain "
+            << g.eps_plain.value_or(0.0) * kDegPerRad << " deg, fused "
+            << g.eps_fused.value_or(0.0) * kDegPerRad << " deg\n"
             << "  mean return error, bumps: uncalibrated plain " << g.uncal_plain_bumps * 1e3
             << " mm, calibrated fused " << g.cal_fused_bumps * 1e3 << " mm\n"
             << "  mean return error, smooth, calibrated: plain " << g.cal_plain_smooth * 1e3
@@ -350,7 +353,7 @@ void print_simulate_text(const analysis::UmbmarkSimResult& r, const std::string&
   std::cout << std::setprecision(1) << "improvement (first before / last after): " << r.improvement
             << "-fold\n";
   if (const auto& e = r.passes.front().result.eps_theta_nonsys) {
-    std::cout << std::setprecision(3) << "eps_theta,nonsys (extended UMBmark): " << *e * kDeg
+    std::cout << std::setprecision(3) << "eps_theta,nonsys (extended UMBmark): " << *e * kDegPerRad
               << " deg\n";
   }
   if (r.gyro) print_gyro_comparison(*r.gyro, gyro_class);

@@ -237,7 +237,7 @@ std::string mm(double v) {
 
 void print_pose(const char* when, const Pose2& p) {
   std::cout << "  odometry at " << when << ": x " << std::fixed << std::setprecision(4) << p.x
-            << " m, y " << p.y << " m, theta " << std::setprecision(3) << p.theta * kDeg
+            << " m, y " << p.y << " m, theta " << std::setprecision(3) << p.theta * kDegPerRad
             << " deg\n";
 }
 
@@ -302,11 +302,11 @@ bool record_run(Prompter& in, PoseFeed& feed, const RecordOpts& o, Direction d, 
       !in.number(bumps || o.bumps ? "  heading change [deg, counter-clockwise +]: "
                                   : "  heading change [deg, counter-clockwise +; empty: not "
                                     "measured]: ",
-                 -180.0, 180.0, 1.0 / kDeg, !(bumps || o.bumps), heading))
+                 -180.0, 180.0, kRadPerDeg, !(bumps || o.bumps), heading))
     return false;
   run = calib::tape_return_error(d, bumps, o.wall, t0, t1, heading, p0, p1);
   std::cout << "  return error (absolute - odometry): ex " << mm(run.ex) << ", ey " << mm(run.ey);
-  if (run.etheta) std::cout << ", etheta " << std::showpos << *run.etheta * kDeg << " deg";
+  if (run.etheta) std::cout << ", etheta " << std::showpos << *run.etheta * kDegPerRad << " deg";
   std::cout << std::noshowpos << "\n";
   return true;
 }

@@ -3,17 +3,14 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
-#include <numbers>
 #include <ostream>
 #include <string>
 
 #include "odo/calibration/record.hpp"
 #include "odo/calibration/umbmark.hpp"
+#include "odo/hal/angle.hpp"
 
 namespace odo::ctl {
-
-// kDeg: degrees per radian, for the reports' degree figures.
-inline constexpr double kDeg = 180.0 / std::numbers::pi;
 
 // compute_json: the documented keys of `umbmark compute --json` (SI units, radians); also what
 // `odomctl calib import` reads (c_l, c_r, b_new, e_max_syst, n_cw, n_ccw).

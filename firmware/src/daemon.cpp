@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <iomanip>
 #include <mutex>
-#include <numbers>
 #include <ostream>
 #include <thread>
 
@@ -24,14 +23,13 @@
 #include "odo/firmware/state_persist.hpp"
 #include "odo/firmware/timing_report.hpp"
 #include "odo/firmware/watchdog.hpp"
+#include "odo/hal/angle.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/sim/truth.hpp"
 #include "ros2_output.hpp"
 
 namespace odo::fw {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
 std::string flags_text(std::uint32_t f) {
   if (f == 0) return "ok";
@@ -65,7 +63,7 @@ void print_status(std::ostream& out, const loop::LoopSnapshot& s, double rate_hz
                   const sim::TruthSample* truth) {
   char line[320];
   std::snprintf(line, sizeof line, "t=%7.2f s  x=%+8.4f m  y=%+8.4f m  th=%+8.2f deg  v=%+5.2f m/s",
-                to_seconds(s.loop_time), s.pose.x, s.pose.y, wrap_angle(s.pose.theta) * kRadToDeg,
+                to_seconds(s.loop_time), s.pose.x, s.pose.y, wrap_angle(s.pose.theta) * kDegPerRad,
                 s.v);
   out << line;
   if (truth != nullptr) {
@@ -380,10 +378,10 @@ void Daemon::report() {
        << std::fixed << std::setprecision(1) << mean_rate << " Hz), missed deadlines "
        << st.missed_deadlines << "\n"
        << std::setprecision(4) << "odometryd: final pose x=" << s.pose.x << " m y=" << s.pose.y
-       << " m theta=" << wrap_angle(s.pose.theta) * kRadToDeg << " deg";
+       << " m theta=" << wrap_angle(s.pose.theta) * kDegPerRad << " deg";
   if (truth != nullptr) {
     log_ << "; ground truth x=" << truth->truth.x << " m y=" << truth->truth.y
-         << " m theta=" << wrap_angle(truth->truth.theta) * kRadToDeg << " deg; position error "
+         << " m theta=" << wrap_angle(truth->truth.theta) * kDegPerRad << " deg; position error "
          << std::setprecision(2) << truth->position_error() * 1e3 << " mm";
   }
   log_ << std::defaultfloat << std::setprecision(6) << std::endl;

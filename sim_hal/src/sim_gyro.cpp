@@ -3,24 +3,24 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <sstream>
+
+#include "odo/hal/angle.hpp"
 
 namespace odo::sim {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kPerHour = 1.0 / 3600.0;
 
 }  // namespace
 
 GyroModel consumer_gyro() {
   GyroModel m;
-  m.full_scale = 2000.0 * kDeg;
+  m.full_scale = 2000.0 * kRadPerDeg;
   m.bits = 16;
-  m.noise_density = 0.014 * kDeg;                          // 2.443e-4 rad/s/sqrt(Hz)
-  m.bias_offset = 1.0 * kDeg;                              // 1.745e-2 rad/s
-  m.bias_walk = 2.0 * kDeg * kPerHour / std::sqrt(100.0);  // 9.70e-7 rad/s/sqrt(s)
+  m.noise_density = 0.014 * kRadPerDeg;                          // 2.443e-4 rad/s/sqrt(Hz)
+  m.bias_offset = 1.0 * kRadPerDeg;                              // 1.745e-2 rad/s
+  m.bias_walk = 2.0 * kRadPerDeg * kPerHour / std::sqrt(100.0);  // 9.70e-7 rad/s/sqrt(s)
   m.scale_error = 0.005;
   m.odr = 1000.0;
   m.delay = 0.002;
@@ -29,11 +29,11 @@ GyroModel consumer_gyro() {
 
 GyroModel industrial_gyro() {
   GyroModel m;
-  m.full_scale = 2000.0 * kDeg;
+  m.full_scale = 2000.0 * kRadPerDeg;
   m.bits = 16;
-  m.noise_density = 0.34 / 60.0 * kDeg;                    // 9.89e-5 rad/s/sqrt(Hz)
-  m.bias_offset = 0.2 * kDeg;                              // 3.49e-3 rad/s
-  m.bias_walk = 8.0 * kDeg * kPerHour / std::sqrt(100.0);  // 3.88e-6 rad/s/sqrt(s)
+  m.noise_density = 0.34 / 60.0 * kRadPerDeg;                    // 9.89e-5 rad/s/sqrt(Hz)
+  m.bias_offset = 0.2 * kRadPerDeg;                              // 3.49e-3 rad/s
+  m.bias_walk = 8.0 * kRadPerDeg * kPerHour / std::sqrt(100.0);  // 3.88e-6 rad/s/sqrt(s)
   m.scale_error = 0.002;
   m.odr = 2000.0;
   m.delay = 0.001;

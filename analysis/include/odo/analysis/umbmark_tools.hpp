@@ -6,13 +6,13 @@
 #include <cstdint>
 #include <functional>
 #include <istream>
-#include <numbers>
 #include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include "odo/calibration/umbmark.hpp"
+#include "odo/hal/angle.hpp"
 #include "odo/hal/choice.hpp"
 #include "odo/hal/result.hpp"
 
@@ -69,7 +69,7 @@ inline constexpr double kReferenceSigmaXy = 0.002;         // [m]
 inline constexpr double kReferenceSigmaTheta = 0.0069813;  // [rad] = 0.4 deg
 // Travel loss of one extended-UMBmark bump: the report's 0.44 deg per 10 mm bump on a LabMate
 // (Sec. 3.4) times the true wheelbase 0.337 m.
-inline constexpr double kBumpLoss = 0.337 * 0.44 * std::numbers::pi / 180.0;  // [m]
+inline constexpr double kBumpLoss = 0.337 * 0.44 * kRadPerDeg;  // [m]
 
 // One set of N + N runs driven with the given factors.
 struct UmbmarkRunSet {
