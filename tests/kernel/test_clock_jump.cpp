@@ -1,7 +1,7 @@
 // Fault matrix, "clock jump of the wall clock": odometryd's loop and its status thread run on
 // CLOCK_MONOTONIC (absolute deadlines with clock_nanosleep, condition waits on steady_clock),
 // so stepping the wall clock (CLOCK_REALTIME, what `date -s` or an NTP step does) by a day
-// backwards and then forwards while the daemon runs must change nothing: the run lasts its
+// backwards and then forwards while the loop runs must change nothing: the run lasts its
 // duration, ticks at its rate and integrates the same pose. Needs root and a throw-away clock,
 // so it runs in the VM harness only.
 #include <time.h>
@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../sim/daemon_text.hpp"
 #include "kernel_env.hpp"
 #include "odo/firmware/daemon.hpp"
 
@@ -48,24 +49,37 @@ TEST(ClockJump, WallClockStepsDoNotReachTheLoop) {
   o.duration = 3.0;
   o.json = true;
   std::atomic<bool> stop{false};
-  std::ostringstream out, err;
+  std::ostringstream out;
+  LockedText err_text;
+  std::ostream err(&err_text);
   int rc = -1;
   const auto t0 = std::chrono::steady_clock::now();
   std::thread daemon([&] { rc = fw::run_daemon(o, stop, out, err); });
 
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  // Each step waits for status lines, not for a guessed time: under TCG a start has taken over
+  // 3 s, and a step before the loop runs would test nothing. The backward step comes after the
+  // first status line (the loop and the status thread run), the forward one after two more
+  // lines (both threads went on after the backward step); the lines after the forward step are
+  // checked below. At most 60 s each.
+  const bool running = wait_until([&] { return status_lines(err_text.text()) >= 1; }, 60.0);
   const double back = step_wall_clock(-86400);  // one day back
-  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  const std::size_t after_back = status_lines(err_text.text());
+  const bool went_on =
+      wait_until([&] { return status_lines(err_text.text()) >= after_back + 2; }, 60.0);
   const double fwd = step_wall_clock(2 * 86400);  // two days forward
+  const std::size_t after_fwd = status_lines(err_text.text());
   daemon.join();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   step_wall_clock(-86400);  // put it back
+  const std::string e = err_text.text();
 
+  ASSERT_TRUE(running) << "no status line within 60 s: " << e;
+  ASSERT_TRUE(went_on) << "no status lines after the backward step: " << e;
   // The fault was really injected.
   EXPECT_NEAR(back, -86400.0, 1.0);
   EXPECT_NEAR(fwd, 2 * 86400.0, 1.0);
 
-  ASSERT_EQ(rc, 0) << err.str();
+  ASSERT_EQ(rc, 0) << e;
   std::printf("clock jump: steps %+.0f s and %+.0f s; %.2f s monotonic wall time; odometryd: %s",
               back, fwd, wall, out.str().c_str());
   const auto j = nlohmann::json::parse(out.str());
@@ -80,12 +94,10 @@ TEST(ClockJump, WallClockStepsDoNotReachTheLoop) {
   EXPECT_LE(periods, 301u);
   // The pose follows the truth to the encoder quantisation (about 1e-5 m per count).
   EXPECT_LT(j["position_error"].get<double>(), 1e-4) << out.str();
-  // The status thread kept printing through both steps (about 15 lines at 0.2 s).
-  std::size_t lines = 0;
-  for (std::size_t p = err.str().find("t="); p != std::string::npos;
-       p = err.str().find("t=", p + 1))
-    ++lines;
-  EXPECT_GE(lines, 10u) << err.str();
+  // The status thread kept printing through both steps (about 15 lines at 0.2 s), and after
+  // the forward step: the run's last ~2 s came after it.
+  EXPECT_GE(status_lines(e), 10u) << e;
+  EXPECT_GE(status_lines(e), after_fwd + 3) << e;
 }
 
 }  // namespace

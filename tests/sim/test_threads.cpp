@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "daemon_text.hpp"
 #include "odo/firmware/daemon.hpp"
 #include "sim_fixture.hpp"
 
@@ -65,39 +66,6 @@ TEST(Threads, SetPoseRequestsAreNeverTorn) {
   // the 16-command queue, so the very last request may have been refused).
   EXPECT_EQ(run.loop->odometry().pose().x, static_cast<double>(accepted));
   EXPECT_EQ(run.loop->odometry().pose().y, -static_cast<double>(accepted));
-}
-
-// LockedText: an ostream sink that keeps what is written to it, readable from another thread
-// while the daemon writes (an ostringstream would be a data race there).
-class LockedText final : public std::streambuf {
- public:
-  std::string text() const {
-    std::lock_guard<std::mutex> l(m_);
-    return text_;
-  }
-
- protected:
-  int overflow(int c) override {
-    if (c == traits_type::eof()) return traits_type::not_eof(c);
-    std::lock_guard<std::mutex> l(m_);
-    text_.push_back(static_cast<char>(c));
-    return c;
-  }
-  std::streamsize xsputn(const char* s, std::streamsize n) override {
-    std::lock_guard<std::mutex> l(m_);
-    text_.append(s, static_cast<std::size_t>(n));
-    return n;
-  }
-
- private:
-  mutable std::mutex m_;
-  std::string text_;
-};
-
-std::size_t status_lines(const std::string& e) {
-  std::size_t lines = 0;
-  for (auto p = e.find("  rate="); p != std::string::npos; p = e.find("  rate=", p + 1)) ++lines;
-  return lines;
 }
 
 TEST(Threads, DaemonRealTimeWithStatusThreadStopsOnFlag) {
