@@ -71,6 +71,13 @@ void SocketCanBus::close_socket() noexcept {
   fd_ = -1;
 }
 
+void SocketCanBus::close_and_retry_later() noexcept {
+  close_socket();
+  // Not at once: the interface may be in the middle of going away or being re-created (ip link
+  // delete / add); a period later it is a new interface or still gone.
+  next_reopen_ = monotonic_now() + from_seconds(opts_.reopen_period);
+}
+
 int SocketCanBus::open_socket(const char*& stage) noexcept {
   close_socket();
   stage = "socket(PF_CAN, SOCK_RAW, CAN_RAW)";
@@ -131,9 +138,11 @@ Result<std::unique_ptr<SocketCanBus>> SocketCanBus::open(const SocketCanOptions&
 
 bool SocketCanBus::try_reopen() noexcept {
   if (fd_ >= 0) return true;
-  const std::int64_t now = monotonic_now();
-  if (now < next_reopen_ns_) return false;
-  next_reopen_ns_ = now + static_cast<std::int64_t>(opts_.reopen_period * 1e9);
+  const TimeNs now = monotonic_now();
+  if (now < next_reopen_) return false;
+  // The next attempt is a period away whether this one succeeds or not: a link that flaps
+  // costs at most one socket() + bind() per period on the loop thread.
+  next_reopen_ = now + from_seconds(opts_.reopen_period);
   const char* stage = "";
   if (open_socket(stage) != 0) return false;
   ++counters_.reopens;
@@ -162,12 +171,7 @@ CanTx SocketCanBus::send(const CanFrame& f) noexcept {
       break;
     case CanTx::kLinkDown:
       ++counters_.tx_link_down;
-      if (errno_means_vanished(err)) {
-        // The interface vanished (or came back with a new index): re-open it by name after
-        // one retry period.
-        close_socket();
-        next_reopen_ns_ = monotonic_now() + static_cast<std::int64_t>(opts_.reopen_period * 1e9);
-      }
+      if (errno_means_vanished(err)) close_and_retry_later();
       break;
     default:
       ++counters_.tx_errors;
@@ -184,10 +188,7 @@ bool SocketCanBus::receive(CanFrame& out) noexcept {
     if (n < 0) {
       // EAGAIN: nothing waiting. ENETDOWN is reported once after the link went down;
       // ENODEV after the interface vanished: re-open later.
-      if (errno_means_vanished(errno)) {
-        close_socket();
-        next_reopen_ns_ = monotonic_now() + static_cast<std::int64_t>(opts_.reopen_period * 1e9);
-      }
+      if (errno_means_vanished(errno)) close_and_retry_later();
       return false;
     }
     if (n != static_cast<ssize_t>(sizeof cf)) continue;  // not a classic frame (CAN FD): skip

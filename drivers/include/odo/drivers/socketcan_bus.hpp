@@ -13,6 +13,7 @@
 
 #include "odo/hal/can_bus.hpp"
 #include "odo/hal/result.hpp"
+#include "odo/hal/time.hpp"
 
 namespace odo::drivers {
 
@@ -80,11 +81,14 @@ class SocketCanBus final : public CanBus {
   // try_reopen: at most once per reopen_period, replaces a closed/vanished socket; true if open.
   bool try_reopen() noexcept;
   void close_socket() noexcept;
+  // close_and_retry_later: the interface vanished (or came back with a new index): closes the
+  // socket; try_reopen re-opens it by name one reopen_period from now.
+  void close_and_retry_later() noexcept;
 
   SocketCanOptions opts_;
   std::vector<std::uint32_t> kfilters_;  // struct can_filter pairs (can_id, can_mask), built once
   int fd_ = -1;
-  std::int64_t next_reopen_ns_ = 0;
+  TimeNs next_reopen_ = 0;  // CLOCK_MONOTONIC [ns]: no re-open attempt before it
   SocketCanCounters counters_;
 };
 
