@@ -31,7 +31,8 @@ Error io_error(const std::string& what, const std::string& path) {
 // Backend ids as stored in a record: the EncoderKind plus the bus, so that the simulated and
 // the real variant of a backend never continue each other's counts.
 std::uint8_t backend_id(const Config& cfg) {
-  std::uint8_t id = static_cast<std::uint8_t>(cfg.encoder.backend) << 4;
+  // The kind in the high nibble (the shift is done in unsigned; the ids fit a byte).
+  auto id = static_cast<std::uint8_t>(static_cast<unsigned>(cfg.encoder.backend) << 4);
   if (cfg.encoder.backend == EncoderKind::kHctl1100)
     id |= static_cast<std::uint8_t>(cfg.hctl1100.bus);
   if (cfg.encoder.backend == EncoderKind::kCan)
