@@ -109,8 +109,12 @@ void truncated_writes_load_old(NvStorage& medium) {
       ASSERT_EQ(l->status, StoreStatus::kOk) << "k=" << k << ": " << l->describe();
       // A prefix that already completes the record (the old bytes after it happen to match,
       // e.g. the last CRC byte on an EEPROM) is the new record: old or new, nothing else.
-      if (k == 0) ASSERT_EQ(*l->record, *old->record);
-      if (k == bytes->size()) ASSERT_EQ(*l->record, next);
+      if (k == 0) {
+        ASSERT_EQ(*l->record, *old->record);
+      }
+      if (k == bytes->size()) {
+        ASSERT_EQ(*l->record, next);
+      }
       ASSERT_TRUE(*l->record == *old->record || *l->record == next) << "k=" << k;
     }
   }

@@ -50,8 +50,12 @@ struct QuadWriter {
     pos += dir;
     const QuadState to = quad_state_at(pos);
     const QuadState changed = from ^ to;
-    if (changed & 2u) ASSERT_TRUE(sim.pull(a, (to & 2u) != 0));
-    if (changed & 1u) ASSERT_TRUE(sim.pull(b, (to & 1u) != 0));
+    if (changed & 2u) {
+      ASSERT_TRUE(sim.pull(a, (to & 2u) != 0));
+    }
+    if (changed & 1u) {
+      ASSERT_TRUE(sim.pull(b, (to & 1u) != 0));
+    }
   }
 };
 

@@ -265,7 +265,9 @@ TEST(ResumeCanVcan, HundredSigkillsDuringMotionResumeFromTheControllersCounts) {
     int status = 0;
     waitpid(d, &status, 0);
     reaper.pids.pop_back();
-    if (i == kKills) EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << slurp(err);
+    if (i == kKills) {
+      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << slurp(err);
+    }
     auto rec = fw::read_state_file(state);
     ASSERT_TRUE(rec.ok()) << "after run " << i << ": " << rec.error().message;
     records.push_back(*rec);
@@ -325,21 +327,21 @@ TEST(ResumeCanVcan, HundredSigkillsDuringMotionResumeFromTheControllersCounts) {
     Pose2 pose;
   };
   auto locate = [&](std::int64_t l, std::int64_t r) {
-    Ref ref;
+    Ref found;
     const auto lit = std::lower_bound(fr.begin(), fr.end(), l,
                                       [](const Frame& f, std::int64_t v) { return f.left < v; });
     const auto rit = std::lower_bound(fr.begin(), fr.end(), r,
                                       [](const Frame& f, std::int64_t v) { return f.right < v; });
-    if (lit == fr.end() || rit == fr.end() || lit->left != l || rit->right != r) return ref;
+    if (lit == fr.end() || rit == fr.end() || lit->left != l || rit->right != r) return found;
     const long ml = lit - fr.begin(), mr = rit - fr.begin();
-    if (std::abs(ml - mr) > 1) return ref;
-    ref.lo = std::min(ml, mr);
-    ref.hi = std::max(ml, mr);
+    if (std::abs(ml - mr) > 1) return found;
+    found.lo = std::min(ml, mr);
+    found.hi = std::max(ml, mr);
     Odometry o(k);
-    o.reset(fr[ref.lo].pose);
-    o.advance(l - fr[ref.lo].left, r - fr[ref.lo].right, 0.01);
-    ref.pose = o.pose();
-    return ref;
+    o.reset(fr[found.lo].pose);
+    o.advance(l - fr[found.lo].left, r - fr[found.lo].right, 0.01);
+    found.pose = o.pose();
+    return found;
   };
   auto locate_record = [&](const loop::StateRecord& rec) {
     return locate(wrap_delta(kLeft0, rec.left, 32), wrap_delta(kRight0, rec.right, 32));

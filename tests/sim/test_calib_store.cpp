@@ -236,8 +236,12 @@ TEST(CalibStoreFaults, PowerCutAfterEveryByteOfEverySave) {
             ASSERT_TRUE(o == Outcome::kOld || o == Outcome::kNew || o == Outcome::kUncalibratedOld)
                 << spec.name << " tear=" << tear << " prior=" << prior << " clear=" << clear
                 << " cut after " << cut << " of " << total << ": " << l->describe();
-            if (cut == total) EXPECT_EQ(o, Outcome::kNew);
-            if (cut == 0) EXPECT_NE(o, Outcome::kNew);
+            if (cut == total) {
+              EXPECT_EQ(o, Outcome::kNew);
+            }
+            if (cut == 0) {
+              EXPECT_NE(o, Outcome::kNew);
+            }
             // The store recovers: the next save succeeds and is what loads.
             if (cut % 97 == 0) {
               ASSERT_TRUE(store->save(make_record(9)));

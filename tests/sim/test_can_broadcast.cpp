@@ -321,7 +321,9 @@ TEST(CanBroadcast, ReceiveFloodIsReadAtMostMaxRxPerTickAndSetPoseStillApplies) {
     // commands apply in the order they arrived.
     const int p = serial_of_pose();
     EXPECT_GE(p, last_pose) << "tick " << t;
-    if (p != 0) EXPECT_TRUE(std::find(accepted.begin(), accepted.end(), p) != accepted.end());
+    if (p != 0) {
+      EXPECT_TRUE(std::find(accepted.begin(), accepted.end(), p) != accepted.end());
+    }
     last_pose = p;
   }
   // The loop kept its period: every tick ran, none missed.

@@ -146,7 +146,8 @@ TEST(SelfCalOnline, LoopRecordsEstimatorAppliesAndOfflineFitAgrees) {
   // Offline: the readings and fixes as odomctl calib fit-fixes reads them.
   std::ostringstream ticks, fx;
   ticks << "t,left,right\n";
-  char line[128];
+  // Room for the widest line GCC can prove (-Wformat-truncation): a %.9f and five %.17g.
+  char line[512];
   for (const EncoderSample& s : logged.log) {
     std::snprintf(line, sizeof line, "%.9f,%lld,%lld\n", to_seconds(s.stamp),
                   static_cast<long long>(s.left), static_cast<long long>(s.right));

@@ -164,7 +164,9 @@ TEST(SimGyro, ScaleBiasAndQuantisation) {
     // 1000 Hz read at 200 Hz; the first read gets 3 (samples of 1, 2, 3 ms, available 2 ms later).
     EXPECT_EQ(s.samples, t == kTickNs ? 3u : 5u);
     // Mean of whole LSBs: a multiple of the LSB unless the samples straddle a rounding edge.
-    if (t > 100'000'000) EXPECT_NEAR(s.rate_z, 488.0 * lsb, 1e-9) << t;
+    if (t > 100'000'000) {
+      EXPECT_NEAR(s.rate_z, 488.0 * lsb, 1e-9) << t;
+    }
   }
 }
 
@@ -264,7 +266,9 @@ TEST(SimGyro, ReadIntoEqualsRead) {
     const GyroSample s = a.read(t);
     b.read_into(t, into);
     EXPECT_EQ(std::isnan(s.rate_z), std::isnan(into.rate_z)) << i;
-    if (!std::isnan(s.rate_z)) EXPECT_EQ(s.rate_z, into.rate_z) << i;
+    if (!std::isnan(s.rate_z)) {
+      EXPECT_EQ(s.rate_z, into.rate_z) << i;
+    }
     EXPECT_EQ(s.stamp, into.stamp) << i;
     EXPECT_EQ(s.samples, into.samples) << i;
     EXPECT_EQ(s.flags, into.flags) << i;

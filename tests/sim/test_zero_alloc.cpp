@@ -341,8 +341,9 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
       loop->tick();
       // The status thread's side of the hand-over too, now and then.
       if ((i & 1023) == 0 && loop->snapshots().latest(reader)) ++published;
-      if (i == 100'000)  // new calibration from the reloader thread: the other producer
+      if (i == 100'000) {  // new calibration from the reloader thread: the other producer
         ASSERT_TRUE(loop->post(loop::SetKinematics{*kin, calib::StoreStatus::kOk}));
+      }
       if (i == 120'000) {
         // Let the log's writer thread catch up once while the window is open, so that "it
         // wrote while the loop ran" below does not depend on the scheduler: on a loaded
@@ -517,7 +518,9 @@ TEST(ZeroAlloc, GyroFusionTicksWithoutAllocating) {
     AllocWindow w;
     for (std::uint64_t i = 0; i < kTicks; ++i) {
       loop->tick();
-      if (i == 60'000) ASSERT_TRUE(loop->post(loop::SetPose{Pose2{}}));
+      if (i == 60'000) {
+        ASSERT_TRUE(loop->post(loop::SetPose{Pose2{}}));
+      }
     }
     w.disarm();
     EXPECT_EQ(g_allocs.load(), 0u) << "heap allocations during " << kTicks << " gyro ticks";

@@ -69,7 +69,9 @@ TEST(CalibRecordV2, ByteLayoutAndRoundTrip) {
   auto b1 = encode_record(v1);
   ASSERT_TRUE(b1);
   for (std::size_t i = 8; i < 104; ++i)
-    if (i != 16) EXPECT_EQ((*b)[i], (*b1)[i]) << "byte " << i;
+    if (i != 16) {
+      EXPECT_EQ((*b)[i], (*b1)[i]) << "byte " << i;
+    }
 }
 
 TEST(CalibRecordV2, EveryBitFlipDetectedAndFlagNeedsTheFields) {

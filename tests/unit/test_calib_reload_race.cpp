@@ -150,7 +150,9 @@ TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
       EXPECT_TRUE(during.sequence == seq || during.sequence == seq + 1) << during.report;
       check_applied(during, nominal, during.sequence);
     }
-    if (w == 0) ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    if (w == 0) {
+      ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    }
     ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "writer status " << status;
     ++seq;
     // A SIGHUP after the save: the new record.

@@ -304,7 +304,9 @@ TEST(ErrorModel, AgreesWithBruteForceJacobianPropagation) {
     const double e20 = worst_rel(brute_force(c, 20000), closed);
     const double e80 = worst_rel(brute_force(c, 80000), closed);
     EXPECT_LT(e80, 1e-7) << c.name;
-    if (e20 > 1e-8) EXPECT_GT(e20 / e80, 10.0) << c.name << ": " << e20 << " -> " << e80;
+    if (e20 > 1e-8) {
+      EXPECT_GT(e20 / e80, 10.0) << c.name << ": " << e20 << " -> " << e80;
+    }
   }
 }
 

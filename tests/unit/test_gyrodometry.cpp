@@ -168,7 +168,9 @@ TEST(Gyrodometry, BumpReplacedOverTheWholeInterval) {
     ds += t.ds;
     used += (t.flags & kFusionGyroUsed) != 0;
     starts += (t.flags & kFusionEventStart) != 0;
-    if (i == 51) EXPECT_TRUE(t.flags & kFusionEventStart);
+    if (i == 51) {
+      EXPECT_TRUE(t.flags & kFusionEventStart);
+    }
   }
   EXPECT_NEAR(odo, -7.647059e-3, 1e-9);
   EXPECT_NEAR(fused, 0.0, 1e-15);
@@ -338,7 +340,9 @@ TEST(Gyrodometry, DelayedGyroTurnIsNeverFlagged) {
       EXPECT_NEAR(g.disagreement(), 8e-4, 1e-15);
       EXPECT_NEAR(g.threshold() - t_still, 1e-3, 1e-15);
     }
-    if (j == 2) EXPECT_NEAR(g.disagreement(), 0.0, 1e-15);
+    if (j == 2) {
+      EXPECT_NEAR(g.disagreement(), 0.0, 1e-15);
+    }
   }
   EXPECT_EQ(fused, odo);
   EXPECT_EQ(g.counters().disagreements, 0u);
