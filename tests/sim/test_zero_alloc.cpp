@@ -61,9 +61,15 @@ void* raw_malloc(std::size_t n) noexcept {
 void* raw_memalign(std::size_t a, std::size_t n) noexcept {
   return std::aligned_alloc(a, n);
 }
+// GCC 12 reports this free() as freeing operator new's memory once the replaced operators
+// below are inlined at -O2 (-Wmismatched-new-delete): it does not see that they allocate with
+// raw_malloc. A false positive of replacing the global allocator.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 void raw_free(void* p) noexcept {
   std::free(p);
 }
+#pragma GCC diagnostic pop
 #endif
 
 std::atomic<bool> g_armed{false};
