@@ -7,7 +7,6 @@
 #include <atomic>
 #include <chrono>
 #include <fstream>
-#include <mutex>
 #include <sstream>
 #include <string>
 #include <thread>
