@@ -14,6 +14,7 @@
 #include <optional>
 #include <string>
 
+#include "can_env.hpp"
 #include "kernel_env.hpp"
 #include "odo/drivers/can_encoder.hpp"
 #include "odo/drivers/monotonic_clock.hpp"
@@ -30,45 +31,6 @@ using drivers::SocketCanBus;
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kS = 1'000'000'000;
-
-struct Vcan {
-  std::string name;
-  bool ok = false;
-  explicit Vcan(std::string n) : name(std::move(n)) {
-    run("ip link del " + name + " 2>/dev/null");
-    ok = run("ip link add dev " + name + " type vcan && ip link set " + name + " up") == 0;
-  }
-  ~Vcan() { run("ip link del " + name + " 2>/dev/null"); }
-};
-
-// Background: a shell command started with `&`, killed by its pid at the end.
-struct Background {
-  int pid = -1;
-  explicit Background(const std::string& cmd) {
-    const std::string file = "/tmp/odo_bg_" + std::to_string(::getpid()) + ".pid";
-    if (run(cmd + " >/dev/null 2>&1 & echo $! > " + file) == 0) std::ifstream(file) >> pid;
-  }
-  void stop() {
-    if (pid > 0) ::kill(pid, SIGKILL);
-    pid = -1;
-  }
-  ~Background() { stop(); }
-};
-
-// FifoScope: the calling thread runs SCHED_FIFO 80 as the firmware's loop does (README,
-// [realtime]) while it lives; RESET_ON_FORK: processes started meanwhile run normally.
-struct FifoScope {
-  bool on = false;
-  FifoScope() {
-    sched_param sp{};
-    sp.sched_priority = 80;
-    on = sched_setscheduler(0, SCHED_FIFO | SCHED_RESET_ON_FORK, &sp) == 0;
-  }
-  ~FifoScope() {
-    sched_param sp{};
-    if (on) sched_setscheduler(0, SCHED_OTHER, &sp);
-  }
-};
 
 // Rig: a SocketCanBus with exact kernel filters for the two wheels (as the firmware's
 // make_can_socketcan_backend installs them) and the encoder on it.

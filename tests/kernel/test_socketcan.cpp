@@ -7,6 +7,7 @@
 #include <string>
 #include <thread>
 
+#include "can_env.hpp"
 #include "kernel_env.hpp"
 #include "odo/drivers/socketcan_bus.hpp"
 
@@ -17,17 +18,6 @@ using namespace std::chrono_literals;
 using drivers::CanFilter;
 using drivers::SocketCanBus;
 using drivers::SocketCanOptions;
-
-// Vcan: a vcan interface for one test, removed at the end.
-struct Vcan {
-  std::string name;
-  explicit Vcan(std::string n) : name(std::move(n)) {
-    run("ip link del " + name + " 2>/dev/null");
-    ok = run("ip link add " + name + " type vcan && ip link set " + name + " up") == 0;
-  }
-  ~Vcan() { run("ip link del " + name + " 2>/dev/null"); }
-  bool ok = false;
-};
 
 CanFrame frame(std::uint32_t id, std::uint8_t fill, bool ext = false) {
   CanFrame f;

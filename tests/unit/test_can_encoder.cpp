@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "can_frame_bytes.hpp"
 #include "odo/drivers/can_encoder.hpp"
 #include "odo/odometry/count_delta.hpp"
 #include "odo/sim/sim_can_bus.hpp"
@@ -15,17 +16,7 @@ namespace {
 
 constexpr TimeNs kMs = 1'000'000;
 
-CanFrame frame(std::uint32_t id, std::initializer_list<std::uint8_t> bytes, TimeNs stamp = 0,
-               bool extended = false) {
-  CanFrame f;
-  f.id = id;
-  f.extended = extended;
-  f.len = static_cast<std::uint8_t>(bytes.size());
-  std::size_t i = 0;
-  for (std::uint8_t b : bytes) f.data[i++] = b;
-  f.stamp = stamp;
-  return f;
-}
+using test::frame;
 
 // odrive: a Get_Encoder_Count reply of `node` with shadow count `shadow` (little endian int32
 // at byte 0) and count-in-CPR 0x55 at byte 4 (never read).
