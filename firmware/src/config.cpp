@@ -302,6 +302,29 @@ void read_gyro(TableReader t, GyroSection& s) {
   t.finish();
 }
 
+// ---- [can_gyro] ----
+void read_can_gyro(TableReader t, CanGyroSection& s) {
+  s.bus = t.choice("bus", s.bus);
+  s.interface = t.string("interface", s.interface);
+  if (s.interface.empty() || s.interface.size() > 15)
+    t.reject("interface",
+             "= \"" + s.interface + "\" must be 1..15 characters (a network interface)");
+  s.extended = t.boolean("extended", s.extended);
+  s.id = t.integer("id", s.id, 0, s.extended ? 0x1FFFFFFF : 0x7FF);
+  s.width = static_cast<int>(t.integer("width", s.width, 16, 32));
+  if (s.width % 8 != 0)
+    t.reject("width", "= " + std::to_string(s.width) + " must be 16, 24 or 32 (whole bytes)");
+  s.offset = static_cast<int>(t.integer("offset", s.offset, 0, 8 - s.width / 8));
+  s.is_signed = t.boolean("signed", s.is_signed);
+  s.byte_order = t.choice("byte_order", s.byte_order);
+  s.scale = t.number("scale", s.scale, 1e-9, 1.0, "rad/s per LSB");
+  s.rate_offset = t.number("rate_offset", s.rate_offset, -1000.0, 1000.0, "rad/s");
+  s.max_frames_per_read =
+      static_cast<int>(t.integer("max_frames_per_read", s.max_frames_per_read, 1, 4096));
+  s.sim_stop_after = t.number("sim_stop_after", s.sim_stop_after, -1.0, 1e6, "s");
+  t.finish();
+}
+
 // first_non_ascii: the first byte >= 0x80 as "line N, column C (byte 0xXX)", or "" if none.
 // The config is plain ASCII: toml++ 3.3 (Debian 12) reaches __builtin_unreachable() on some
 // non-ASCII characters (upstream issues #190 and #295; found here by fuzz_config), so such a
@@ -362,6 +385,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_resume(root.sub("resume"), c.resume, c.loop.rate_hz);
   read_selfcal(root.sub("selfcal"), c.selfcal);
   read_gyro(root.sub("gyro"), c.gyro);
+  read_can_gyro(root.sub("can_gyro"), c.can_gyro);
   root.finish();
   if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
   return c;

@@ -25,9 +25,13 @@ class GyroWiring {
   virtual const std::string& describe() const noexcept = 0;
 };
 
+// simulated_gyro: the gyro is the simulated model (backend "sim", or "can" with [can_gyro] bus
+// "sim"): it needs the simulated robot, and its model's figures are the fusion's defaults.
+bool simulated_gyro(const Config& cfg);
+
 // gyrodometry_params: the fusion's parameters from [gyro]; keys left unset take the simulated
-// model's figures (backend = "sim") or the consumer-class defaults (GyroNoiseModel).
-GyrodometryParams gyrodometry_params(const GyroSection& g);
+// model's figures (simulated_gyro) or the consumer-class defaults (GyroNoiseModel).
+GyrodometryParams gyrodometry_params(const Config& cfg);
 
 // make_iio_gyro: [gyro] backend = "iio"; errors name the config file, the device and channel.
 Result<std::unique_ptr<GyroWiring>> make_iio_gyro(const Config& cfg);
@@ -36,5 +40,14 @@ Result<std::unique_ptr<GyroWiring>> make_iio_gyro(const Config& cfg);
 // robot runs on the real clock with its time zero at *epoch [ns] (EpochGyro).
 Result<std::unique_ptr<GyroWiring>> make_sim_gyro(const Config& cfg, sim::SimRobot& robot,
                                                   const TimeNs* epoch);
+
+// make_can_socketcan_gyro: [gyro] backend = "can", [can_gyro] bus = "socketcan": a CAN IMU on a
+// SocketCAN interface; errors name the config file and [can_gyro].
+Result<std::unique_ptr<GyroWiring>> make_can_socketcan_gyro(const Config& cfg);
+
+// make_can_sim_gyro: [gyro] backend = "can", [can_gyro] bus = "sim": the simulated CAN IMU (the
+// [gyro] model on `robot`) read through the real decoder; `epoch` as for make_sim_gyro.
+Result<std::unique_ptr<GyroWiring>> make_can_sim_gyro(const Config& cfg, sim::SimRobot& robot,
+                                                      const TimeNs* epoch);
 
 }  // namespace odo::fw

@@ -45,7 +45,7 @@ struct Rig::Impl {
   std::string description;
   double scenario_duration = 0.0;
   std::unique_ptr<GyroWiring> gyro;  // [gyro]; null: none
-  GyroSection gyro_cfg;
+  GyrodometryParams gyro_params;     // from [gyro] (and [can_gyro]'s bus)
   TimeNs sim_epoch = 0;  // real-time simulation: the robot's time zero of the fixed-epoch backends
 };
 
@@ -73,26 +73,31 @@ YawRateSource* Rig::gyro() noexcept {
   return impl_->gyro ? &impl_->gyro->gyro() : nullptr;
 }
 GyrodometryParams Rig::gyrodometry() const {
-  return gyrodometry_params(impl_->gyro_cfg);
+  return impl_->gyro_params;
 }
 
 // add_gyro: [gyro] on top of the wired encoders: the IIO device, or the simulated gyro on the
 // simulated robot (on its clock: virtual, the EpochEncoder's epoch, or the backends' fixed one).
 Status Rig::add_gyro(const Config& cfg, Impl& impl, bool virtual_time) {
-  impl.gyro_cfg = cfg.gyro;
+  impl.gyro_params = gyrodometry_params(cfg);
   const GyroBackend be = cfg.gyro.backend;
   if (be == GyroBackend::kNone) return Ok{};
-  if (be == GyroBackend::kSim && impl.robot == nullptr)
+  const bool simulated = simulated_gyro(cfg);
+  if (simulated && impl.robot == nullptr)
     return make_error(Errc::kInvalidArgument,
-                      cfg.source +
-                          ": gyro.backend = \"sim\" needs a simulated robot (encoder "
-                          "backend sim, or hctl1100/can_encoder with bus = \"sim\")");
+                      cfg.source + ": gyro.backend = \"" + std::string(name_of(be)) + "\"" +
+                          (be == GyroBackend::kCan ? " with can_gyro.bus = \"sim\"" : "") +
+                          " needs a simulated robot (encoder backend sim, or "
+                          "hctl1100/can_encoder with bus = \"sim\")");
   const TimeNs* epoch = nullptr;
-  if (be == GyroBackend::kSim && !virtual_time) {
+  if (simulated && !virtual_time) {
     auto* e = dynamic_cast<sim::EpochEncoder*>(impl.encoder_wrapper.get());
     epoch = impl.backend ? &impl.sim_epoch : &e->epoch();
   }
-  auto g = be == GyroBackend::kIio ? make_iio_gyro(cfg) : make_sim_gyro(cfg, *impl.robot, epoch);
+  auto g = be == GyroBackend::kIio   ? make_iio_gyro(cfg)
+           : be == GyroBackend::kSim ? make_sim_gyro(cfg, *impl.robot, epoch)
+           : simulated               ? make_can_sim_gyro(cfg, *impl.robot, epoch)
+                                     : make_can_socketcan_gyro(cfg);
   if (!g) return std::move(g).error();
   impl.gyro = std::move(g).value();
   impl.description += ", " + impl.gyro->describe();
@@ -154,7 +159,7 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
   sim::Scenario scenario = make_scenario(cfg.sim, k);
   // With a gyro the robot first stands still for a second, as a real one does after power-up:
   // the fusion learns the gyro's bias before the first move (detection is off until then).
-  if (cfg.gyro.backend == GyroBackend::kSim) scenario.insert(scenario.begin(), {1.0, 0.0, 0.0});
+  if (simulated_gyro(cfg)) scenario.insert(scenario.begin(), {1.0, 0.0, 0.0});
   impl->scenario_duration = sim::scenario_duration(scenario);
   auto robot = sim::SimRobot::create(g, std::move(scenario));
   if (!robot) return std::move(robot).error();

@@ -496,15 +496,17 @@ TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
   EXPECT_EQ(snap.encoder_counters.stale_events, 1u);
 }
 
-TEST(ZeroAlloc, GyroFusionTicksWithoutAllocating) {
-  // [gyro] backend = "sim" (consumer model) fused in the loop, both squares at 1 kHz. The wheel
+// gyro_fusion_without_allocating: the fused loop on [gyro] `backend` ticks without the heap.
+void gyro_fusion_without_allocating(fw::GyroBackend backend) {
+  // The consumer gyro model fused in the loop, both squares at 1 kHz. The wheel
   // acceleration limit is set below what the squares' ramps need, so every start and stop of a
   // leg opens a flagged interval and the gyro path (window correction, gyro heading, its
   // covariance) runs inside the window, not just the comparison; a set-pose resets the fusion.
   fw::Config cfg = fw::default_config();
   cfg.loop.rate_hz = 1000.0;
   cfg.sim.scenario = fw::SimScenario::kSquares;
-  cfg.gyro.backend = fw::GyroBackend::kSim;
+  cfg.gyro.backend = backend;
+  cfg.can_gyro.bus = fw::CanEncoderBus::kSim;  // backend = "can": the simulated CAN IMU
   cfg.gyro.max_wheel_accel = 0.05;
   auto kin = Kinematics::create(cfg.robot);
   ASSERT_TRUE(kin.ok());
@@ -539,6 +541,15 @@ TEST(ZeroAlloc, GyroFusionTicksWithoutAllocating) {
   EXPECT_GT(g.fusion.accel_events, 0u);
   EXPECT_GT(g.fusion.flagged_ticks, 0u);
   EXPECT_EQ(loop->commands_applied(), 1u);
+}
+
+TEST(ZeroAlloc, GyroFusionTicksWithoutAllocating) {
+  gyro_fusion_without_allocating(fw::GyroBackend::kSim);
+}
+
+TEST(ZeroAlloc, CanGyroFusionTicksWithoutAllocating) {
+  // The same through the simulated CAN IMU and the firmware's CAN decoder (drivers/can_gyro).
+  gyro_fusion_without_allocating(fw::GyroBackend::kCan);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
-// Config sections [hctl1100] and [gpio] (issue 5): values, defaults, and clear errors.
+// Config sections [hctl1100], [gpio], [can_encoder] (issue 5) and [can_gyro] (issue 16):
+// values, defaults, and clear errors.
 #include <gtest/gtest.h>
 
 #include "odo/firmware/config.hpp"
@@ -141,6 +142,63 @@ reverse_left = true
   EXPECT_FALSE(e.reverse_right);
 }
 
+TEST(ConfigEncoders, CanGyroDefaults) {
+  auto c = parse_config("[gyro]\nbackend = \"can\"\n", "g.toml");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  EXPECT_EQ(c->gyro.backend, GyroBackend::kCan);
+  const CanGyroSection& g = c->can_gyro;
+  EXPECT_EQ(g.bus, CanEncoderBus::kSocketCan);
+  EXPECT_EQ(g.interface, "can0");
+  EXPECT_EQ(g.id, 0x120);
+  EXPECT_FALSE(g.extended);
+  EXPECT_EQ(g.offset, 0);
+  EXPECT_EQ(g.width, 16);
+  EXPECT_TRUE(g.is_signed);
+  EXPECT_EQ(g.byte_order, ByteOrder::kLittle);
+  // 2000 deg/s over the 2^15 steps of a signed 16-bit word: 34.906585 / 32768 rad/s.
+  EXPECT_NEAR(g.scale, 1.0652644e-3, 1e-10);
+  EXPECT_DOUBLE_EQ(g.rate_offset, 0.0);
+  EXPECT_EQ(g.max_frames_per_read, 64);
+  EXPECT_DOUBLE_EQ(g.sim_stop_after, -1.0);
+}
+
+TEST(ConfigEncoders, ReadsCanGyroSection) {
+  auto c = parse_config(R"(
+[gyro]
+backend = "can"
+sign = -1
+[can_gyro]
+bus = "sim"
+interface = "vcan1"
+extended = true
+id = 0x18FF0120
+offset = 4
+width = 32
+signed = false
+byte_order = "big"
+scale = 1e-7
+rate_offset = -214.7483648
+max_frames_per_read = 8
+sim_stop_after = 3.5
+)",
+                        "g.toml");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  EXPECT_EQ(c->gyro.sign, -1);
+  const CanGyroSection& g = c->can_gyro;
+  EXPECT_EQ(g.bus, CanEncoderBus::kSim);
+  EXPECT_EQ(g.interface, "vcan1");
+  EXPECT_TRUE(g.extended);
+  EXPECT_EQ(g.id, 0x18FF0120);
+  EXPECT_EQ(g.offset, 4);
+  EXPECT_EQ(g.width, 32);
+  EXPECT_FALSE(g.is_signed);
+  EXPECT_EQ(g.byte_order, ByteOrder::kBig);
+  EXPECT_DOUBLE_EQ(g.scale, 1e-7);
+  EXPECT_DOUBLE_EQ(g.rate_offset, -214.7483648);
+  EXPECT_EQ(g.max_frames_per_read, 8);
+  EXPECT_DOUBLE_EQ(g.sim_stop_after, 3.5);
+}
+
 struct Bad {
   const char* text;
   const char* expect;
@@ -195,7 +253,32 @@ INSTANTIATE_TEST_SUITE_P(
         Bad{"[can_encoder]\nmax_frames_per_read = 0\n",
             "bad.toml:2: can_encoder.max_frames_per_read = 0 is outside the allowed range [1, "
             "4096]"},
-        Bad{"[can_encoder]\nnode = 1\n", "bad.toml:2: can_encoder.node is not a known setting"}));
+        Bad{"[can_encoder]\nnode = 1\n", "bad.toml:2: can_encoder.node is not a known setting"},
+        Bad{"[gyro]\nbackend = \"spi\"\n",
+            "bad.toml:2: gyro.backend = \"spi\" is not one of: none, sim, iio, can"},
+        Bad{"[can_gyro]\nbus = \"usb\"\n",
+            "bad.toml:2: can_gyro.bus = \"usb\" is not one of: socketcan, sim"},
+        Bad{"[can_gyro]\ninterface = \"\"\n", "bad.toml:2: can_gyro.interface = \"\" must be"},
+        Bad{"[can_gyro]\nid = 2048\n",
+            "bad.toml:2: can_gyro.id = 2048 is outside the allowed range [0, 2047]"},
+        // A rate of 8 bits would be too coarse, one of 40 or more is no MEMS output.
+        Bad{"[can_gyro]\nwidth = 8\n",
+            "bad.toml:2: can_gyro.width = 8 is outside the allowed range [16, 32]"},
+        Bad{"[can_gyro]\nwidth = 40\n",
+            "bad.toml:2: can_gyro.width = 40 is outside the allowed range [16, 32]"},
+        Bad{"[can_gyro]\nwidth = 20\n", "bad.toml:2: can_gyro.width = 20 must be 16, 24 or 32"},
+        // 24 bits are 3 bytes: the last offset that fits 8 data bytes is 5.
+        Bad{"[can_gyro]\nwidth = 24\noffset = 6\n",
+            "bad.toml:3: can_gyro.offset = 6 is outside the allowed range [0, 5]"},
+        Bad{"[can_gyro]\nscale = 0\n", "bad.toml:2: can_gyro.scale = 0 is outside"},
+        Bad{"[can_gyro]\nrate_offset = 1e4\n", "bad.toml:2: can_gyro.rate_offset = 10000"},
+        Bad{"[can_gyro]\nbyte_order = \"middle\"\n",
+            "bad.toml:2: can_gyro.byte_order = \"middle\" is not one of: little, big"},
+        Bad{"[can_gyro]\nmax_frames_per_read = 4097\n",
+            "bad.toml:2: can_gyro.max_frames_per_read = 4097 is outside the allowed range [1, "
+            "4096]"},
+        Bad{"[can_gyro]\nsim_stop_after = -2\n", "bad.toml:2: can_gyro.sim_stop_after = -2"},
+        Bad{"[can_gyro]\nnode = 1\n", "bad.toml:2: can_gyro.node is not a known setting"}));
 
 }  // namespace
 }  // namespace odo::fw

@@ -11,6 +11,7 @@
 #include <tuple>
 #include <vector>
 
+#include "odo/hal/angle.hpp"
 #include "odo/hal/choice.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/error_model.hpp"
@@ -37,7 +38,7 @@ enum class CanEncoderProtocol : std::uint8_t { kOdrive, kGeneric };
 enum class ByteOrder : std::uint8_t { kLittle, kBig };
 enum class StoreBackend : std::uint8_t { kAuto, kFile, kNvmem, kMtd };
 enum class CanBusKind : std::uint8_t { kSim, kSocketCan, kNone };
-enum class GyroBackend : std::uint8_t { kNone, kSim, kIio };
+enum class GyroBackend : std::uint8_t { kNone, kSim, kIio, kCan };
 enum class GyroAxis : std::uint8_t { kX, kY, kZ };
 enum class GyroMode : std::uint8_t { kBuffered, kPolled };
 enum class GyroModelKind : std::uint8_t { kConsumer, kIndustrial };
@@ -67,8 +68,10 @@ inline constexpr Choice<StoreBackend> kStoreBackends[] = {{StoreBackend::kAuto, 
                                                           {StoreBackend::kMtd, "mtd"}};
 inline constexpr Choice<CanBusKind> kCanBusKinds[] = {
     {CanBusKind::kSim, "sim"}, {CanBusKind::kSocketCan, "socketcan"}, {CanBusKind::kNone, "none"}};
-inline constexpr Choice<GyroBackend> kGyroBackends[] = {
-    {GyroBackend::kNone, "none"}, {GyroBackend::kSim, "sim"}, {GyroBackend::kIio, "iio"}};
+inline constexpr Choice<GyroBackend> kGyroBackends[] = {{GyroBackend::kNone, "none"},
+                                                        {GyroBackend::kSim, "sim"},
+                                                        {GyroBackend::kIio, "iio"},
+                                                        {GyroBackend::kCan, "can"}};
 inline constexpr Choice<GyroAxis> kGyroAxes[] = {
     {GyroAxis::kX, "x"}, {GyroAxis::kY, "y"}, {GyroAxis::kZ, "z"}};
 inline constexpr Choice<GyroMode> kGyroModes[] = {{GyroMode::kBuffered, "buffered"},
@@ -289,8 +292,9 @@ inline constexpr SelfCalRange<double> kSelfCalNumbers[] = {
     {"prior_sigma_wheelbase", &SelfCalSection::prior_sigma_wheelbase, 1e-4, 1.0, "m"}};
 
 // [gyro]: a yaw-rate gyro and the gyrodometry fusion (README "Gyro"). backend = "iio": a MEMS
-// gyro through Linux IIO; "sim": a simulated gyro on the simulated robot (model's error terms).
-// Numbers default to NaN where "not set" means "the model's value" (see gyro_noise_model).
+// gyro through Linux IIO; "can": a rate sent on CAN ([can_gyro]); "sim": a simulated gyro on the
+// simulated robot (model's error terms). Numbers default to kNotSet where "not set" means "the
+// model's value" (see gyrodometry_params).
 struct GyroSection {
   GyroBackend backend = GyroBackend::kNone;
   std::string device;            // iio: device name, sysfs directory or /dev/iio:deviceN
@@ -318,6 +322,24 @@ struct GyroSection {
   static constexpr double kNotSet = -1.0;
 };
 
+// [can_gyro]: the yaw rate of a CAN IMU ([gyro] backend = "can"; drivers/can_gyro.hpp).
+struct CanGyroSection {
+  CanEncoderBus bus = CanEncoderBus::kSocketCan;  // socketcan | sim (a simulated CAN IMU)
+  std::string interface = "can0";                 // SocketCAN interface
+  std::int64_t id = 0x120;  // arbitration id, 0..0x7FF (0..0x1FFFFFFF extended)
+  bool extended = false;    // 29-bit id
+  int offset = 0;           // [bytes] first byte of the rate field, 0..7
+  int width = 16;           // [bits] 16, 24 or 32
+  bool is_signed = true;    // key "signed"
+  ByteOrder byte_order = ByteOrder::kLittle;
+  // [rad/s per LSB]: default 2000 deg/s full scale of a 16-bit word, the usual MEMS range (and
+  // the simulated consumer gyro's)
+  double scale = 2000.0 * kRadPerDeg / 32768.0;
+  double rate_offset = 0.0;      // [rad/s] added after scaling (unsigned fields)
+  int max_frames_per_read = 64;  // frames taken per loop tick, 1..4096
+  double sim_stop_after = -1.0;  // bus = "sim": [s] the IMU stops sending after this; < 0 never
+};
+
 struct Config {
   std::string source = "<built-in>";  // file the config came from
   LoopSection loop;
@@ -337,6 +359,7 @@ struct Config {
   ResumeSection resume;
   SelfCalSection selfcal;
   GyroSection gyro;
+  CanGyroSection can_gyro;
 };
 
 // default_config: the embedded default: the simulated LabMate of the UMBmark report.
