@@ -168,13 +168,18 @@ void read_error_model(TableReader t, ErrorModelParams& k) {
   t.finish();
 }
 
+// read_interface: the key "interface", a network interface name (the kernel's IFNAMSIZ - 1).
+std::string read_interface(TableReader& t, std::string def) {
+  std::string name = t.string("interface", std::move(def));
+  if (name.empty() || name.size() > 15)
+    t.reject("interface", "= \"" + name + "\" must be 1..15 characters (a network interface)");
+  return name;
+}
+
 // ---- [can] (CAN pose broadcast) ----
 void read_can(TableReader t, CanSection& s, double loop_hz) {
   s.bus = t.choice("bus", s.bus);
-  s.interface = t.string("interface", s.interface);
-  if (s.interface.empty() || s.interface.size() > 15)
-    t.reject("interface",
-             "= \"" + s.interface + "\" must be 1..15 characters (a network interface)");
+  s.interface = read_interface(t, s.interface);
   s.node_id = static_cast<int>(t.integer("node_id", s.node_id, 0, protocol::kMaxNodeId));
   s.base_id = static_cast<int>(t.integer("base_id", s.base_id, 0, 1024));
   if (s.base_id % 16 != 0)
@@ -305,10 +310,7 @@ void read_gyro(TableReader t, GyroSection& s) {
 // ---- [can_gyro] ----
 void read_can_gyro(TableReader t, CanGyroSection& s) {
   s.bus = t.choice("bus", s.bus);
-  s.interface = t.string("interface", s.interface);
-  if (s.interface.empty() || s.interface.size() > 15)
-    t.reject("interface",
-             "= \"" + s.interface + "\" must be 1..15 characters (a network interface)");
+  s.interface = read_interface(t, s.interface);
   s.extended = t.boolean("extended", s.extended);
   s.id = t.integer("id", s.id, 0, s.extended ? 0x1FFFFFFF : 0x7FF);
   s.width = static_cast<int>(t.integer("width", s.width, 16, 32));
