@@ -1,6 +1,5 @@
 #include "gyro_backend.hpp"
 
-#include <cmath>
 #include <optional>
 #include <sstream>
 
@@ -16,6 +15,12 @@ namespace {
 
 sim::GyroModel sim_model(const GyroSection& g) {
   return g.model == GyroModelKind::kIndustrial ? sim::industrial_gyro() : sim::consumer_gyro();
+}
+
+// model_gyro: the simulated gyro of [gyro] model and seed on `robot`.
+Result<sim::SimGyro> model_gyro(const GyroSection& g, sim::SimRobot& robot) {
+  return sim::SimGyro::create(robot, sim_model(g), static_cast<std::uint64_t>(g.seed),
+                              from_seconds(g.stale_timeout));
 }
 
 // or_model: the configured value, or the model's when the key was not set.
@@ -113,7 +118,7 @@ drivers::CanGyroConfig can_gyro_config(const Config& cfg) {
   c.scale = s.scale;
   c.offset = s.rate_offset;
   c.sign = cfg.gyro.sign;
-  c.stale_timeout = static_cast<TimeNs>(std::llround(cfg.gyro.stale_timeout * 1e9));
+  c.stale_timeout = from_seconds(cfg.gyro.stale_timeout);
   c.max_frames_per_read = s.max_frames_per_read;
   return c;
 }
@@ -178,7 +183,7 @@ Result<std::unique_ptr<GyroWiring>> make_iio_gyro(const Config& cfg) {
   c.expected_rate = g.rate;
   c.trigger = g.trigger;
   c.buffer_length = g.buffer_length;
-  c.stale_timeout = static_cast<TimeNs>(std::llround(g.stale_timeout * 1e9));
+  c.stale_timeout = from_seconds(g.stale_timeout);
   auto opened = drivers::IioGyro::open(c);
   if (!opened) {
     return make_error(opened.error().code,
@@ -194,8 +199,7 @@ Result<std::unique_ptr<GyroWiring>> make_iio_gyro(const Config& cfg) {
 Result<std::unique_ptr<GyroWiring>> make_sim_gyro(const Config& cfg, sim::SimRobot& robot,
                                                   const TimeNs* epoch) {
   const GyroSection& g = cfg.gyro;
-  const auto stale = static_cast<TimeNs>(std::llround(g.stale_timeout * 1e9));
-  auto made = sim::SimGyro::create(robot, sim_model(g), static_cast<std::uint64_t>(g.seed), stale);
+  auto made = model_gyro(g, robot);
   if (!made) return std::move(made).error();
   std::ostringstream d;
   d << "simulated " << name_of(g.model) << " gyro (seed " << g.seed << ")";
@@ -225,8 +229,7 @@ Result<std::unique_ptr<GyroWiring>> make_can_sim_gyro(const Config& cfg, sim::Si
   const GyroSection& g = cfg.gyro;
   const CanGyroSection& s = cfg.can_gyro;
   const drivers::CanGyroConfig c = can_gyro_config(cfg);
-  const auto stale = static_cast<TimeNs>(std::llround(g.stale_timeout * 1e9));
-  auto made = sim::SimGyro::create(robot, sim_model(g), static_cast<std::uint64_t>(g.seed), stale);
+  auto made = model_gyro(g, robot);
   if (!made) return std::move(made).error();
   // The simulated chip is mounted as [gyro] sign says: the decoder's sign undoes it.
   sim::SimCanImuOptions o{c.field.id,
