@@ -16,8 +16,6 @@ CanGyroSource::CanGyroSource(CanBus& bus, const CanGyroConfig& cfg) : bus_(&bus)
   const double hi = static_cast<double>(v_max_) * cfg.scale + cfg.offset;
   full_scale_ = std::min(std::fabs(lo), std::fabs(hi));
   book_.stale_timeout = cfg.stale_timeout;
-  // Stale from the start until the first frame; that state is not an event (as the encoder's).
-  book_.stale = true;
 }
 
 Result<CanGyroSource> CanGyroSource::create(CanBus& bus, const CanGyroConfig& cfg) {
@@ -88,12 +86,6 @@ void CanGyroSource::read_into(TimeNs now, GyroSample& s) noexcept {
   }
   if (n == cfg_.max_frames_per_read) ++stats_.capped_reads;
   book_.close(s, now, s.samples > 0 ? sum / s.samples : 0.0);
-  // Before the first sample close() judges by last_stamp 0, i.e. fresh while now <= stale_timeout
-  // (a clock starting at 0, as the virtual clock does): stale until the first frame, no event.
-  if (book_.counters.samples == 0) {
-    s.flags |= kGyroStale;
-    book_.stale = true;
-  }
 }
 
 }  // namespace odo::drivers

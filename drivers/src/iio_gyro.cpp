@@ -205,8 +205,6 @@ IioGyro::~IioGyro() {
 }
 
 void IioGyro::finish(GyroSample& s, TimeNs now, double sum) noexcept {
-  if (s.samples > 0) have_sample_ = true;
-  if (!have_sample_ && book_.last_stamp == 0) book_.last_stamp = now;  // stale from the first read
   const double mean = s.samples > 0 ? sign_ * (sum / s.samples + offset_) * scale_ : 0.0;
   book_.close(s, now, mean);
 }

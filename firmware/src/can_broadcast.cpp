@@ -17,10 +17,11 @@ namespace odo::fw {
 namespace {
 
 // gyro_state: the Status frame's gyro_state (protocol/odometry.dbc): 0 no gyro, 1 fusing,
-// 2 learning the bias, 3 gyro fault.
+// 2 learning the bias (or waiting for the gyro's first sample), 3 gyro fault.
 std::uint8_t gyro_state(const loop::LoopGyroStatus& g) noexcept {
   if (!g.enabled) return 0;
-  if ((g.fusion_flags & kFusionGyroFault) != 0) return 3;
+  // A gyro still starting is not a fault: the bias is not known yet either, so state 2.
+  if ((g.fusion_flags & kFusionGyroFault) != 0 && g.gyro_flags != kGyroStarting) return 3;
   return g.bias_valid ? 1 : 2;
 }
 

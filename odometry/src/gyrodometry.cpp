@@ -339,9 +339,15 @@ FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
   const bool rate_ok = in.gyro.flags == kGyroOk && std::isfinite(in.gyro.rate_z);
   if (!rate_ok) {
     flags |= kFusionGyroFault;
-    if (gyro_was_ok_) ++counters_.gyro_faults;
+    // A gyro still starting (no sample yet, within its timeout) cannot be used but has not
+    // failed: no event, and the state is left as it was (its timeout, if it comes, is the event).
+    if (in.gyro.flags != kGyroStarting) {
+      if (gyro_was_ok_) ++counters_.gyro_faults;
+      gyro_was_ok_ = false;
+    }
+  } else {
+    gyro_was_ok_ = true;
   }
-  gyro_was_ok_ = rate_ok;
   const double abs_left = std::fabs(in.d_left), abs_right = std::fabs(in.d_right);
   if (abs_left + abs_right == 0.0) {  // both travels 0: a sum of magnitudes is 0 only then
     flags |= kFusionStill;

@@ -90,7 +90,6 @@ SimGyro::SimGyro(SimRobot& robot, const GyroModel& m, std::uint64_t seed, TimeNs
   next_t_ = robot.time() + period_;
   last_theta_ = robot.true_pose().theta;
   book_.stale_timeout = stale_timeout;
-  book_.last_stamp = robot.time();
   hist_[0] = {robot.time(), last_theta_};
   hist_n_ = 1;
 }

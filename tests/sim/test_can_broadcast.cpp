@@ -143,6 +143,49 @@ TEST(CanBroadcast, RatesFollowTheTickNumberWhenItRepeatsJumpsOrGoesBack) {
   EXPECT_GT(frames, 60u);
 }
 
+// gyro_state in the Status frame (protocol/odometry.dbc: 0 none, 1 fusing, 2 learning the bias or
+// waiting for the first sample, 3 fault), one snapshot per case on a status-every-tick bus.
+TEST(CanBroadcast, GyroStateFollowsTheGyroAndTheFusion) {
+  sim::SimCanPort port(64, 16);
+  fw::CanFrameRing ring{1 << 10};
+  fw::CanBroadcastOptions o;
+  o.div = fw::CanDivisors{0, 0, 0, 1, 0};  // status only, every tick
+  port.connect_wire();
+  fw::CanBroadcaster bc(o, port, nullptr, &ring);
+  struct Case {
+    bool enabled;
+    std::uint32_t gyro_flags, fusion_flags;
+    bool bias_valid;
+    int want;
+  };
+  const Case cases[] = {
+      {false, kGyroOk, 0, false, 0},                                       // no gyro wired
+      {true, kGyroOk, kFusionNoBias, false, 2},                            // learning the bias
+      {true, kGyroOk, 0, true, 1},                                         // fusing
+      {true, kGyroStarting, kFusionGyroFault | kFusionNoBias, false, 2},   // no sample yet
+      {true, kGyroStale, kFusionGyroFault, true, 3},                       // went stale
+      {true, kGyroStarting | kGyroReadError, kFusionGyroFault, false, 3},  // starting, read fails
+      {true, kGyroOk, kFusionGyroFault, true, 3},  // NaN rate (the fusion's flag)
+  };
+  std::uint64_t tick = 0;
+  for (const Case& c : cases) {
+    loop::LoopSnapshot s;
+    s.tick = tick++;
+    s.gyro.enabled = c.enabled;
+    s.gyro.gyro_flags = c.gyro_flags;
+    s.gyro.fusion_flags = c.fusion_flags;
+    s.gyro.bias_valid = c.bias_valid;
+    bc.on_tick(s);
+    CanFrame f;
+    protocol::StatusMsg st;
+    ASSERT_TRUE(ring.pop(f));
+    ASSERT_EQ(f.id, id(Msg::kStatus));
+    ASSERT_TRUE(protocol::decode_status(f, st));
+    EXPECT_EQ(st.gyro_state, c.want) << "case " << s.tick;
+    EXPECT_FALSE(ring.pop(f));
+  }
+}
+
 TEST(CanBroadcast, LinkDownDropsCountsKeepsTheLoopAndResumes) {
   Bench b;
   const auto before = b.ticks(50);

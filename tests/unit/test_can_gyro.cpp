@@ -223,14 +223,24 @@ TEST_F(CanGyro, MeanOfTheFramesOfOneReadAndTheNewestStamp) {
   EXPECT_EQ(s.counters.samples, 4u);
 }
 
-// Stale from the start until the first frame (also when the clock starts at 0, as the virtual
-// clock does: now < stale_timeout), not an event; then one event per fresh -> stale transition.
-TEST_F(CanGyro, StaleBeforeTheFirstFrameThenFreshThenStaleOncePerTransition) {
+// Before the first frame: starting (not usable, no event) for stale_timeout from the first read
+// (also when the clock starts at 0, as the virtual clock does), then stale with one event; then
+// one event per fresh -> stale transition.
+TEST_F(CanGyro, StartingThenStaleBeforeTheFirstFrameThenOneEventPerTransition) {
   CanGyroSource g = make();
-  for (TimeNs t : {TimeNs{0}, 10 * kMs, 60 * kMs, 100 * kMs}) {
+  // First read at 0: starting until 0 + 50 ms, stale (the first event) from 50 ms + 1 ns.
+  for (TimeNs t : {TimeNs{0}, 10 * kMs, 50 * kMs}) {
+    const GyroSample s = g.read(t);
+    EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kGyroStarting)) << t;
+    EXPECT_EQ(s.counters.stale_events, 0u) << t;
+    EXPECT_EQ(s.samples, 0u);
+    EXPECT_EQ(s.rate_z, 0.0);
+    EXPECT_EQ(s.stamp, 0);
+  }
+  for (TimeNs t : {50 * kMs + 1, 60 * kMs, 100 * kMs}) {
     const GyroSample s = g.read(t);
     EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kGyroStale)) << t;
-    EXPECT_EQ(s.counters.stale_events, 0u) << t;
+    EXPECT_EQ(s.counters.stale_events, 1u) << t;
     EXPECT_EQ(s.samples, 0u);
   }
   // First frame at 110 ms (2048 LSB = 0.5 rad/s): fresh while now - 110 ms <= 50 ms.
@@ -240,20 +250,20 @@ TEST_F(CanGyro, StaleBeforeTheFirstFrameThenFreshThenStaleOncePerTransition) {
     EXPECT_EQ(s.flags, 0u) << t;
     EXPECT_EQ(s.rate_z, 0.5);
   }
-  // 160 ms + 1 ns is 50 ms + 1 ns after the frame: stale, one event; it stays one.
+  // 160 ms + 1 ns is 50 ms + 1 ns after the frame: stale, the second event; it stays two.
   for (TimeNs t : {160 * kMs + 1, 170 * kMs, 300 * kMs}) {
     const GyroSample s = g.read(t);
     EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kGyroStale)) << t;
-    EXPECT_EQ(s.counters.stale_events, 1u) << t;
+    EXPECT_EQ(s.counters.stale_events, 2u) << t;
     EXPECT_EQ(s.rate_z, 0.5);  // the last rate is kept
   }
-  // Back at 400 ms, silent again: stale after 450 ms, the second event.
+  // Back at 400 ms, silent again: stale after 450 ms, the third event.
   port.inject(le16(0x00, 0x08, 400 * kMs));
   EXPECT_EQ(g.read(400 * kMs).flags, 0u);
   EXPECT_EQ(g.read(450 * kMs).flags, 0u);
   const GyroSample s = g.read(451 * kMs);
   EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kGyroStale));
-  EXPECT_EQ(s.counters.stale_events, 2u);
+  EXPECT_EQ(s.counters.stale_events, 3u);
 }
 
 // int16: -32768 and 32767 are the field's ends (saturated), -32767 and 32766 are not.
@@ -395,7 +405,7 @@ TEST_F(CanGyro, ReadAndReadIntoAgree) {
     std::vector<CanFrame> frames;
   };
   const Step steps[] = {
-      {5 * kMs, {}},                                                        // stale (start)
+      {5 * kMs, {}},                                                        // starting
       {10 * kMs, {le16(0x00, 0x10, 9 * kMs), le16(0x00, 0x20, 10 * kMs)}},  // 1.5 rad/s
       {20 * kMs, {}},                                                       // kept
       {30 * kMs, {le16(0x00, 0x80, 30 * kMs)}},                             // saturated
@@ -422,8 +432,8 @@ TEST_F(CanGyro, ReadAndReadIntoAgree) {
     EXPECT_EQ(x.counters.invalid, y.counters.invalid);
     EXPECT_EQ(x.counters.read_errors, y.counters.read_errors);
   }
-  // The last step: 3 samples, 1 saturation, 1 invalid frame, one stale event (the start-up
-  // state is none).
+  // The last step: 3 samples, 1 saturation, 1 invalid frame, one stale event (starting, before
+  // the first frame at 10 ms, is none).
   const GyroSample last = a.read(210 * kMs);
   EXPECT_EQ(last.counters.samples, 3u);
   EXPECT_EQ(last.counters.saturated, 1u);

@@ -262,6 +262,39 @@ TEST(Gyrodometry, FaultyGyroFallsBackToOdometry) {
   }
 }
 
+// A gyro still starting (kGyroStarting: no sample yet, within its timeout) is not used and is
+// no fault; the same gyro going stale without ever delivering is one fault, and so is a failure
+// after it has worked. Bias learning waits for usable samples: the standstill's still_time runs
+// from the first tick (0.5 s = 100 ticks), but only ticks with a usable rate are averaged.
+TEST(Gyrodometry, StartingGyroIsNotAFault) {
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  for (int i = 0; i < 150; ++i) {
+    const FusedTick t = g.step(input(0.0, 0.0, 0.0, kGyroStarting));
+    EXPECT_TRUE(t.flags & kFusionGyroFault);  // not used: odometry alone
+    EXPECT_EQ(t.flags & kFusionGyroUsed, 0u);
+  }
+  EXPECT_EQ(g.counters().gyro_faults, 0u);
+  EXPECT_FALSE(g.bias_valid());  // no usable sample yet, though still for 0.75 s
+  // The first samples arrive: ticks 151..250 are averaged (the standstill is long confirmed);
+  // the bias is valid once 0.5 s of them are (tick 250).
+  for (int i = 0; i < 100; ++i) g.step(input(0.0, 0.0, 1e-3));
+  EXPECT_TRUE(g.bias_valid());
+  EXPECT_NEAR(g.bias(), 1e-3, 1e-15);
+  EXPECT_EQ(g.counters().gyro_faults, 0u);
+  // It goes stale: the first fault. A source never reports starting again after a sample; were
+  // it to, that would not end the run of faults (no second count) as a usable sample does.
+  g.step(input(0.0, 0.0, 0.0, kGyroStale));
+  EXPECT_EQ(g.counters().gyro_faults, 1u);
+  g.step(input(0.0, 0.0, 0.0, kGyroStarting));
+  g.step(input(0.0, 0.0, 0.0, kGyroStale));
+  EXPECT_EQ(g.counters().gyro_faults, 1u);
+  // A source that never delivers: starting, then stale at its timeout: one fault.
+  auto h = Gyrodometry::create(params(kQLabMate)).value();
+  for (int i = 0; i < 10; ++i) h.step(input(0.0, 0.0, 0.0, kGyroStarting));
+  for (int i = 0; i < 10; ++i) h.step(input(0.0, 0.0, 0.0, kGyroStale));
+  EXPECT_EQ(h.counters().gyro_faults, 1u);
+}
+
 TEST(Gyrodometry, FaultDuringIntervalEndsIt) {
   auto g = Gyrodometry::create(params(kQLabMate)).value();
   learn_bias(g, 0.0);

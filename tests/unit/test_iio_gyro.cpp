@@ -208,10 +208,12 @@ TEST_F(FakeIio, BufferedReadsScaledMeanWithTimestamps) {
   EXPECT_DOUBLE_EQ(gyro.scale(), 0.000266);
   // Full scale: 32767 * 0.000266 = 8.716022 rad/s (500 deg/s = 8.726646: the LSB is rounded).
   EXPECT_NEAR(gyro.full_scale(), 8.716022, 1e-9);
-  // Nothing yet: no samples, not stale before the timeout.
+  // Nothing yet: no samples, starting (not usable, not stale) before the timeout, rate 0.
   GyroSample s = gyro.read(1'000'000'000);
   EXPECT_EQ(s.samples, 0u);
-  EXPECT_EQ(s.flags, kGyroOk);
+  EXPECT_EQ(s.flags, kGyroStarting);
+  EXPECT_EQ(s.rate_z, 0.0);
+  EXPECT_EQ(s.counters.stale_events, 0u);
   // Three scans: 100, 200, -60 LSB at 1.001, 1.002, 1.003 s. Mean 80 LSB, sign -1:
   // -80 * 0.000266 = -0.02128 rad/s, stamp of the newest scan.
   scan(100, 1'001'000'000);

@@ -14,8 +14,8 @@
 //   device's range: kGyroSaturated (and counted); a frame with the id but too short a DLC is
 //   kGyroInvalid (and counted); remote requests and other ids are ignored;
 // - the stamp is the newest sample's receive time (SocketCanBus: when the loop read it, so the
-//   [gyro] delay includes the transport); no sample for stale_timeout: kGyroStale, the start-up
-//   state before the first frame included (not counted as an event).
+//   [gyro] delay includes the transport); no sample for stale_timeout: kGyroStale; before the
+//   first frame kGyroStarting, for stale_timeout from the first read (GyroReadBook).
 #pragma once
 
 #include <cstdint>

@@ -95,7 +95,6 @@ class IioGyro final : public YawRateSource {
   std::size_t scan_bytes_ = 0, rate_off_ = 0, ts_off_ = 0;
   std::vector<std::uint8_t> buf_;  // max_scans_per_read scans, allocated at open
   std::size_t pending_ = 0;        // bytes of an incomplete scan kept from the last read
-  bool have_sample_ = false;
   GyroReadBook book_;
 };
 

@@ -16,6 +16,10 @@ enum GyroFlag : std::uint32_t {
   kGyroSaturated = 1u << 1,  // a sample reached the end of the measuring range
   kGyroInvalid = 1u << 2,    // the rate is not a finite number (NaN, inf) or undecodable
   kGyroReadError = 1u << 3,  // the backend could not read the device this tick
+  // No sample since start yet, and the first read was at most the source's timeout ago: the
+  // device is still starting (an IIO buffer's first scan, a CAN IMU's first frame). Not usable,
+  // but not a fault either; after the timeout it becomes kGyroStale.
+  kGyroStarting = 1u << 4,
 };
 
 // Cumulative event counters of a gyro backend since start; they only grow.
@@ -37,12 +41,15 @@ struct GyroSample {
 };
 
 // GyroReadBook: the bookkeeping every gyro source does at the end of a read, shared by the IIO
-// backend (drivers/) and the simulated gyro (sim_hal/) so that both flag and count alike.
+// and CAN backends (drivers/) and the simulated gyro (sim_hal/) so that all flag and count alike.
+// Start-up is one policy for all: until the first sample a read is kGyroStarting (rate 0, stamp
+// 0) for stale_timeout from the first read, then kGyroStale with one stale event.
 struct GyroReadBook {
   TimeNs stale_timeout = 0;  // no sample for longer than this: kGyroStale [ns]
-  TimeNs last_stamp = 0;     // time of the newest sample [ns]
+  TimeNs last_stamp = 0;     // time of the newest sample; before the first, of the first read [ns]
   double last_rate = 0.0;    // newest mean rate [rad/s]
   bool stale = false;
+  bool opened = false;  // close() has run
   GyroCounters counters;
 
   // close: s.samples samples of mean rate `mean` [rad/s] arrived in this read; fills rate_z (the
@@ -50,6 +57,10 @@ struct GyroReadBook {
   // the stale state) and the counters.
   void close(GyroSample& s, TimeNs now, double mean) noexcept {
     counters.samples += s.samples;
+    if (counters.samples == 0) {  // rare: only while the device has never delivered
+      close_waiting(s, now);
+      return;
+    }
     if (s.samples > 0) last_rate = mean;
     const bool now_stale = now - last_stamp > stale_timeout;
     if (now_stale) {
@@ -59,6 +70,20 @@ struct GyroReadBook {
     stale = now_stale;
     s.rate_z = last_rate;
     s.stamp = last_stamp;
+    s.counters = counters;
+  }
+
+  // close_waiting: close() before the first sample: the device's wait counts from the first read
+  // (not from a clock's zero or the source's construction, which may be long before the loop).
+  void close_waiting(GyroSample& s, TimeNs now) noexcept {
+    if (!opened) last_stamp = now;
+    opened = true;
+    const bool now_stale = now - last_stamp > stale_timeout;
+    s.flags |= now_stale ? kGyroStale : kGyroStarting;
+    if (now_stale && !stale) ++counters.stale_events;
+    stale = now_stale;
+    s.rate_z = 0.0;  // no rate to repeat: never a made-up one that reads as valid
+    s.stamp = 0;
     s.counters = counters;
   }
 };

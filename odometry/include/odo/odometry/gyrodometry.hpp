@@ -154,7 +154,8 @@ struct FusionCounters {
   std::uint64_t disagreements = 0;  // flagged intervals started by gyro/odometry disagreement
   std::uint64_t speed_events = 0;   // ... by a wheel speed beyond the limit
   std::uint64_t accel_events = 0;   // ... by a wheel acceleration beyond the limit
-  std::uint64_t gyro_faults = 0;    // transitions of the gyro into a faulty state
+  std::uint64_t gyro_faults = 0;    // transitions of the gyro into a faulty state (a gyro still
+                                    // starting, kGyroStarting, is not faulty)
   std::uint64_t flagged_ticks = 0;  // ticks whose heading came from the gyro
 };
 
@@ -304,7 +305,7 @@ class Gyrodometry {
   double interval_c_ = 0.0;   // heading corrections of the interval so far [rad]
   double interval_ds_ = 0.0;  // centre-travel corrections of the interval so far [m]
   double interval_l_ = 0.0, interval_r_ = 0.0;  // wheel travels the interval covers [m]
-  bool gyro_was_ok_ = true;
+  bool gyro_was_ok_ = true;  // the previous sample was usable or the gyro still starting
   FusionCounters counters_;
 };
 
