@@ -1,4 +1,5 @@
-// Fuzz target: received encoder-count frames (odo::drivers::decode_count and CanEncoderSource).
+// Fuzz target: received encoder-count frames (odo::drivers::decode_count and CanEncoderSource),
+// and the same frames as yaw-rate frames (CanGyroSource, which decodes its field alike).
 // Input: byte 0 chooses the layout (width 16..64 bits, signedness, byte order, 11/29-bit ids,
 // ODrive or generic), byte 1 the byte offsets, bytes 2-3 the base id; then records of 11 bytes:
 // [who, flags, dt_ms, 8 data bytes], who 0/1 = the left/right wheel's id, else a foreign id;
@@ -6,13 +7,19 @@
 // bit 2: the loop reads after this frame.
 // Properties: no crash or UB (ASan, UBSan); a decoded count re-encodes to the frame's bytes and
 // lies in the range of its width; samples stay inside counter_bits, carry only the stale and
-// jump flags, and their counters never decrease.
+// jump flags, and their counters never decrease. The gyro (on the left wheel's layout, when its
+// width is 16..32 bits) reads on the same records: a finite rate within the field's range, only
+// its four flags, starting only before its first sample, and counters that never decrease.
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 
 #include "fuzz_check.hpp"
 #include "odo/drivers/can_encoder.hpp"
+#include "odo/drivers/can_gyro.hpp"
 
 namespace {
 
@@ -60,6 +67,59 @@ void check_decoded(const CanFrame& f, const CanCountLayout& l, std::int64_t v) {
   }
 }
 
+// Gyro: a CanGyroSource on the left wheel's layout, fed the same frames on a bus of its own.
+class Gyro {
+ public:
+  // Gyro: `sel` picks the sign and offset; no gyro when the layout is not one a gyro takes.
+  Gyro(const CanCountLayout& field, std::uint8_t sel) {
+    cfg_.field = field;
+    cfg_.scale = 1.0 / 4096.0;
+    cfg_.offset = (sel & 0x04) != 0 ? -8.0 : 0.0;
+    cfg_.sign = (sel & 0x02) != 0 ? -1 : 1;
+    cfg_.stale_timeout = 50'000'000;
+    cfg_.max_frames_per_read = 16;
+    auto made = odo::drivers::CanGyroSource::create(bus_, cfg_);
+    if (made) gyro_.emplace(std::move(made).value());
+    // The field's ends [rad/s]: |rate| never exceeds the larger.
+    const int w = field.width_bits;
+    const double lo = field.is_signed ? -std::ldexp(1.0, w - 1) : 0.0;
+    const double hi = field.is_signed ? std::ldexp(1.0, w - 1) - 1.0 : std::ldexp(1.0, w) - 1.0;
+    bound_ = std::max(std::fabs(lo * cfg_.scale + cfg_.offset),
+                      std::fabs(hi * cfg_.scale + cfg_.offset));
+  }
+  void push(const CanFrame& f) noexcept { bus_.push(f); }
+  // read: one read at `now` [ns] and its properties.
+  void read(odo::TimeNs now) {
+    using odo::fuzz::require;
+    if (!gyro_) return;
+    const odo::GyroSample s = gyro_->read(now);
+    const std::uint32_t allowed =
+        odo::kGyroStale | odo::kGyroSaturated | odo::kGyroInvalid | odo::kGyroStarting;
+    require((s.flags & ~allowed) == 0, "gyro: unexpected flag");
+    require(std::isfinite(s.rate_z) && std::fabs(s.rate_z) <= bound_, "gyro: rate out of range");
+    require((s.flags & odo::kGyroStarting) == 0 || s.counters.samples == 0,
+            "gyro: starting after a sample");
+    // A read that took a sample is past starting (it may be stale: frames beyond
+    // max_frames_per_read wait, and the newest one taken can be old).
+    require(s.samples == 0 || (s.flags & odo::kGyroStarting) == 0, "gyro: starting with a sample");
+    require(s.stamp <= now, "gyro: stamp after the read");
+    const odo::GyroCounters& c = s.counters;
+    require(c.samples >= last_.samples && c.stale_events >= last_.stale_events &&
+                c.saturated >= last_.saturated && c.invalid >= last_.invalid,
+            "gyro: a counter went back");
+    require(c.samples + c.invalid <= gyro_->stats().frames, "gyro: more samples than frames");
+    require(c.read_errors == 0, "gyro: counted a read error this bus cannot give");
+    last_ = c;
+  }
+
+ private:
+  ListBus bus_;
+  odo::drivers::CanGyroConfig cfg_;
+  std::optional<odo::drivers::CanGyroSource> gyro_;
+  double bound_ = 0.0;
+  odo::GyroCounters last_{};
+};
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -94,6 +154,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!made) return 0;  // e.g. both wheels on the same bytes
   odo::drivers::CanEncoderSource enc = std::move(made).value();
   const int bits = enc.counter_bits();
+  Gyro gyro(cfg.left, sel);
   odo::TimeNs now = 1;
   odo::EncoderCounters last{};
   for (std::size_t at = 4; at + 11 <= size; at += 11) {
@@ -112,7 +173,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (odo::drivers::decode_count(f, *l, v) == CanDecode::kOk) check_decoded(f, *l, v);
     }
     bus.push(f);
+    gyro.push(f);
     if ((r[1] & 0x04) == 0) continue;
+    gyro.read(now);
     const odo::EncoderSample s = enc.read(now);
     const std::uint32_t allowed =
         odo::kEncoderStaleLeft | odo::kEncoderStaleRight | odo::kEncoderImplausibleJump;
