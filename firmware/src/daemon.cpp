@@ -122,6 +122,11 @@ class StatusPrinter {
   std::thread thread_;
 };
 
+// The README ("Gyro") documents gyro.flags by these bit values: they are part of --json.
+static_assert(kGyroStale == 1 && kGyroSaturated == 2 && kGyroInvalid == 4 && kGyroReadError == 8 &&
+                  kGyroStarting == 16,
+              "gyro.flags bits changed: update README \"Gyro\"");
+
 // gyro_json: the gyro and its fusion ([gyro]; README "Gyro").
 nlohmann::json gyro_json(const loop::LoopGyroStatus& g) {
   nlohmann::json j;
