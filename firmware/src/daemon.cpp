@@ -2,9 +2,12 @@
 
 #include <time.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstddef>
 #include <cstdio>
 #include <iomanip>
 #include <mutex>
@@ -31,31 +34,75 @@
 namespace odo::fw {
 namespace {
 
-std::string flags_text(std::uint32_t f) {
-  if (f == 0) return "ok";
+struct BitName {
+  std::uint32_t bit;
+  const char* name;
+};
+constexpr BitName kEncoderFlagNames[] = {{kEncoderStaleLeft, "stale-left"},
+                                         {kEncoderStaleRight, "stale-right"},
+                                         {kEncoderInvalidTransition, "invalid-transition"},
+                                         {kEncoderImplausibleJump, "implausible-jump"},
+                                         {kEncoderReadError, "read-error"}};
+constexpr BitName kGyroFlagNames[] = {{kGyroStarting, "starting"},
+                                      {kGyroStale, "stale"},
+                                      {kGyroSaturated, "saturated"},
+                                      {kGyroInvalid, "invalid"},
+                                      {kGyroReadError, "read-error"}};
+
+// bits_text: the names of the bits set in f, joined by '|'; "" when none is.
+template <std::size_t N>
+std::string bits_text(std::uint32_t f, const BitName (&names)[N]) {
   std::string s;
-  auto add = [&](std::uint32_t bit, const char* name) {
-    if (f & bit) s += (s.empty() ? "" : "|") + std::string(name);
-  };
-  add(kEncoderStaleLeft, "stale-left");
-  add(kEncoderStaleRight, "stale-right");
-  add(kEncoderInvalidTransition, "invalid-transition");
-  add(kEncoderImplausibleJump, "implausible-jump");
-  add(kEncoderReadError, "read-error");
+  for (const BitName& b : names) {
+    if (f & b.bit) s += (s.empty() ? "" : "|") + std::string(b.name);
+  }
   return s;
+}
+
+std::string flags_text(std::uint32_t f) {
+  return f == 0 ? "ok" : bits_text(f, kEncoderFlagNames);
+}
+
+struct Count {
+  const char* name;
+  std::uint64_t value;
+};
+
+// counts_text: " (name=value ...)" of four event counters, "" while all are 0.
+std::string counts_text(const std::array<Count, 4>& counts) {
+  if (std::all_of(counts.begin(), counts.end(), [](const Count& c) { return c.value == 0; }))
+    return {};
+  std::string s = " (";
+  for (std::size_t i = 0; i < counts.size(); ++i)
+    s += (i > 0 ? " " : "") + std::string(counts[i].name) + "=" + std::to_string(counts[i].value);
+  return s + ")";
+}
+
+// gyro_text: the status line's gyro part: what the fusion does this tick (the sample's flags
+// when it has any, "non-finite" for a NaN/inf rate without one, else learning-bias or fusing),
+// and the event counters once there is something to count.
+std::string gyro_text(const loop::LoopGyroStatus& g) {
+  std::string s = "  gyro=";
+  if (g.gyro_flags != 0)
+    s += bits_text(g.gyro_flags, kGyroFlagNames);
+  else if ((g.fusion_flags & kFusionGyroFault) != 0)
+    s += "non-finite";
+  else
+    s += g.bias_valid ? "fusing" : "learning-bias";
+  const FusionCounters& c = g.fusion;
+  return s + counts_text({{{"bumps", c.disagreements},
+                           {"speed", c.speed_events},
+                           {"accel", c.accel_events},
+                           {"faults", c.gyro_faults}}});
 }
 
 // counters_text: the cumulative encoder fault counters, once there is something to count (a
 // fault between two status lines would otherwise be invisible in the per-sample flags).
 std::string counters_text(const EncoderCounters& c) {
-  if (c.invalid_transitions + c.implausible_jumps + c.stale_events + c.read_errors == 0) return {};
-  char line[160];
-  std::snprintf(line, sizeof line, " (invalid=%llu jumps=%llu stale=%llu read_errors=%llu)",
-                static_cast<unsigned long long>(c.invalid_transitions),
-                static_cast<unsigned long long>(c.implausible_jumps),
-                static_cast<unsigned long long>(c.stale_events),
-                static_cast<unsigned long long>(c.read_errors));
-  return line;
+  return counts_text({{{"invalid", c.invalid_transitions},
+                       {"jumps", c.implausible_jumps},
+                       {"stale", c.stale_events},
+                       {"read_errors", c.read_errors}}});
 }
 
 // print_status: one status line; `truth` is the simulation's newest sample (null: none).
@@ -75,7 +122,9 @@ void print_status(std::ostream& out, const loop::LoopSnapshot& s, double rate_hz
                 format_timing_status(timing, sizeof timing, s.stats),
                 static_cast<unsigned long long>(s.stats.missed_deadlines),
                 flags_text(s.encoder_flags).c_str());
-  out << line << counters_text(s.encoder_counters) << std::endl;
+  out << line << counters_text(s.encoder_counters);
+  if (s.gyro.enabled) out << gyro_text(s.gyro);
+  out << std::endl;
 }
 
 nlohmann::json timing_json(const loop::TimingSummary& t) {
