@@ -97,11 +97,10 @@ class Gyro {
         odo::kGyroStale | odo::kGyroSaturated | odo::kGyroInvalid | odo::kGyroStarting;
     require((s.flags & ~allowed) == 0, "gyro: unexpected flag");
     require(std::isfinite(s.rate_z) && std::fabs(s.rate_z) <= bound_, "gyro: rate out of range");
+    // Starting only before the first sample, this read's included (a read that took one may
+    // still be stale: frames beyond max_frames_per_read wait, and the newest taken can be old).
     require((s.flags & odo::kGyroStarting) == 0 || s.counters.samples == 0,
             "gyro: starting after a sample");
-    // A read that took a sample is past starting (it may be stale: frames beyond
-    // max_frames_per_read wait, and the newest one taken can be old).
-    require(s.samples == 0 || (s.flags & odo::kGyroStarting) == 0, "gyro: starting with a sample");
     require(s.stamp <= now, "gyro: stamp after the read");
     const odo::GyroCounters& c = s.counters;
     require(c.samples >= last_.samples && c.stale_events >= last_.stale_events &&

@@ -62,12 +62,7 @@ struct GyroReadBook {
       return;
     }
     if (s.samples > 0) last_rate = mean;
-    const bool now_stale = now - last_stamp > stale_timeout;
-    if (now_stale) {
-      s.flags |= kGyroStale;
-      if (!stale) ++counters.stale_events;
-    }
-    stale = now_stale;
+    judge_stale(s, now);
     s.rate_z = last_rate;
     s.stamp = last_stamp;
     s.counters = counters;
@@ -78,13 +73,22 @@ struct GyroReadBook {
   void close_waiting(GyroSample& s, TimeNs now) noexcept {
     if (!opened) last_stamp = now;
     opened = true;
-    const bool now_stale = now - last_stamp > stale_timeout;
-    s.flags |= now_stale ? kGyroStale : kGyroStarting;
-    if (now_stale && !stale) ++counters.stale_events;
-    stale = now_stale;
+    if (!judge_stale(s, now)) s.flags |= kGyroStarting;
     s.rate_z = 0.0;  // no rate to repeat: never a made-up one that reads as valid
     s.stamp = 0;
     s.counters = counters;
+  }
+
+  // judge_stale: kGyroStale when nothing arrived for longer than stale_timeout since last_stamp,
+  // one stale event per transition into it; true when stale.
+  bool judge_stale(GyroSample& s, TimeNs now) noexcept {
+    const bool now_stale = now - last_stamp > stale_timeout;
+    if (now_stale) {
+      s.flags |= kGyroStale;
+      if (!stale) ++counters.stale_events;
+    }
+    stale = now_stale;
+    return now_stale;
   }
 };
 
