@@ -327,6 +327,22 @@ void read_can_gyro(TableReader t, CanGyroSection& s) {
   t.finish();
 }
 
+// check_gyro_robot: a simulated gyro measures the simulated robot's motion, so it needs the
+// simulated robot's encoders; caught here, with the line, before any hardware is opened.
+void check_gyro_robot(TableReader& root, const Config& c) {
+  if (!simulated_gyro(c) || simulated_robot(c)) return;
+  const std::string why =
+      " is a simulated gyro, which needs the simulated robot, but encoder.backend "
+      "= \"" +
+      std::string(name_of(c.encoder.backend)) +
+      "\" reads real hardware (use the real gyro: gyro.backend = \"iio\", or "
+      "\"can\" with can_gyro.bus = \"socketcan\")";
+  if (c.gyro.backend == GyroBackend::kSim)
+    root.sub("gyro").reject("backend", "= \"sim\"" + why);
+  else
+    root.sub("can_gyro").reject("bus", "= \"sim\" with gyro.backend = \"can\"" + why);
+}
+
 // first_non_ascii: the first byte >= 0x80 as "line N, column C (byte 0xXX)", or "" if none.
 // The config is plain ASCII: toml++ 3.3 (Debian 12) reaches __builtin_unreachable() on some
 // non-ASCII characters (upstream issues #190 and #295; found here by fuzz_config), so such a
@@ -388,9 +404,22 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_selfcal(root.sub("selfcal"), c.selfcal);
   read_gyro(root.sub("gyro"), c.gyro);
   read_can_gyro(root.sub("can_gyro"), c.can_gyro);
+  check_gyro_robot(root, c);
   root.finish();
   if (!error.empty()) return make_error(Errc::kInvalidArgument, error);
   return c;
+}
+
+bool simulated_robot(const Config& cfg) {
+  const EncoderKind be = cfg.encoder.backend;
+  return be == EncoderKind::kSim ||
+         (be == EncoderKind::kHctl1100 && cfg.hctl1100.bus == HctlBus::kSim) ||
+         (be == EncoderKind::kCan && cfg.can_encoder.bus == CanEncoderBus::kSim);
+}
+
+bool simulated_gyro(const Config& cfg) {
+  return cfg.gyro.backend == GyroBackend::kSim ||
+         (cfg.gyro.backend == GyroBackend::kCan && cfg.can_gyro.bus == CanEncoderBus::kSim);
 }
 
 Result<Config> load_config(const std::string& path) {

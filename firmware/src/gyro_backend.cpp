@@ -138,11 +138,6 @@ Error in_can_gyro(const Config& cfg, Error e) {
 
 }  // namespace
 
-bool simulated_gyro(const Config& cfg) {
-  return cfg.gyro.backend == GyroBackend::kSim ||
-         (cfg.gyro.backend == GyroBackend::kCan && cfg.can_gyro.bus == CanEncoderBus::kSim);
-}
-
 GyrodometryParams gyrodometry_params(const Config& cfg) {
   const GyroSection& g = cfg.gyro;
   GyrodometryParams p;

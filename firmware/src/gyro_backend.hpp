@@ -25,10 +25,6 @@ class GyroWiring {
   virtual const std::string& describe() const noexcept = 0;
 };
 
-// simulated_gyro: the gyro is the simulated model (backend "sim", or "can" with [can_gyro] bus
-// "sim"): it needs the simulated robot, and its model's figures are the fusion's defaults.
-bool simulated_gyro(const Config& cfg);
-
 // gyrodometry_params: the fusion's parameters from [gyro]; keys left unset take the simulated
 // model's figures (simulated_gyro) or the consumer-class defaults (GyroNoiseModel).
 GyrodometryParams gyrodometry_params(const Config& cfg);

@@ -278,7 +278,30 @@ INSTANTIATE_TEST_SUITE_P(
             "bad.toml:2: can_gyro.max_frames_per_read = 4097 is outside the allowed range [1, "
             "4096]"},
         Bad{"[can_gyro]\nsim_stop_after = -2\n", "bad.toml:2: can_gyro.sim_stop_after = -2"},
-        Bad{"[can_gyro]\nnode = 1\n", "bad.toml:2: can_gyro.node is not a known setting"}));
+        Bad{"[can_gyro]\nnode = 1\n", "bad.toml:2: can_gyro.node is not a known setting"},
+        // A simulated gyro measures the simulated robot: on real encoders it is refused here,
+        // at the line that asks for it, before any hardware is opened.
+        Bad{"[encoder]\nbackend = \"gpio\"\n[gyro]\nbackend = \"sim\"\n",
+            "bad.toml:4: gyro.backend = \"sim\" is a simulated gyro, which needs the simulated "
+            "robot, but encoder.backend = \"gpio\" reads real hardware"},
+        Bad{"[encoder]\nbackend = \"can\"\n[gyro]\nbackend = \"can\"\n[can_gyro]\nbus = "
+            "\"sim\"\n",
+            "bad.toml:6: can_gyro.bus = \"sim\" with gyro.backend = \"can\" is a simulated gyro, "
+            "which needs the simulated robot, but encoder.backend = \"can\" reads real "
+            "hardware"}));
+
+// The simulated gyro goes with every simulated robot: encoder backend sim, or the counter chip
+// and the CAN motor controllers on their simulated buses.
+TEST(ConfigEncoders, SimulatedGyroOnEverySimulatedRobot) {
+  for (const char* enc : {"backend = \"sim\"", "backend = \"hctl1100\"\n[hctl1100]\nbus = \"sim\"",
+                          "backend = \"can\"\n[can_encoder]\nbus = \"sim\""}) {
+    const std::string text = std::string("[gyro]\nbackend = \"sim\"\n[encoder]\n") + enc + "\n";
+    auto c = parse_config(text, "g.toml");
+    ASSERT_TRUE(c) << text << ": " << c.error().message;
+    EXPECT_TRUE(simulated_robot(*c));
+    EXPECT_TRUE(simulated_gyro(*c));
+  }
+}
 
 }  // namespace
 }  // namespace odo::fw

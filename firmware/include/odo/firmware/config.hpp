@@ -371,4 +371,12 @@ Result<Config> parse_config(std::string_view text, std::string_view source);
 // load_config: reads and parses a file.
 Result<Config> load_config(const std::string& path);
 
+// simulated_robot: the encoders are the simulated robot's (backend "sim", or hctl1100 /
+// can_encoder on their simulated bus).
+bool simulated_robot(const Config& cfg);
+
+// simulated_gyro: the gyro is the simulated model (backend "sim", or "can" with [can_gyro] bus
+// "sim"): it needs the simulated robot, and its model's figures are the fusion's defaults.
+bool simulated_gyro(const Config& cfg);
+
 }  // namespace odo::fw
