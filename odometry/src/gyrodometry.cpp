@@ -269,6 +269,23 @@ void Gyrodometry::update_bias(double rate, bool rate_ok, double dt) noexcept {
   update_b_res();
 }
 
+bool Gyrodometry::restore(const GyroCalibration& c) noexcept {
+  // A restart is a gap in the bias's learning like any drive without a standstill: the estimate
+  // keeps the weight it had (its residual B_res included), capped as update_bias caps it.
+  if (std::isfinite(c.bias) && std::isfinite(c.bias_time) && c.bias_time > 0.0) {
+    bias_ = c.bias;
+    bias_time_ = std::min(c.bias_time, p_.bias_tau);
+    bias_valid_ = bias_time_ >= p_.still_time;
+    update_b_res();
+  }
+  // Only a scale the estimator itself would have applied.
+  if (c.scale_valid && std::isfinite(c.scale) && std::fabs(c.scale - 1.0) <= p_.scale_max_error) {
+    scale_ = c.scale;
+    scale_valid_ = true;
+  }
+  return bias_valid_;
+}
+
 void Gyrodometry::update_scale(double odo, double raw_gyro, double dt) noexcept {
   if (std::fabs(odo) < p_.turn_rate_min * dt) return;
   // Sign-weighted sums: a residual bias adds to clockwise and subtracts from counter-clockwise

@@ -190,6 +190,68 @@ TEST(Gyrodometry, BumpReplacedOverTheWholeInterval) {
   EXPECT_NEAR(var, 2.642319e-8, 1e-13);
 }
 
+// After a restart mid-drive (the loop's state record): the restored calibration detects the
+// bump of BumpReplacedOverTheWholeInterval at once; a fresh fusion has no bias and cannot.
+TEST(Gyrodometry, RestoredCalibrationDetectsAtOnce) {
+  auto before = Gyrodometry::create(params(kQLabMate)).value();
+  learn_bias(before, 0.01);
+  const GyroCalibration c = before.calibration();
+  EXPECT_NEAR(c.bias_time, 0.51, 1e-12);  // 102 averaged ticks of 0.005 s (learn_bias)
+  EXPECT_NEAR(c.bias, 0.01, 1e-17);
+  auto restored = Gyrodometry::create(params(kQLabMate)).value();
+  auto fresh = Gyrodometry::create(params(kQLabMate)).value();
+  EXPECT_TRUE(restored.restore(c));
+  // Same bias, same averaging time, so the same B_res: the threshold of
+  // WindowIsTwentyTicksAndThresholdIsHandDerived, 5.061246e-4 rad.
+  EXPECT_NEAR(restored.threshold(), 5.061246e-4, 1e-9);
+  double fused_r = 0.0, fused_f = 0.0, odo = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    const bool bump = i >= 50 && i < 70;
+    const FusionInput in = input(bump ? 0.00113 : 0.001, 0.001, 0.01);
+    const FusedTick r = restored.step(in);
+    const FusedTick f = fresh.step(in);
+    EXPECT_EQ(r.flags & kFusionNoBias, 0u) << i;
+    EXPECT_NE(f.flags & kFusionNoBias, 0u) << i;
+    fused_r += r.dtheta;
+    fused_f += f.dtheta;
+    odo += r.dtheta_odo;
+  }
+  EXPECT_NEAR(odo, -7.647059e-3, 1e-9);  // the bump's heading error (see the test above)
+  EXPECT_NEAR(fused_r, 0.0, 1e-15);
+  EXPECT_EQ(restored.counters().disagreements, 1u);
+  EXPECT_EQ(fused_f, odo);  // without a bias: odometry alone, the bump kept
+  EXPECT_EQ(fresh.counters().disagreements, 0u);
+}
+
+TEST(Gyrodometry, RestoreKeepsTheEstimatorsOwnLimits) {
+  GyrodometryParams p = params(kQLabMate);
+  p.bias_tau = 60.0;
+  p.scale_max_error = 0.05;
+  auto g = Gyrodometry::create(p).value();
+  // Averaged longer than bias_tau: capped at it, as update_bias caps it.
+  EXPECT_TRUE(g.restore({2e-3, 1000.0, 1.0, false}));
+  EXPECT_EQ(g.calibration().bias_time, 60.0);
+  EXPECT_FALSE(g.scale_valid());
+  // Averaged for less than still_time (0.5 s): kept as 0.25 s of averaging, but not yet valid.
+  auto s = Gyrodometry::create(p).value();
+  EXPECT_FALSE(s.restore({2e-3, 0.25, 1.0, false}));
+  EXPECT_FALSE(s.bias_valid());
+  EXPECT_EQ(s.calibration().bias_time, 0.25);
+  // Scales: 1.04 is within 1 +- 0.05 and applied; 1.06 is not, nor is a NaN or a bias that was
+  // never learnt (bias_time 0).
+  auto k = Gyrodometry::create(p).value();
+  EXPECT_FALSE(k.restore({0.0, 0.0, 1.06, true}));
+  EXPECT_FALSE(k.scale_valid());
+  EXPECT_EQ(k.scale(), 1.0);
+  k.restore({0.0, 0.0, 1.04, true});
+  EXPECT_TRUE(k.scale_valid());
+  EXPECT_EQ(k.scale(), 1.04);
+  auto n = Gyrodometry::create(p).value();
+  EXPECT_FALSE(n.restore({std::numeric_limits<double>::quiet_NaN(), 10.0, 1.0, false}));
+  EXPECT_EQ(n.bias(), 0.0);
+  EXPECT_EQ(n.calibration().bias_time, 0.0);
+}
+
 TEST(Gyrodometry, WheelSpeedBeyondLimitFlagsASlip) {
   auto g = Gyrodometry::create(params(kQLabMate)).value();
   learn_bias(g, 0.0);

@@ -177,6 +177,15 @@ struct FusedTick {
   std::uint32_t flags = 0;   // FusionFlag bits
 };
 
+// What the fusion has learnt about its gyro: kept across a restart (the loop's state record) so
+// that detection resumes at once instead of waiting for the next standstill.
+struct GyroCalibration {
+  double bias = 0.0;         // [rad/s]
+  double bias_time = 0.0;    // [s] of standstill averaged into bias (0: never learnt)
+  double scale = 1.0;        // multiplies the bias-corrected rate
+  bool scale_valid = false;  // scale was estimated from turns
+};
+
 class Gyrodometry {
  public:
   // create: validates the parameters and sizes the window (the only allocation).
@@ -203,6 +212,13 @@ class Gyrodometry {
   bool bias_valid() const noexcept { return bias_valid_; }
   double scale() const noexcept { return scale_; }  // multiplies the bias-corrected rate
   bool scale_valid() const noexcept { return scale_valid_; }
+  // calibration: the bias and scale as learnt so far.
+  GyroCalibration calibration() const noexcept { return {bias_, bias_time_, scale_, scale_valid_}; }
+  // restore: continue from a calibration learnt before a restart (same gyro, same boot). The
+  // averaging time is capped at bias_tau; a bias averaged for less than still_time stays invalid,
+  // a non-finite value or a scale beyond 1 +- scale_max_error is ignored. Returns whether the
+  // bias is now valid.
+  bool restore(const GyroCalibration& c) noexcept;
   bool in_interval() const noexcept { return in_interval_; }
   const FusionCounters& counters() const noexcept { return counters_; }
   const GyrodometryParams& params() const noexcept { return p_; }
