@@ -107,6 +107,12 @@ void OdometryLoop::apply_resume(const EncoderSample& s) noexcept {
   // once (the arc of a constant-curvature gap is exact) and the covariance grows for it.
   odom_.advance(resume_.dl, resume_.dr, to_seconds(resume_.gap));
   resume_.pose = odom_.pose();
+  // The same gyro (its id says so) in the same boot: its bias has drifted only for the gap, as
+  // it drifts on any drive without a standstill, so detection goes on at once.
+  if (fusion_ && resume_.gyro_matches) {
+    resume_.gyro_restored = fusion_->restore(resume_rec_.gyro);
+    resume_.gyro = fusion_->calibration();  // told by other threads: a copy, not the fusion's
+  }
 }
 
 LoopSnapshot& OdometryLoop::copy_newest() noexcept {

@@ -14,6 +14,10 @@ namespace odo::loop {
 namespace {
 
 constexpr std::size_t kCrcOffset = kStateRecordBytes - 4;
+// Version 2's gyro part.
+constexpr std::size_t kGyroId = 208, kGyroFlags = 212, kGyroBias = 216, kGyroBiasTime = 224,
+                      kGyroScale = 232;
+constexpr std::uint8_t kGyroScaleValid = 1;
 
 template <class T>
 void put(StateBytes& b, std::size_t off, T v) noexcept {
@@ -73,19 +77,45 @@ void encode_state(const StateRecord& r, StateBytes& b) noexcept {
   put(b, 72, r.calibration_sequence);
   const auto d = doubles(r);
   for (std::size_t i = 0; i < kDoubles; ++i) put(b, kFirstDouble + 8 * i, *d[i]);
+  put(b, kGyroId, r.gyro_id);
+  put(b, kGyroFlags, r.gyro.scale_valid ? kGyroScaleValid : std::uint8_t{0});
+  put(b, kGyroFlags + 1, std::uint8_t{0});
+  put(b, kGyroFlags + 2, std::uint16_t{0});
+  put(b, kGyroBias, r.gyro.bias);
+  put(b, kGyroBiasTime, r.gyro.bias_time);
+  put(b, kGyroScale, r.gyro.scale);
   put(b, kCrcOffset, calib::crc32(std::span<const std::uint8_t>(b.data(), kCrcOffset)));
 }
 
+// decode_gyro: version 2's gyro part of `b` into r.
+Status decode_gyro(std::span<const std::uint8_t> b, StateRecord& r) {
+  r.gyro_id = get<std::uint32_t>(b, kGyroId);
+  r.gyro.scale_valid = (get<std::uint8_t>(b, kGyroFlags) & kGyroScaleValid) != 0;
+  r.gyro.bias = get<double>(b, kGyroBias);
+  r.gyro.bias_time = get<double>(b, kGyroBiasTime);
+  r.gyro.scale = get<double>(b, kGyroScale);
+  if (!std::isfinite(r.gyro.bias)) return corrupt("non-finite gyro bias");
+  // Both are written by the fusion, which keeps them there: anything else is damage.
+  if (!(r.gyro.bias_time >= 0.0 && r.gyro.bias_time <= 1e9))
+    return corrupt("gyro bias averaging time outside [0, 1e9] s");
+  if (!(r.gyro.scale > 0.0 && r.gyro.scale < 2.0)) return corrupt("gyro scale outside (0, 2)");
+  return Ok{};
+}
+
 Result<StateRecord> decode_state(std::span<const std::uint8_t> b) {
-  if (b.size() < kStateRecordBytes)
+  const auto version = b.size() >= 8 ? get<std::uint16_t>(b, 4) : std::uint16_t{0};
+  const std::size_t length = version == 1 ? kStateRecordBytesV1 : kStateRecordBytes;
+  if (b.size() < length)
     return corrupt("length " + std::to_string(b.size()) + " bytes, expected " +
-                   std::to_string(kStateRecordBytes));
+                   std::to_string(length));
   if (get<std::uint32_t>(b, 0) != kStateMagic) return corrupt("bad magic (not a state record)");
-  if (get<std::uint16_t>(b, 4) != kStateVersion || get<std::uint16_t>(b, 6) != kStateRecordBytes)
-    return corrupt("version " + std::to_string(get<std::uint16_t>(b, 4)) + " length " +
-                   std::to_string(get<std::uint16_t>(b, 6)) + ", expected version 1 length 212");
+  if ((version != 1 && version != kStateVersion) || get<std::uint16_t>(b, 6) != length)
+    return corrupt("version " + std::to_string(version) + " length " +
+                   std::to_string(get<std::uint16_t>(b, 6)) +
+                   ", expected version 2 length 244 (or 1 and 212)");
   // The CRC covers everything else: a write torn at any byte fails here.
-  if (get<std::uint32_t>(b, kCrcOffset) != calib::crc32(b.first(kCrcOffset)))
+  const std::size_t crc_at = length - 4;
+  if (get<std::uint32_t>(b, crc_at) != calib::crc32(b.first(crc_at)))
     return corrupt("CRC mismatch (torn or damaged write)");
   StateRecord r;
   r.sequence = get<std::uint64_t>(b, 8);
@@ -107,6 +137,15 @@ Result<StateRecord> decode_state(std::span<const std::uint8_t> b) {
   if (!check_counter_bits(r.counter_bits))
     return corrupt("counter width " + std::to_string(r.counter_bits) + " outside [16, 64]");
   if (r.sequence == 0) return corrupt("sequence 0");
+  // Values no loop writes: a sample time before its clock's zero (the resume decision subtracts
+  // it from the clock's now, which must not overflow) and kinematics that are no kinematics.
+  if (r.stamp < 0) return corrupt("negative sample time");
+  if (!(r.metres_per_count_left > 0.0 && r.metres_per_count_right > 0.0 && r.wheelbase > 0.0))
+    return corrupt("metres per count or wheelbase not positive");
+  // Version 1 has no gyro part: gyro_id 0 matches no gyro, so nothing is restored from it.
+  if (version == kStateVersion) {
+    if (auto st = decode_gyro(b, r); !st) return std::move(st).error();
+  }
   return r;
 }
 
@@ -165,6 +204,7 @@ ResumeDecision decide_resume(const StateRecord& rec, const ResumeContext& ctx,
   if (std::fabs(static_cast<double>(d.dl)) > max_l || std::fabs(static_cast<double>(d.dr)) > max_r)
     return fresh(ResumeReason::kCounterJump);
   d.reason = ResumeReason::kResumed;
+  d.gyro_matches = ctx.gyro_id != 0 && rec.gyro_id == ctx.gyro_id;
   return d;
 }
 
@@ -181,6 +221,8 @@ void fill_state_record(const OdometryLoop& loop, StateRecord& r) noexcept {
   r.pose = o.pose();
   r.cov = o.covariance();
   r.distance = o.distance();
+  // gyro_id is the firmware's, like backend; the calibration is the fusion's (none: not learnt).
+  if (const Gyrodometry* f = loop.fusion()) r.gyro = f->calibration();
 }
 
 }  // namespace odo::loop

@@ -24,6 +24,7 @@ Result<std::unique_ptr<SimRun>> SimRun::create(const RobotGeometry& g, const Kin
     // The model's delay as it is (see gyrodometry_params in firmware/src/gyro_backend.cpp).
     lc.gyrodometry.gyro_delay = o.gyro->delay;
   }
+  run->loop_config_ = lc;
   auto loop = loop::OdometryLoop::create(lc, believed, run->encoder_, run->clock_,
                                          run->gyro_ ? &*run->gyro_ : nullptr);
   if (!loop) return std::move(loop).error();

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "odo/loop/state_record.hpp"
 #include "odo/sim/floor.hpp"
 #include "odo/sim/sim_run.hpp"
 
@@ -133,6 +134,67 @@ TEST(LoopGyro, SetPoseMidLegKeepsTheFusionRight) {
   EXPECT_EQ(lp.commands_applied(), 1u);
   const double turned = fused->robot().true_pose().theta - truth_at_reset;
   EXPECT_LT(std::fabs(lp.odometry().pose().theta - turned), 0.1034 / 2.0 / 10.0);
+}
+
+// restart_mid_leg: the bump leg with the process restarted 2 s into the drive (0.1 s down, the
+// robot rolling on): the state record goes through its bytes to a new loop on the same robot,
+// encoders and gyro; its gyro id matches the record's or not. The heading error at the end.
+struct Restarted {
+  loop::ResumeDecision decision;
+  double heading_error = 0.0;
+  std::uint64_t events = 0;
+};
+Restarted restart_mid_leg(bool same_gyro) {
+  Leg leg;
+  UmbmarkFloor f(bumps(10), 1);
+  auto run = leg.run(&f, true);
+  loop::OdometryLoop& first = run->loop();
+  first.start();
+  for (int i = 0; i < 600; ++i) first.tick();  // 1 s lead-in and 2 s of the leg at 200 Hz
+  loop::StateRecord rec;
+  loop::fill_state_record(first, rec);
+  rec.sequence = 1;
+  rec.gyro_id = 7;
+  loop::StateBytes bytes{};
+  loop::encode_state(rec, bytes);
+  run->clock().advance(from_seconds(0.1));
+  auto second = loop::OdometryLoop::create(run->loop_config(), leg.k, run->encoder(), run->clock(),
+                                           run->gyro())
+                    .value();
+  loop::ResumeContext c;
+  c.max_age = from_seconds(1.0);
+  c.backend_continuous = true;  // the simulated robot's counters count on while nobody reads
+  c.counter_bits = second->counter_bits();
+  c.metres_per_count_left = leg.k.metres_per_count_left();
+  c.metres_per_count_right = leg.k.metres_per_count_right();
+  c.wheelbase = leg.k.wheelbase();
+  c.gyro_id = same_gyro ? 7 : 8;
+  second->resume_from(loop::decode_state(bytes).value(), c);
+  second->start();
+  while (second->last_stamp() < from_seconds(22.0)) second->tick();
+  return {second->resume_decision(),
+          run->robot().true_pose().theta - second->odometry().pose().theta,
+          second->fusion()->counters().disagreements};
+}
+
+TEST(LoopGyro, RestartMidLegKeepsDetectingWithTheRestoredBias) {
+  // 2 s of the 20 s leg are done at the restart: the bumps after it turn odometry's heading by
+  // most of the leg's 0.1034 rad. With the gyro's bias restored (same gyro) the fusion rejects
+  // them as if there had been no restart (LoopGyro.BumpsOnALegAreRejectedInTheLoop's 10x); with
+  // another gyro's record it has no bias until the standstill at the end, and keeps them.
+  const Restarted same = restart_mid_leg(true);
+  const Restarted other = restart_mid_leg(false);
+  ASSERT_TRUE(same.decision.resumed()) << loop::resume_reason_name(same.decision.reason);
+  ASSERT_TRUE(other.decision.resumed());
+  EXPECT_TRUE(same.decision.gyro_restored);
+  EXPECT_FALSE(other.decision.gyro_restored);
+  EXPECT_GT(same.decision.gyro.bias_time, 0.0);
+  EXPECT_LT(std::fabs(same.heading_error), 0.1034 / 10.0);
+  EXPECT_GT(std::fabs(other.heading_error), 0.1034 / 2.0);
+  EXPECT_GE(same.events, 8u);
+  EXPECT_EQ(other.events, 0u);
+  std::printf("restart 2 s into the bump leg: heading error %.3e rad restored, %.3e rad not\n",
+              same.heading_error, other.heading_error);
 }
 
 }  // namespace

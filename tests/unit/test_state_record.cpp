@@ -4,6 +4,7 @@
 
 #include <cstring>
 
+#include "odo/calibration/record.hpp"
 #include "odo/loop/state_record.hpp"
 
 namespace odo::loop {
@@ -30,6 +31,8 @@ StateRecord sample_record(std::uint64_t seq) {
   r.pose = {1.5, -2.25, 7.0};  // theta beyond 2 pi: cumulative heading kept
   for (std::size_t i = 0; i < 9; ++i) r.cov[i] = 1e-6 * static_cast<double>(i + 1);
   r.distance = 12.5;
+  r.gyro_id = 0x12345678;
+  r.gyro = {1.5e-3, 30.0, 1.01, true};  // bias [rad/s], 30 s averaged, scale 1.01 estimated
   return r;
 }
 
@@ -47,6 +50,7 @@ ResumeContext matching_context(const StateRecord& r) {
   c.metres_per_count_right = r.metres_per_count_right;
   c.wheelbase = r.wheelbase;
   c.max_wheel_speed = 3.0;
+  c.gyro_id = r.gyro_id;
   return c;
 }
 
@@ -81,10 +85,50 @@ TEST(StateRecord, RoundTripKeepsEveryField) {
   EXPECT_EQ(d->pose.theta, 7.0);
   EXPECT_EQ(d->cov[8], 9e-6);
   EXPECT_EQ(d->distance, 12.5);
-  // Byte 0..3: "ODST"; 6..7: length 212 = 0x00D4 little endian.
+  EXPECT_EQ(d->gyro_id, 0x12345678U);
+  EXPECT_EQ(d->gyro.bias, 1.5e-3);
+  EXPECT_EQ(d->gyro.bias_time, 30.0);
+  EXPECT_EQ(d->gyro.scale, 1.01);
+  EXPECT_TRUE(d->gyro.scale_valid);
+  // Byte 0..3: "ODST"; 4..5: version 2; 6..7: length 244 = 0x00F4 little endian; 208..211 the
+  // gyro id 0x12345678 little endian; 212 flags (bit 0: scale valid).
   EXPECT_EQ(std::memcmp(b.data(), "ODST", 4), 0);
-  EXPECT_EQ(b[6], 0xD4);
+  EXPECT_EQ(b[4], 2);
+  EXPECT_EQ(b[6], 0xF4);
   EXPECT_EQ(b[7], 0x00);
+  EXPECT_EQ(b[208], 0x78);
+  EXPECT_EQ(b[211], 0x12);
+  EXPECT_EQ(b[212], 1);
+}
+
+// A version-1 record (212 bytes, written before the gyro part existed) is still read, so an
+// update does not lose the pose: everything but the gyro part, which reads as no gyro.
+TEST(StateRecord, VersionOneRecordIsStillRead) {
+  StateBytes b{};
+  encode_state(sample_record(42), b);
+  // Version 1's bytes are version 2's first 208 with version 1, length 212 and the CRC of
+  // bytes [0, 208) at 208.
+  b[4] = 1;
+  b[6] = 212;
+  const std::uint32_t crc = calib::crc32(std::span<const std::uint8_t>(b.data(), 208));
+  for (int i = 0; i < 4; ++i) b[208 + i] = static_cast<std::uint8_t>(crc >> (8 * i));
+  auto d = decode_state(std::span<const std::uint8_t>(b.data(), kStateRecordBytesV1));
+  ASSERT_TRUE(d) << d.error().message;
+  EXPECT_EQ(d->sequence, 42U);
+  EXPECT_EQ(d->pose.theta, 7.0);
+  EXPECT_EQ(d->distance, 12.5);
+  EXPECT_EQ(d->gyro_id, 0U);
+  EXPECT_EQ(d->gyro.bias_time, 0.0);
+  EXPECT_FALSE(d->gyro.scale_valid);
+  // In a two-slot file beside an older version-2 record, the newer version-1 one wins.
+  std::array<std::uint8_t, kStateFileBytes> file{};
+  StateBytes older{};
+  encode_state(sample_record(41), older);
+  std::memcpy(file.data() + kStateSlotBytes, older.data(), older.size());
+  std::memcpy(file.data(), b.data(), kStateRecordBytesV1);
+  EXPECT_EQ(decode_state_file(file)->sequence, 42U);
+  // A version-1 header on a slot cut before 212 bytes is torn.
+  EXPECT_FALSE(decode_state(std::span<const std::uint8_t>(b.data(), kStateRecordBytesV1 - 1)));
 }
 
 // A write of record `next` over record `prev` in the same slot, torn after k bytes: the slot
@@ -113,9 +157,9 @@ TEST(StateRecord, WriteTornAtEveryByteIsDetected) {
     if (k < kStateRecordBytes && !same(*d, prev)) ADD_FAILURE() << "k=" << k;
   }
   // Bytes 0..7 (magic, version, length) are the same in both records, so k <= 8 leaves prev
-  // intact; from k = 9 on the sequence's byte 8 differs (6 vs 8) and k = 212 is next intact:
-  // the 203 slots k = 9..211 are torn and all rejected.
-  EXPECT_EQ(rejected, 203);
+  // intact; from k = 9 on the sequence's byte 8 differs (6 vs 8) and k = 244 is next intact:
+  // the 235 slots k = 9..243 are torn and all rejected.
+  EXPECT_EQ(rejected, 235);
 }
 
 // Two-slot file: a torn write into one slot leaves the other slot's record, the newest valid.
@@ -130,7 +174,10 @@ TEST(StateRecord, FileWithOneTornSlotGivesTheOtherSlot) {
     std::memcpy(f.data(), b.data(), k);
     auto d = decode_state_file(f);
     ASSERT_TRUE(d) << "k=" << k;
-    EXPECT_EQ(d->sequence, 7U) << "k=" << k;
+    // A write cut where the bytes still to come already hold their values (the zeros of a new
+    // file) is not torn: the slot is record 8 intact. Otherwise it is torn and 7 remains.
+    const bool intact = std::memcmp(f.data(), b.data(), b.size()) == 0;
+    EXPECT_EQ(d->sequence, intact ? 8U : 7U) << "k=" << k;
   }
   std::memcpy(file.data(), b.data(), b.size());
   EXPECT_EQ(decode_state_file(file)->sequence, 8U);
@@ -165,6 +212,19 @@ TEST(StateRecord, CorruptValuesAreRejected) {
   bad.counter_bits = 8;
   encode_state(bad, b);
   EXPECT_NE(decode_state(b).error().message.find("counter width"), std::string::npos);
+  // The gyro part: values the fusion never holds are damage, with a valid CRC or not.
+  bad = sample_record(3);
+  bad.gyro.bias = std::numeric_limits<double>::infinity();
+  encode_state(bad, b);
+  EXPECT_NE(decode_state(b).error().message.find("non-finite gyro bias"), std::string::npos);
+  bad = sample_record(3);
+  bad.gyro.bias_time = -1.0;
+  encode_state(bad, b);
+  EXPECT_NE(decode_state(b).error().message.find("averaging time"), std::string::npos);
+  bad = sample_record(3);
+  bad.gyro.scale = 0.0;
+  encode_state(bad, b);
+  EXPECT_NE(decode_state(b).error().message.find("gyro scale"), std::string::npos);
 }
 
 TEST(ResumeDecision, ResumesAcrossTheWrapWithTheGapsCounts) {
@@ -177,6 +237,28 @@ TEST(ResumeDecision, ResumesAcrossTheWrapWithTheGapsCounts) {
   EXPECT_EQ(d.dr, 100);
   EXPECT_EQ(d.gap, 500'000'000);
   EXPECT_EQ(resume_reason_name(d.reason), "resumed");
+}
+
+// The gyro's calibration goes only to the gyro it was learnt on: same nonzero id, and only
+// with the pose (a fresh start relearns everything).
+TEST(ResumeDecision, GyroCalibrationGoesOnlyToTheSameGyro) {
+  StateRecord r = sample_record(9);
+  const EncoderSample ok = reading(r, 20, 88, 0.5);
+  ResumeContext c = matching_context(r);
+  EXPECT_TRUE(decide_resume(r, c, ok).gyro_matches);
+  c.gyro_id = 0x12345679;  // another gyro (another device, axis, sign, ...)
+  auto d = decide_resume(r, c, ok);
+  EXPECT_TRUE(d.resumed());  // the pose still resumes
+  EXPECT_FALSE(d.gyro_matches);
+  c.gyro_id = 0;  // no gyro now
+  EXPECT_FALSE(decide_resume(r, c, ok).gyro_matches);
+  r.gyro_id = 0;  // neither then nor now: nothing to restore
+  EXPECT_FALSE(decide_resume(r, c, ok).gyro_matches);
+  r = sample_record(9);
+  c = matching_context(r);
+  c.boot_id[0] ^= 1;
+  EXPECT_FALSE(decide_resume(r, c, ok).gyro_matches);
+  EXPECT_FALSE(decide_resume(r, c, ok).gyro_restored);  // the loop's to set, never the decision's
 }
 
 TEST(ResumeDecision, EveryFreshStartReason) {

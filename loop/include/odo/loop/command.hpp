@@ -30,7 +30,8 @@ struct SetKinematics {
 };
 
 using Command = std::variant<SetPose, SetKinematics>;
-static_assert(std::is_trivially_copyable_v<Command>, "commands are copied through a lock-free ring");
+static_assert(std::is_trivially_copyable_v<Command>,
+              "commands are copied through a lock-free ring");
 
 // CommandQueue: bounded multi-producer single-consumer queue, allocated inside the object (no
 // heap), lock-free for the consumer (the loop thread never waits). A slot's sequence number

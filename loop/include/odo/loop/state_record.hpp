@@ -13,6 +13,7 @@
 #include "odo/hal/result.hpp"
 #include "odo/hal/time.hpp"
 #include "odo/odometry/error_model.hpp"
+#include "odo/odometry/gyrodometry.hpp"
 #include "odo/odometry/pose.hpp"
 
 namespace odo::loop {
@@ -37,16 +38,24 @@ struct StateRecord {
   Pose2 pose;                              // cumulative heading
   Cov3 cov{};                              // (x, y, theta), row-major
   double distance = 0.0;                   // path length [m]
+  // Version 2: the gyro fusion's calibration, and which gyro it belongs to (the firmware's
+  // gyro id; 0: no gyro). A version-1 record reads as gyro_id 0.
+  std::uint32_t gyro_id = 0;
+  GyroCalibration gyro;
 };
 
 // Layout (little endian): 0 magic "ODST" u32, 4 version u16, 6 length u16, 8 sequence u64,
 // 16 boot id [16], 32 clock_epoch u64, 40 stamp i64, 48 left i64, 56 right i64, 64 counter_bits
 // u8, 65 backend u8, 66 calibration_state u8, 67 reserved u8 (0), 68 reserved u32 (0),
 // 72 calibration_sequence u64, 80 m/count left, 88 m/count right, 96 wheelbase, 104 x, 112 y,
-// 120 theta, 128 cov[9], 200 distance (f64), 208 CRC-32 of bytes [0, 208). Length 212.
+// 120 theta, 128 cov[9], 200 distance (f64); version 2 adds 208 gyro_id u32, 212 gyro flags u8
+// (bit 0: scale valid), 213 reserved u8 u16 (0), 216 gyro bias, 224 its averaging time, 232
+// gyro scale (f64); then the CRC-32 of all bytes before it: 240 (version 2, length 244), or 208
+// (version 1, length 212, still read: a record written before an update resumes).
 inline constexpr std::uint32_t kStateMagic = 0x5453444FU;  // bytes 'O' 'D' 'S' 'T'
-inline constexpr std::uint16_t kStateVersion = 1;
-inline constexpr std::size_t kStateRecordBytes = 212;
+inline constexpr std::uint16_t kStateVersion = 2;
+inline constexpr std::size_t kStateRecordBytes = 244;
+inline constexpr std::size_t kStateRecordBytesV1 = 212;
 // A state file holds two slots (A at 0, B at kStateSlotBytes): record n goes to slot n % 2, so a
 // write torn at any byte leaves the other slot's record intact.
 inline constexpr std::size_t kStateSlotBytes = 256;
@@ -57,8 +66,10 @@ using StateBytes = std::array<std::uint8_t, kStateRecordBytes>;
 // encode_state: the bytes of `r` (no allocation; callable on any thread).
 void encode_state(const StateRecord& r, StateBytes& out) noexcept;
 
-// decode_state: the record in `bytes`; Errc::kCorrupt naming the reason (length, magic,
-// version, CRC, counter width, non-finite value) when it is not a valid record.
+// decode_state: the record in `bytes` (version 2, or 1 without the gyro part); Errc::kCorrupt
+// naming the reason (length, magic, version, CRC, counter width, sequence 0, non-finite value,
+// negative sample time, kinematics not positive, gyro scale or averaging time out of range)
+// when it is not a valid record.
 Result<StateRecord> decode_state(std::span<const std::uint8_t> bytes);
 
 // decode_state_file: the newest valid record of a two-slot state file (kStateFileBytes, or
@@ -106,6 +117,7 @@ struct ResumeContext {
   double metres_per_count_right = 0.0;
   double wheelbase = 0.0;
   double max_wheel_speed = 3.0;  // [m/s] physical maximum: bounds the travel during the gap
+  std::uint32_t gyro_id = 0;     // the firmware's id of the gyro now configured (0: none)
 };
 
 // ResumeDecision: the outcome; on kResumed the gap's count deltas to integrate as one step.
@@ -115,6 +127,10 @@ struct ResumeDecision {
   std::int64_t dl = 0;  // counts of each wheel during the gap (wrap rule)
   std::int64_t dr = 0;
   Pose2 pose;  // on kResumed: the pose the loop starts from (the record's plus the gap's step)
+  // On kResumed: the record's gyro calibration belongs to this loop's gyro (same nonzero id).
+  bool gyro_matches = false;
+  bool gyro_restored = false;  // the loop restored it and its bias is valid
+  GyroCalibration gyro;        // on gyro_restored: the fusion's calibration after the restore
   bool resumed() const noexcept { return reason == ResumeReason::kResumed; }
 };
 
@@ -122,6 +138,7 @@ struct ResumeDecision {
 // reading `current` after the restart. Checks in order: boot, clock, age, backend, continuity,
 // kinematics, calibration, reading health, counter plausibility (each wheel's travel during the
 // gap at most max_wheel_speed * gap plus one count, and that bound below half the counter range).
+// On kResumed also whether the record's gyro calibration is this gyro's (gyro_matches).
 ResumeDecision decide_resume(const StateRecord& rec, const ResumeContext& ctx,
                              const EncoderSample& current) noexcept;
 

@@ -49,6 +49,9 @@ class SimRun {
   // gyro: the simulated gyro (fault injection), null without SimRunOptions::gyro.
   SimGyro* gyro() noexcept { return gyro_ ? &*gyro_ : nullptr; }
   loop::OdometryLoop& loop() noexcept { return *loop_; }
+  // loop_config: the loop's configuration (the gyro model's noise and delay filled in): a second
+  // loop on the same robot, as after a restart, is created with it.
+  const loop::LoopConfig& loop_config() const noexcept { return loop_config_; }
 
  private:
   SimRun(SimRobot robot, const SimRunOptions& o);
@@ -56,6 +59,7 @@ class SimRun {
   SimRobot robot_;
   SimEncoderSource encoder_;
   std::optional<SimGyro> gyro_;
+  loop::LoopConfig loop_config_;
   std::unique_ptr<loop::OdometryLoop> loop_;
 };
 
