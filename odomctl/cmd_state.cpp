@@ -46,7 +46,12 @@ nlohmann::json state_json(const loop::StateRecord& r) {
           {"y", r.pose.y},
           {"theta_cumulative", r.pose.theta},
           {"cov", r.cov},
-          {"distance", r.distance}};
+          {"distance", r.distance},
+          {"gyro_id", r.gyro_id},
+          {"gyro_bias", r.gyro.bias},
+          {"gyro_bias_time", r.gyro.bias_time},
+          {"gyro_scale", r.gyro.scale},
+          {"gyro_scale_valid", r.gyro.scale_valid}};
 }
 
 void run_state_show(const StateOpts& o, int& exit_code) {
@@ -72,6 +77,13 @@ void run_state_show(const StateOpts& o, int& exit_code) {
   std::printf(
       "  kinematics %.9g / %.9g m per count, wheelbase %.6f m; calibration sequence %" PRIu64 "\n",
       r->metres_per_count_left, r->metres_per_count_right, r->wheelbase, r->calibration_sequence);
+  if (r->gyro_id == 0) {
+    std::printf("  gyro: none\n");
+    return;
+  }
+  std::printf("  gyro 0x%08" PRIx32 ": bias %.6e rad/s (%.1f s of standstill), scale %.6f (%s)\n",
+              r->gyro_id, r->gyro.bias, r->gyro.bias_time, r->gyro.scale,
+              r->gyro.scale_valid ? "estimated" : "not estimated");
 }
 
 }  // namespace

@@ -449,7 +449,9 @@ void Daemon::report() {
         {"resumed", why == loop::ResumeReason::kResumed},
         {"reason", std::string(loop::resume_reason_name(why))},
         {"gap",
-         why == loop::ResumeReason::kResumed ? to_seconds(loop_->resume_decision().gap) : 0.0}};
+         why == loop::ResumeReason::kResumed ? to_seconds(loop_->resume_decision().gap) : 0.0},
+        {"gyro_restored",
+         why == loop::ResumeReason::kResumed && loop_->resume_decision().gyro_restored}};
   }
   if (selfcal_) j["selfcal"] = selfcal_json(selfcal_->estimator().counters());
   out_ << j.dump() << std::endl;

@@ -6,6 +6,7 @@
 #include <sys/statfs.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <sstream>
 
 namespace odo::fw {
 namespace {
@@ -38,6 +40,22 @@ std::uint8_t backend_id(const Config& cfg) {
   if (cfg.encoder.backend == EncoderKind::kCan)
     id |= static_cast<std::uint8_t>(cfg.can_encoder.bus);
   return id;
+}
+
+// gyro_resume_text: the resume line's end (from "; gyro" to the newline) into out[0, n):
+// what became of the record's gyro calibration. Returns the characters written.
+int gyro_resume_text(const loop::ResumeDecision& d, bool has_gyro, char* out, std::size_t n) {
+  int k = 0;
+  if (!has_gyro)
+    k = std::snprintf(out, n, "\n");
+  else if (d.gyro_restored)
+    k = std::snprintf(out, n, "; gyro bias %.6e rad/s (%.1f s of standstill)%s restored\n",
+                      d.gyro.bias, d.gyro.bias_time, d.gyro.scale_valid ? " and scale" : "");
+  else
+    k = std::snprintf(
+        out, n, "; gyro: %s, detection waits for the next standstill\n",
+        d.gyro_matches ? "its bias was not learnt yet" : "the record is another gyro's (or none)");
+  return std::clamp(k, 0, static_cast<int>(n) - 1);
 }
 
 // on_tmpfs: whether the directory of `path` is a tmpfs (emptied by every reboot).
@@ -111,6 +129,24 @@ Result<loop::StateRecord> read_state_file(const std::string& path) {
   auto r = loop::decode_state_file(std::span<const std::uint8_t>(b.data(), std::size_t(n)));
   if (!r) return make_error(r.error().code, path + ": " + r.error().message);
   return r;
+}
+
+std::uint32_t gyro_id(const Config& cfg) {
+  const GyroSection& g = cfg.gyro;
+  if (g.backend == GyroBackend::kNone) return 0;
+  std::ostringstream t;
+  t << name_of(g.backend) << '|' << g.device << '|' << name_of(g.axis) << '|' << g.sign << '|'
+    << name_of(g.model) << '|' << g.seed;
+  if (g.backend == GyroBackend::kCan) {
+    const CanGyroSection& c = cfg.can_gyro;
+    t << '|' << name_of(c.bus) << '|' << c.interface << '|' << c.id << '|' << c.extended << '|'
+      << c.offset << '|' << c.width << '|' << c.is_signed << '|' << name_of(c.byte_order) << '|'
+      << c.scale << '|' << c.rate_offset;
+  }
+  // FNV-1a (32 bit) of that text: configure time, and any change of it is another gyro.
+  std::uint32_t h = 2166136261u;
+  for (const char ch : t.str()) h = (h ^ static_cast<std::uint8_t>(ch)) * 16777619u;
+  return h != 0 ? h : 1;  // 0 means "no gyro"
 }
 
 bool counters_survive_restart(const Config& cfg) {
@@ -198,6 +234,7 @@ void StatePersister::write_newest() noexcept {
   r.clock_epoch = identity_.clock_epoch;
   r.backend = identity_.backend;
   r.calibration_sequence = identity_.calibration_sequence;
+  r.gyro_id = identity_.gyro_id;
   loop::StateBytes b{};
   loop::encode_state(r, b);
   const auto off = static_cast<off_t>((r.sequence % 2) * loop::kStateSlotBytes);
@@ -233,9 +270,12 @@ void StatePersister::run(std::ostream& log, std::optional<loop::ResumeReason> fi
         // the resume (against the counts the controllers sent) needs.
         n = std::snprintf(line, sizeof line,
                           "odometryd: resume: resumed after a gap of %.3f s (left %+lld, right "
-                          "%+lld counts) at x %.10f m, y %.10f m, theta %.12f rad\n",
+                          "%+lld counts) at x %.10f m, y %.10f m, theta %.12f rad",
                           to_seconds(d.gap), static_cast<long long>(d.dl),
                           static_cast<long long>(d.dr), d.pose.x, d.pose.y, d.pose.theta);
+        n = std::clamp(n, 0, static_cast<int>(sizeof line) - 1);  // the pose's digits are bounded
+        n += gyro_resume_text(d, loop_.fusion() != nullptr, line + n,
+                              sizeof line - static_cast<std::size_t>(n));
       } else {
         const std::string_view name = loop::resume_reason_name(why);
         n = std::snprintf(line, sizeof line, "odometryd: resume: fresh start (%.*s)%s\n",
@@ -263,6 +303,7 @@ ResumeWiring prepare_resume(const Config& cfg, loop::OdometryLoop& loop,
   if (boot) identity.boot_id = *boot;
   identity.backend = backend_id(cfg);
   identity.calibration_sequence = calibration_sequence;
+  identity.gyro_id = gyro_id(cfg);
   auto rec = read_state_file(cfg.resume.path);
   if (rec && boot) {
     identity.sequence = rec->sequence;  // ours follow it: the newest slot is always ours
@@ -277,6 +318,7 @@ ResumeWiring prepare_resume(const Config& cfg, loop::OdometryLoop& loop,
     c.metres_per_count_left = k.metres_per_count_left();
     c.metres_per_count_right = k.metres_per_count_right();
     c.wheelbase = k.wheelbase();
+    c.gyro_id = identity.gyro_id;
     c.max_wheel_speed = cfg.encoder.backend == EncoderKind::kCan ? cfg.can_encoder.max_speed
                                                                  : cfg.hctl1100.max_speed;
     loop.resume_from(*rec, c);

@@ -31,7 +31,7 @@ for k in ("faults", "stale_events", "saturated", "invalid", "read_errors", "flag
           "gyro_used_ticks", "bumps_detected", "speed_events", "accel_events"):
     assert g[k] == 0, (k, g)
 assert g["bias_valid"] is True, g  # learnt in the first second
-assert abs(g["bias"]) < 0.05, g    # the consumer model's offset is within its 0.5 deg/s
+assert abs(g["bias"]) < 0.05, g    # the consumer model's offset is 1 deg/s (1.745e-2 rad/s)
 for k in ("x", "y", "theta", "distance"):
     assert abs(f[k] - p[k]) < 1e-9, (k, f[k], p[k])
 PY

@@ -33,6 +33,8 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
+#include <numbers>
 #include <random>
 #include <sstream>
 #include <string>
@@ -79,11 +81,20 @@ constexpr std::uint32_t kTwoAxisId = 0x18FF0010;
 volatile sig_atomic_t g_feeder_stop = 0;
 volatile sig_atomic_t g_feeder_go = 0;
 
+// The IMU of GyroCalibrationSurvivesARestart: [can_gyro]'s default frame (id 0x120, int16 little
+// endian at byte 0, 2000 deg/s over the signed word: 1.0652644e-3 rad/s per LSB), sent with the
+// counts.
+constexpr canid_t kGyroId = 0x120;
+constexpr double kGyroLsb = 2000.0 * std::numbers::pi / 180.0 / 32768.0;  // [rad/s]
+constexpr int kNoGyro = -100000;
+
 // run_feeder: the simulated motor controllers (in a child process): ODrive Get_Encoder_Count
 // frames of nodes 0 and 1 every 10 ms on `ifc`, each frame's counts logged to `log` as
 // "t,left,right" (replay CSV). The robot stands (the counts of frame 0) until SIGUSR1, so that
-// the first daemon's origin is frame 0; it stops on SIGTERM.
-[[noreturn]] void run_feeder(const std::string& ifc, const std::string& log, Feed feed) {
+// the first daemon's origin is frame 0; it stops on SIGTERM. With gyro_bias [LSB] other than
+// kNoGyro an IMU sends the robot's turn rate plus that bias in the same period.
+[[noreturn]] void run_feeder(const std::string& ifc, const std::string& log, Feed feed,
+                             int gyro_bias = kNoGyro) {
   signal(SIGTERM, [](int) { g_feeder_stop = 1; });
   signal(SIGUSR1, [](int) { g_feeder_go = 1; });
   const int s = socket(PF_CAN, SOCK_RAW, CAN_RAW);
@@ -109,8 +120,8 @@ volatile sig_atomic_t g_feeder_go = 0;
     // are skipped, never sent in a burst (which would look like an implausible jump).
     const TimeNs now = now_ns();
     if (g_feeder_go != 0 && go_at < 0) go_at = now;
+    int dl = 0, dr = 0;  // the last frame's counts: the turn rate the IMU sees
     for (const std::int64_t due = go_at < 0 ? 0 : (now - go_at) / kFramePeriod + 1; k < due;) {
-      int dl = 0, dr = 0;
       step_counts(++k, dl, dr);
       left += static_cast<std::uint32_t>(dl);  // modulo 2^32, as the controller's int32
       right += static_cast<std::uint32_t>(dr);
@@ -130,6 +141,18 @@ volatile sig_atomic_t g_feeder_go = 0;
         }
       }
       // A full transmit queue is retried: a frame is never lost, the log stays exact.
+      while (write(s, &fr, sizeof fr) != static_cast<ssize_t>(sizeof fr) && g_feeder_stop == 0)
+        usleep(200);
+    }
+    if (gyro_bias != kNoGyro) {
+      const double rate = (dr - dl) * (std::numbers::pi * kDiameter / kCountsPerRev) / kWheelbase /
+                          to_seconds(kFramePeriod);  // [rad/s]
+      const auto v = static_cast<std::int16_t>(gyro_bias + std::lround(rate / kGyroLsb));
+      can_frame fr{};
+      fr.can_id = kGyroId;
+      fr.can_dlc = 2;
+      fr.data[0] = static_cast<std::uint8_t>(v & 0xFF);
+      fr.data[1] = static_cast<std::uint8_t>((v >> 8) & 0xFF);
       while (write(s, &fr, sizeof fr) != static_cast<ssize_t>(sizeof fr) && g_feeder_stop == 0)
         usleep(200);
     }
@@ -194,6 +217,24 @@ struct Reaper {
   }
 };
 
+// fresh_vcan: the vcan interface `ifc` (re)created and up, the directory `dir` empty.
+bool fresh_vcan(const std::string& ifc, const std::string& dir) {
+  run("ip link del " + ifc + " 2>/dev/null");
+  return run("ip link add " + ifc + " type vcan && ip link set " + ifc + " up") == 0 &&
+         run("rm -rf " + dir + " && mkdir -p " + dir) == 0;
+}
+
+// robot_toml: the config every test here starts with: the test's robot at 200 Hz, no
+// calibration store, no real-time scheduling (the VM's one CPU is shared with the feeder).
+std::string robot_toml() {
+  std::ostringstream t;
+  t << "[loop]\nrate_hz = 200\nstatus_period = 0\n"
+    << "[robot]\nwheel_diameter = " << kDiameter << "\ncounts_per_rev = " << kCountsPerRev
+    << "\ngear_ratio = 1\nwheelbase = " << kWheelbase << "\n"
+    << "[calibration]\nstore = \"\"\n[realtime]\npriority = 0\nlock_memory = false\n";
+  return t.str();
+}
+
 Pose2 minus(const Pose2& a, const Pose2& b) {
   return {a.x - b.x, a.y - b.y, a.theta - b.theta};
 }
@@ -204,17 +245,11 @@ double norm_xy(const Pose2& p) {
 TEST(ResumeCanVcan, HundredSigkillsDuringMotionResumeFromTheControllersCounts) {
   ODO_REQUIRE_VM();
   const std::string ifc = "vcanr0", dir = "/tmp/odo_resume_can";
-  run("ip link del " + ifc + " 2>/dev/null");
-  ASSERT_EQ(run("ip link add " + ifc + " type vcan && ip link set " + ifc + " up"), 0);
-  run("rm -rf " + dir + " && mkdir -p " + dir);
+  ASSERT_TRUE(fresh_vcan(ifc, dir));
   const std::string state = dir + "/state.bin";
   {
     std::ofstream cfg(dir + "/odometryd.toml");
-    cfg << "[loop]\nrate_hz = 200\nstatus_period = 0\n"
-        << "[robot]\nwheel_diameter = " << kDiameter << "\ncounts_per_rev = " << kCountsPerRev
-        << "\ngear_ratio = 1\nwheelbase = " << kWheelbase << "\n"
-        << "[calibration]\nstore = \"\"\n[realtime]\npriority = 0\nlock_memory = false\n"
-        << "[encoder]\nbackend = \"can\"\n"
+    cfg << robot_toml() << "[encoder]\nbackend = \"can\"\n"
         << "[can_encoder]\nbus = \"socketcan\"\ninterface = \"" << ifc
         << "\"\nprotocol = \"generic\"\nextended = true\nleft_id = " << kTwoAxisId
         << "\nright_id = " << kTwoAxisId
@@ -461,6 +496,89 @@ std::string sh_output(const std::string& cmd) {
   return out;
 }
 
+// The gyro's calibration across a restart (state record version 2): a CAN IMU with a bias of
+// 10 LSB (0.0106526 rad/s) beside the ODrive counts. The first daemon learns the bias while the
+// robot stands, is killed with SIGKILL 1 s into the drive and restarted 0.3 s later: it resumes
+// the pose and restores the bias it had learnt, so detection goes on while the robot moves. A
+// third daemon, configured with the IMU mounted the other way up (sign -1: another gyro as far
+// as its rate goes), resumes the pose but not the bias.
+TEST(ResumeCanVcan, GyroCalibrationSurvivesARestart) {
+  ODO_REQUIRE_VM();
+  const std::string ifc = "vcanr2", dir = "/tmp/odo_resume_gyro";
+  ASSERT_TRUE(fresh_vcan(ifc, dir));
+  const std::string state = dir + "/state.bin", toml = dir + "/odometryd.toml";
+  auto configure = [&](int sign) {
+    std::ofstream cfg(toml);
+    cfg << robot_toml()
+        << "[encoder]\nbackend = \"can\"\n[can_encoder]\nbus = \"socketcan\"\ninterface = \"" << ifc
+        << "\"\n[gyro]\nbackend = \"can\"\nsign = " << sign << "\n[can_gyro]\ninterface = \"" << ifc
+        << "\"\n"
+        << "[resume]\npath = \"" << state << "\"\nrate_hz = 50\nmax_age = 30\n";
+  };
+  configure(1);
+  const auto cfg = fw::load_config(toml);
+  ASSERT_TRUE(cfg.ok()) << cfg.error().message;
+  ASSERT_NEAR(cfg->can_gyro.scale, kGyroLsb, 1e-18);  // the feeder's LSB is the decoder's
+  Reaper reaper;
+  const pid_t feeder = fork();
+  ASSERT_GE(feeder, 0);
+  if (feeder == 0) run_feeder(ifc, dir + "/feeder.csv", Feed::kOdrive, 10);
+  reaper.pids.push_back(feeder);
+  std::this_thread::sleep_for(300ms);
+  // daemon: one odometryd until `stop` after `run_for`; its log (stdout and stderr).
+  auto daemon = [&](int n, int stop, double run_for, const std::function<void()>& meanwhile) {
+    const std::string out = dir + "/run" + std::to_string(n) + ".txt";
+    const pid_t d = spawn(std::string("exec ") + ODOMETRYD_PATH + " --json --config " + toml +
+                          " > " + out + " 2>&1");
+    reaper.pids.push_back(d);
+    double waited = 0.0;
+    const std::string log = wait_for_decision(out, waited);
+    if (meanwhile) meanwhile();
+    std::this_thread::sleep_for(std::chrono::duration<double>(run_for));
+    kill(d, stop);
+    waitpid(d, nullptr, 0);
+    reaper.pids.pop_back();
+    return slurp(out);
+  };
+  // Run 0 stands for 2 s (still_time 0.5 s to confirm the standstill, 0.5 s to average, and
+  // margin under emulation), then drives for 1 s: killed in motion.
+  const std::string first = daemon(0, SIGKILL, 1.0, [&] {
+    std::this_thread::sleep_for(2s);
+    kill(feeder, SIGUSR1);
+  });
+  EXPECT_NE(first.find("resume: fresh start (no-record)"), std::string::npos) << first;
+  auto rec = fw::read_state_file(state);
+  ASSERT_TRUE(rec.ok()) << rec.error().message;
+  EXPECT_GT(rec->distance, 0.0);  // the record is the drive's
+  // The bias: learnt at the standstill, the mean of identical frames, 10 LSB (to rounding).
+  EXPECT_EQ(rec->gyro_id, fw::gyro_id(*cfg));
+  EXPECT_NEAR(rec->gyro.bias, 10 * kGyroLsb, 1e-12);
+  EXPECT_GE(rec->gyro.bias_time, 0.5);
+  // Run 1, same gyro, restarted 0.3 s later while the robot drives: the bias is restored.
+  std::this_thread::sleep_for(300ms);
+  const std::string second = daemon(1, SIGTERM, 1.0, nullptr);
+  const std::size_t at = second.find("; gyro bias ");
+  ASSERT_NE(at, std::string::npos) << second;
+  double bias = 0.0;
+  ASSERT_EQ(std::sscanf(second.c_str() + at, "; gyro bias %lf rad/s", &bias), 1) << second;
+  EXPECT_NEAR(bias, rec->gyro.bias, 1e-8);  // printed with 7 significant digits
+  EXPECT_NE(second.find("resume: resumed after a gap of "), std::string::npos) << second;
+  EXPECT_NE(second.find(" restored\n"), std::string::npos) << second;
+  EXPECT_NE(second.find("\"gyro_restored\":true"), std::string::npos) << second;
+  // Run 2: the IMU now configured upside down. The pose resumes, the bias does not.
+  configure(-1);
+  std::this_thread::sleep_for(300ms);
+  const std::string third = daemon(2, SIGTERM, 0.5, nullptr);
+  EXPECT_NE(third.find("resume: resumed after a gap of "), std::string::npos) << third;
+  EXPECT_NE(third.find("; gyro: the record is another gyro's (or none)"), std::string::npos)
+      << third;
+  EXPECT_NE(third.find("\"gyro_restored\":false"), std::string::npos) << third;
+  kill(feeder, SIGTERM);
+  waitpid(feeder, nullptr, 0);
+  reaper.pids.clear();
+  run("ip link del " + ifc);
+}
+
 // Under systemd (the "also through systemd" of issue 17): systemd 252 runs as PID 1 of a PID
 // namespace in the VM (unshare; the harness's own init is busybox) and starts the project's
 // unit, firmware/systemd/odometryd.service as shipped (hardening, ProcSubset=pid, WatchdogSec=2s,
@@ -500,10 +618,7 @@ TEST(ResumeCanVcan, UnderSystemdAfterSigkillAndWatchdogRestartsResume) {
       << "ExecStartPre=/bin/sh -c '{ test -e /proc/sys/kernel/random/boot_id && echo visible "
          "|| echo hidden $ODOMETRYD_BOOT_ID; } > /run/odometryd/sandbox'\n";
     std::ofstream cfg("/etc/odometryd/odometryd.toml");
-    cfg << "[loop]\nrate_hz = 200\nstatus_period = 0\n"
-        << "[robot]\nwheel_diameter = " << kDiameter << "\ncounts_per_rev = " << kCountsPerRev
-        << "\ngear_ratio = 1\nwheelbase = " << kWheelbase << "\n"
-        << "[calibration]\nstore = \"\"\n[realtime]\npriority = 0\nlock_memory = false\n"
+    cfg << robot_toml()
         // The PM QoS request through the unit's DevicePolicy=closed (its DeviceAllow= line).
         << "cpu_latency_us = 0\n"
         << "[encoder]\nbackend = \"can\"\n[can_encoder]\nbus = \"socketcan\"\ninterface = \"" << ifc

@@ -61,6 +61,37 @@ TEST(StatePersist, OnlyCountersThatKeepCountingResume) {
   EXPECT_TRUE(counters_survive_restart(c));
 }
 
+// A learnt bias belongs to one gyro: whatever changes the meaning of its rate makes another id;
+// the fusion's own settings (noise figures, thresholds) do not.
+TEST(StatePersist, GyroIdNamesTheGyroNotTheFusion) {
+  Config c = default_config();
+  EXPECT_EQ(gyro_id(c), 0U);  // backend none
+  c.gyro.backend = GyroBackend::kIio;
+  c.gyro.device = "bmg160";
+  const std::uint32_t iio = gyro_id(c);
+  EXPECT_NE(iio, 0U);
+  c.gyro.noise_density *= 2.0;
+  c.gyro.k_sigma = 7.0;
+  EXPECT_EQ(gyro_id(c), iio);
+  c.gyro.sign = -1;  // mounted upside down: the bias changes sign
+  EXPECT_NE(gyro_id(c), iio);
+  c.gyro.sign = 1;
+  c.gyro.axis = GyroAxis::kX;
+  EXPECT_NE(gyro_id(c), iio);
+  c.gyro.axis = GyroAxis::kZ;
+  c.gyro.device = "bmi088_gyro";
+  EXPECT_NE(gyro_id(c), iio);
+  c.gyro.backend = GyroBackend::kCan;
+  const std::uint32_t can = gyro_id(c);
+  c.can_gyro.scale *= 2.0;  // another LSB: the same number is another rate
+  EXPECT_NE(gyro_id(c), can);
+  c = default_config();
+  c.gyro.backend = GyroBackend::kSim;
+  const std::uint32_t sim = gyro_id(c);
+  c.gyro.seed += 1;  // another simulated chip
+  EXPECT_NE(gyro_id(c), sim);
+}
+
 TEST(StatePersist, ResumeSectionIsReadAndChecked) {
   auto c = parse_config(
       "[resume]\nenabled = false\npath = \"/tmp/x.bin\"\nrate_hz = 20\n"

@@ -225,6 +225,19 @@ TEST(StateRecord, CorruptValuesAreRejected) {
   bad.gyro.scale = 0.0;
   encode_state(bad, b);
   EXPECT_NE(decode_state(b).error().message.find("gyro scale"), std::string::npos);
+  // No loop writes these: a stamp before its clock's zero, kinematics that are none.
+  bad = sample_record(3);
+  bad.stamp = -1;
+  encode_state(bad, b);
+  EXPECT_NE(decode_state(b).error().message.find("negative sample time"), std::string::npos);
+  bad = sample_record(3);
+  bad.wheelbase = 0.0;
+  encode_state(bad, b);
+  EXPECT_NE(decode_state(b).error().message.find("not positive"), std::string::npos);
+  bad = sample_record(3);
+  bad.metres_per_count_right = -kMpc;
+  encode_state(bad, b);
+  EXPECT_NE(decode_state(b).error().message.find("not positive"), std::string::npos);
 }
 
 TEST(ResumeDecision, ResumesAcrossTheWrapWithTheGapsCounts) {

@@ -48,6 +48,11 @@ Result<loop::StateRecord> read_state_file(const std::string& path);
 // (decoded by this process) and the simulated backends (they restart with the process) do not.
 bool counters_survive_restart(const Config& cfg);
 
+// gyro_id: which gyro [gyro] and [can_gyro] configure, as far as the meaning of its rate goes
+// (backend, device, axis, sign, model and seed, the CAN field and its scaling): the state record
+// carries it, and a learnt bias and scale are restored only to the same id. 0: no gyro.
+std::uint32_t gyro_id(const Config& cfg);
+
 // StatePersister: a TickObserver that, every n-th tick (and at once on the tick a command such
 // as set-pose took effect), copies the loop's state into a triple buffer and wakes a writer
 // thread; the thread writes the record into the state file's next slot. The loop thread never

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# odomctl state show (issue 17; the gyro part of record version 2, issue 16): the record odometryd
+# leaves, printed and as JSON, with and without a gyro; a missing and a damaged state file.
+set -u
+. "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
+
+# odometryd in real time for 2 s with the simulated gyro: the robot stands for its first second
+# (the fusion confirms the standstill for still_time = 0.5 s, then averages the gyro), then
+# drives; a clean stop writes the last tick's record.
+printf '[gyro]\nbackend = "sim"\n[resume]\npath = "%s"\n' "$tmp/gyro.bin" >"$tmp/gyro.toml"
+run "$ODOMETRYD" --config "$tmp/gyro.toml" --duration 2 >"$tmp/gyro.log" 2>&1
+check "odometryd with gyro and resume: exit 0" $?
+grep -q "odometryd: resume: fresh start (no-record)" "$tmp/gyro.log"
+check "first start: fresh, no record" $?
+run "$ODOMCTL" state show --path "$tmp/gyro.bin" >"$tmp/show.txt"
+check "state show: exit 0" $?
+grep -Eq "^  gyro 0x[0-9a-f]{8}: bias -?[0-9.]+e[-+][0-9]+ rad/s \([0-9.]+ s of standstill\), scale 1\.000000 \(not estimated\)$" "$tmp/show.txt"
+check "state show: the gyro line" $?
+run "$ODOMCTL" state show --path "$tmp/gyro.bin" --json >"$tmp/show.json"
+check "state show --json: exit 0" $?
+python3 - "$tmp/show.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["gyro_id"] != 0, r
+# Averaged from 0.5 s (the standstill confirmed) to 1 s (the robot sets off): 0.5 s, give or
+# take the real-time ticks' jitter.
+assert 0.4 < r["gyro_bias_time"] < 0.6, r
+# The consumer model's offset is 1 deg/s = 1.745e-2 rad/s; averaged over 0.5 s its noise
+# (N = 2.443e-4 rad/s/sqrt(Hz)) leaves sigma = N / sqrt(0.5) = 3.5e-4 rad/s: 2e-3 is 5.7 sigma.
+assert abs(r["gyro_bias"] - 1.745e-2) < 2e-3, r
+assert r["gyro_scale"] == 1.0 and r["gyro_scale_valid"] is False, r
+assert r["distance"] > 0.0 and r["sequence"] > 0, r
+PY
+check "state show --json: the gyro's id, bias and averaging time; the drive's pose" $?
+
+# Without a gyro: the record's gyro part is none.
+printf '[resume]\npath = "%s"\n' "$tmp/plain.bin" >"$tmp/plain.toml"
+run "$ODOMETRYD" --config "$tmp/plain.toml" --duration 0.5 >/dev/null 2>&1
+check "odometryd without gyro: exit 0" $?
+run "$ODOMCTL" state show --path "$tmp/plain.bin" | grep -qx "  gyro: none"
+check "state show without gyro: gyro: none" $?
+[ "$(run "$ODOMCTL" state show --path "$tmp/plain.bin" --json | python3 -c \
+  'import json,sys; print(json.load(sys.stdin)["gyro_id"])')" = 0 ]
+check "state show --json without gyro: gyro_id 0" $?
+
+# A missing file and a damaged one: exit 1 with the reason.
+run "$ODOMCTL" state show --path "$tmp/none.bin" >/dev/null 2>"$tmp/none.err"
+[ $? = 1 ] && grep -q "none.bin" "$tmp/none.err"
+check "missing state file: exit 1 naming it" $?
+cp "$tmp/gyro.bin" "$tmp/bad.bin"
+printf '\xff\xff\xff\xff' | dd of="$tmp/bad.bin" bs=1 seek=100 conv=notrunc 2>/dev/null
+printf '\xff\xff\xff\xff' | dd of="$tmp/bad.bin" bs=1 seek=356 conv=notrunc 2>/dev/null
+run "$ODOMCTL" state show --path "$tmp/bad.bin" >/dev/null 2>"$tmp/bad.err"
+[ $? = 1 ] && grep -q "CRC mismatch" "$tmp/bad.err"
+check "both slots damaged: exit 1, CRC mismatch" $?
+
+echo "cli state: $pass passed, $fail failed"
+[ $fail = 0 ]
