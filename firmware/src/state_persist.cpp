@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <iomanip>
 #include <sstream>
 
 namespace odo::fw {
@@ -135,8 +136,9 @@ std::uint32_t gyro_id(const Config& cfg) {
   const GyroSection& g = cfg.gyro;
   if (g.backend == GyroBackend::kNone) return 0;
   std::ostringstream t;
-  t << name_of(g.backend) << '|' << g.device << '|' << name_of(g.axis) << '|' << g.sign << '|'
-    << name_of(g.model) << '|' << g.seed;
+  t << std::setprecision(17);  // every bit of the scaling: another LSB is another gyro
+  t << name_of(g.backend) << '|' << g.device << '|' << name_of(g.axis) << '|' << g.sign;
+  if (simulated_gyro(cfg)) t << '|' << name_of(g.model) << '|' << g.seed;  // another chip
   if (g.backend == GyroBackend::kCan) {
     const CanGyroSection& c = cfg.can_gyro;
     t << '|' << name_of(c.bus) << '|' << c.interface << '|' << c.id << '|' << c.extended << '|'

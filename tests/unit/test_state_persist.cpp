@@ -83,8 +83,11 @@ TEST(StatePersist, GyroIdNamesTheGyroNotTheFusion) {
   EXPECT_NE(gyro_id(c), iio);
   c.gyro.backend = GyroBackend::kCan;
   const std::uint32_t can = gyro_id(c);
-  c.can_gyro.scale *= 2.0;  // another LSB: the same number is another rate
+  c.can_gyro.scale *= 1.0 + 1e-12;  // another LSB, however close: the same number is another rate
   EXPECT_NE(gyro_id(c), can);
+  c.can_gyro.scale = CanGyroSection{}.scale;
+  c.gyro.seed += 1;  // a real gyro has no seed: the same id
+  EXPECT_EQ(gyro_id(c), can);
   c = default_config();
   c.gyro.backend = GyroBackend::kSim;
   const std::uint32_t sim = gyro_id(c);
@@ -126,6 +129,8 @@ TEST(StatePersist, StateFileReasons) {
   rec.sequence = 3;
   rec.counter_bits = 24;
   rec.pose = {1.0, 2.0, 3.0};
+  rec.metres_per_count_left = rec.metres_per_count_right = 1e-3;  // a loop's kinematics are
+  rec.wheelbase = 0.5;                                            // positive (decode_state)
   loop::StateBytes b{};
   loop::encode_state(rec, b);
   {
