@@ -1,5 +1,6 @@
 #include "odo/loop/state_record.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
@@ -161,6 +162,10 @@ Result<StateRecord> decode_state_file(std::span<const std::uint8_t> bytes) {
     }
     if (!best || r->sequence > best->sequence) best = std::move(r);
   }
+  // The persister sizes a new file with zeros: one whose daemon stopped before its first record
+  // is blank, which is no record yet, not damage.
+  if (!best && std::all_of(bytes.begin(), bytes.end(), [](std::uint8_t v) { return v == 0; }))
+    return make_error(Errc::kNotFound, "state file is blank (no record written yet)");
   return best;
 }
 

@@ -3,10 +3,10 @@
 // twice: as a state file as they are (torn or damaged: the CRC rejects nearly all of them), and
 // as one slot whose header and CRC are made right, so that every field value reaches the checks,
 // decide_resume and Gyrodometry::restore. Properties: never crashes, overflows or hits undefined
-// behaviour (ASan, UBSan); an invalid record is Errc::kCorrupt (an empty file kNotFound); a
-// decoded record holds only values a loop writes, and encodes to bytes that decode to the same
-// bytes again; a resume's gap is never negative and its counts within the bound it checked; a
-// restored fusion has a finite bias and threshold.
+// behaviour (ASan, UBSan); an invalid record is Errc::kCorrupt (an empty or all-zero file
+// kNotFound); a decoded record holds only values a loop writes, and encodes to bytes that decode
+// to the same bytes again; a resume's gap is never negative and its counts within the bound it
+// checked; a restored fusion has a finite bias and threshold.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -101,8 +101,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (f) {
     require_valid_values(*f);
   } else {
-    require(f.error().code == (size == 0 ? odo::Errc::kNotFound : odo::Errc::kCorrupt),
-            "a bad state file is not reported corrupt:", f.error().message);
+    const bool blank = std::all_of(data, data + size, [](std::uint8_t v) { return v == 0; });
+    require(f.error().code == (blank ? odo::Errc::kNotFound : odo::Errc::kCorrupt),
+            "a bad state file is not reported corrupt (or an empty or blank one not found):",
+            f.error().message);
   }
   // One slot with its header and CRC made right: version 1 when the input's byte 4 is odd.
   if (size < 8) return 0;

@@ -196,6 +196,18 @@ TEST(StateRecord, TruncatedFileIsCorruptOrEmpty) {
   EXPECT_TRUE(decode_state_file(b));
 }
 
+// The persister sizes a new file with zeros; a daemon stopped before its first record leaves it
+// blank: no record yet (a fresh start `no-record`), not `corrupt`. One nonzero byte is damage.
+TEST(StateRecord, BlankFileIsNoRecordYet) {
+  std::array<std::uint8_t, kStateFileBytes> file{};
+  auto d = decode_state_file(file);
+  ASSERT_FALSE(d);
+  EXPECT_EQ(d.error().code, Errc::kNotFound);
+  EXPECT_NE(d.error().message.find("blank"), std::string::npos);
+  file[300] = 1;
+  EXPECT_EQ(decode_state_file(file).error().code, Errc::kCorrupt);
+}
+
 TEST(StateRecord, CorruptValuesAreRejected) {
   StateBytes b{};
   encode_state(sample_record(3), b);

@@ -74,7 +74,7 @@ Result<StateRecord> decode_state(std::span<const std::uint8_t> bytes);
 
 // decode_state_file: the newest valid record of a two-slot state file (kStateFileBytes, or
 // shorter: a slot cut short counts as torn); Errc::kCorrupt when neither slot holds one,
-// Errc::kNotFound when the file is empty.
+// Errc::kNotFound when the file is empty or blank (all zeros: created, never written).
 Result<StateRecord> decode_state_file(std::span<const std::uint8_t> bytes);
 
 // Why the loop resumed or started fresh; spelt once in kResumeReasonNames.
