@@ -450,8 +450,8 @@ void Daemon::report() {
         {"reason", std::string(loop::resume_reason_name(why))},
         {"gap",
          why == loop::ResumeReason::kResumed ? to_seconds(loop_->resume_decision().gap) : 0.0},
-        {"gyro_restored",
-         why == loop::ResumeReason::kResumed && loop_->resume_decision().gyro_restored}};
+        // With the pose or from a fresh one (restore_gyro): only a decision the loop made.
+        {"gyro_restored", resume_->offered && loop_->resume_decision().gyro_restored}};
   }
   if (selfcal_) j["selfcal"] = selfcal_json(selfcal_->estimator().counters());
   out_ << j.dump() << std::endl;

@@ -159,9 +159,12 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
   const bool modelled = cfg.encoder.backend != EncoderKind::kSim;
   const sim::RobotGeometry g = sim_geometry(cfg.sim, k.params());
   sim::Scenario scenario = make_scenario(cfg.sim, k);
-  // With a gyro the robot first stands still for a second, as a real one does after power-up:
-  // the fusion learns the gyro's bias before the first move (detection is off until then).
-  if (simulated_gyro(cfg)) scenario.insert(scenario.begin(), {1.0, 0.0, 0.0});
+  // With a gyro the robot first stands still, as a real one does after power-up, so that the
+  // fusion learns the gyro's bias before the first move (detection is off until then): still_time
+  // to confirm the standstill, still_time of averaging, and 0.25 s for real-time ticks (with
+  // exactly 2 still_time the averaging ended within a tick of still_time, valid or not by chance).
+  if (simulated_gyro(cfg))
+    scenario.insert(scenario.begin(), {2.0 * cfg.gyro.still_time + 0.25, 0.0, 0.0});
   impl->scenario_duration = sim::scenario_duration(scenario);
   auto robot = sim::SimRobot::create(g, std::move(scenario));
   if (!robot) return std::move(robot).error();

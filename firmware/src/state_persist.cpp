@@ -43,11 +43,11 @@ std::uint8_t backend_id(const Config& cfg) {
   return id;
 }
 
-// gyro_resume_text: the resume line's end (from "; gyro" to the newline) into out[0, n):
-// what became of the record's gyro calibration. Returns the characters written.
-int gyro_resume_text(const loop::ResumeDecision& d, bool has_gyro, char* out, std::size_t n) {
+// gyro_resume_text: the resume line's end into out[0, n): with `tell`, what became of the
+// record's gyro calibration ("; gyro ..."), then the newline. Returns the characters written.
+int gyro_resume_text(const loop::ResumeDecision& d, bool tell, char* out, std::size_t n) {
   int k = 0;
-  if (!has_gyro)
+  if (!tell)
     k = std::snprintf(out, n, "\n");
   else if (d.gyro_restored)
     k = std::snprintf(out, n, "; gyro bias %.6e rad/s (%.1f s of standstill)%s restored\n",
@@ -267,6 +267,7 @@ void StatePersister::run(std::ostream& log, std::optional<loop::ResumeReason> fi
       // A stack buffer and one write: the thread allocates nothing while the loop runs.
       char line[400];
       int n = 0;
+      bool tell_gyro = false;
       if (why == loop::ResumeReason::kResumed) {
         // The gap's counts, integrated as one step, and the pose that gave: what a check of
         // the resume (against the counts the controllers sent) needs.
@@ -275,14 +276,17 @@ void StatePersister::run(std::ostream& log, std::optional<loop::ResumeReason> fi
                           "%+lld counts) at x %.10f m, y %.10f m, theta %.12f rad",
                           to_seconds(d.gap), static_cast<long long>(d.dl),
                           static_cast<long long>(d.dr), d.pose.x, d.pose.y, d.pose.theta);
-        n = std::clamp(n, 0, static_cast<int>(sizeof line) - 1);  // the pose's digits are bounded
-        n += gyro_resume_text(d, loop_.fusion() != nullptr, line + n,
-                              sizeof line - static_cast<std::size_t>(n));
+        tell_gyro = loop_.fusion() != nullptr;
       } else {
         const std::string_view name = loop::resume_reason_name(why);
-        n = std::snprintf(line, sizeof line, "odometryd: resume: fresh start (%.*s)%s\n",
+        n = std::snprintf(line, sizeof line, "odometryd: resume: fresh start (%.*s)%s",
                           static_cast<int>(name.size()), name.data(), note.c_str());
+        // A fresh pose may still come with the gyro's calibration (same chip, same boot): told
+        // when it does; why the pose did not resume is the reason already.
+        tell_gyro = !fixed && d.gyro_restored;
       }
+      n = std::clamp(n, 0, static_cast<int>(sizeof line) - 1);  // a long note is cut
+      n += gyro_resume_text(d, tell_gyro, line + n, sizeof line - static_cast<std::size_t>(n));
       log.write(line, std::min<int>(n, sizeof line - 1)).flush();
       told = true;
     }

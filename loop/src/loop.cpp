@@ -101,18 +101,26 @@ void OdometryLoop::resume_from(const StateRecord& rec, const ResumeContext& ctx)
 void OdometryLoop::apply_resume(const EncoderSample& s) noexcept {
   resume_ctx_.now = clock_->now();
   resume_ = decide_resume(resume_rec_, resume_ctx_, s);
+  restore_gyro();
   if (!resume_.resumed()) return;
   odom_.restore(resume_rec_.pose, resume_rec_.cov, resume_rec_.distance);
   // The downtime is one long step, as after an overrun: its counts are integrated exactly
   // once (the arc of a constant-curvature gap is exact) and the covariance grows for it.
   odom_.advance(resume_.dl, resume_.dr, to_seconds(resume_.gap));
   resume_.pose = odom_.pose();
+}
+
+void OdometryLoop::restore_gyro() noexcept {
   // The same gyro (its id says so) in the same boot: its bias has drifted only for the gap, as
-  // it drifts on any drive without a standstill, so detection goes on at once.
-  if (fusion_ && resume_.gyro_matches) {
-    resume_.gyro_restored = fusion_->restore(resume_rec_.gyro);
-    resume_.gyro = fusion_->calibration();  // told by other threads: a copy, not the fusion's
-  }
+  // it drifts on any drive without a standstill, so detection goes on at once, with the pose or
+  // from a fresh one (GPIO quadrature never resumes the pose).
+  if (!fusion_ || !resume_.gyro_matches) return;
+  GyroCalibration c = resume_rec_.gyro;
+  // The scale was learnt against odometry's heading with the record's kinematics and
+  // calibration: only with the pose, which resumes only when those are the same.
+  if (!resume_.resumed()) c.scale_valid = false;
+  resume_.gyro_restored = fusion_->restore(c);
+  resume_.gyro = fusion_->calibration();  // told by other threads: a copy, not the fusion's
 }
 
 LoopSnapshot& OdometryLoop::copy_newest() noexcept {

@@ -186,6 +186,9 @@ ResumeDecision decide_resume(const StateRecord& rec, const ResumeContext& ctx,
   if (rec.clock_epoch != ctx.clock_epoch) return fresh(ResumeReason::kOtherClock);
   const TimeNs age = ctx.now - rec.stamp;
   if (age < 0 || age > ctx.max_age || d.gap < 0) return fresh(ResumeReason::kStale);
+  // The gyro's bias belongs to the chip, not to the encoders: the same chip in the same boot,
+  // drifted for a gap no longer than max_age, whatever the checks below decide for the pose.
+  d.gyro_matches = ctx.gyro_id != 0 && rec.gyro_id == ctx.gyro_id;
   if (rec.backend != ctx.backend || rec.counter_bits != ctx.counter_bits)
     return fresh(ResumeReason::kOtherBackend);
   if (!ctx.backend_continuous) return fresh(ResumeReason::kNotContinuous);
@@ -209,7 +212,6 @@ ResumeDecision decide_resume(const StateRecord& rec, const ResumeContext& ctx,
   if (std::fabs(static_cast<double>(d.dl)) > max_l || std::fabs(static_cast<double>(d.dr)) > max_r)
     return fresh(ResumeReason::kCounterJump);
   d.reason = ResumeReason::kResumed;
-  d.gyro_matches = ctx.gyro_id != 0 && rec.gyro_id == ctx.gyro_id;
   return d;
 }
 

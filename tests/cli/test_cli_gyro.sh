@@ -6,10 +6,10 @@ set -u
 . "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
 
 # The plain loop and the fused loop on the whole square (97.6 s; with a gyro the robot first
-# stands still for 1 s, so both runs are 100 s and end at rest at the same place). The default
-# floor has no bumps: nothing is flagged (gyro_used_ticks 0), so the fused pose is odometry's
-# (Gyrodometry.FusedUpdateIsOdometryWhenNothingIsFlagged; to rounding: the ticks fall 1 s later
-# on the robot's clock) and the gyro's samples are 1 kHz.
+# stands still for 2 still_time + 0.25 s = 1.25 s, so both runs are 100 s and end at rest at the
+# same place). The default floor has no bumps: nothing is flagged (gyro_used_ticks 0), so the
+# fused pose is odometry's (Gyrodometry.FusedUpdateIsOdometryWhenNothingIsFlagged; to rounding:
+# the ticks fall 1.25 s later on the robot's clock) and the gyro's samples are 1 kHz.
 run "$ODOMETRYD" --virtual-time --duration 100 --json >"$tmp/plain.json" 2>/dev/null
 check "plain run exit 0" $?
 printf '[gyro]\nbackend = "sim"\n' >"$tmp/sim.toml"
@@ -30,7 +30,7 @@ assert 99990 <= g["samples"] <= 100000, g  # 1 kHz for 100 s, less the 2 ms dela
 for k in ("faults", "stale_events", "saturated", "invalid", "read_errors", "flags",
           "gyro_used_ticks", "bumps_detected", "speed_events", "accel_events"):
     assert g[k] == 0, (k, g)
-assert g["bias_valid"] is True, g  # learnt in the first second
+assert g["bias_valid"] is True, g  # learnt before the robot set off
 assert abs(g["bias"]) < 0.05, g    # the consumer model's offset is 1 deg/s (1.745e-2 rad/s)
 for k in ("x", "y", "theta", "distance"):
     assert abs(f[k] - p[k]) < 1e-9, (k, f[k], p[k])
@@ -57,8 +57,8 @@ PY
 check "can gyro stopped at 20 s: one stale event, one fault, flags stale, pose unharmed" $?
 
 # Status lines in real time (every 0.5 s): the IMU stops after 1 s. The robot stands still for
-# its first second (the lines at 0.5 and 1 s: learning-bias, no counters: its start-up was no
-# fault); after the stop the lines say stale and count the fault.
+# its first 1.25 s (the line at 0.5 s: learning-bias, no counters: its start-up was no fault);
+# after the stop the lines say stale and count the fault.
 printf '[loop]\nstatus_period = 0.5\n[realtime]\npriority = 0\nlock_memory = false\n[gyro]\nbackend = "can"\n[can_gyro]\nbus = "sim"\nsim_stop_after = 1.0\n' \
   >"$tmp/line.toml"
 run "$ODOMETRYD" --config "$tmp/line.toml" --duration 2.3 --json >/dev/null 2>"$tmp/line.err"

@@ -79,8 +79,11 @@ void check_resume(const loop::StateRecord& r, std::span<const std::uint8_t> tail
   s.stamp = r.stamp + static_cast<std::int64_t>(ahead);
   c.now = s.stamp;
   const loop::ResumeDecision d = loop::decide_resume(r, c, s);
+  // The context matches the record's boot, clock and age: only the id decides the gyro's match.
+  require(d.reason == loop::ResumeReason::kStale || d.gyro_matches == (r.gyro_id != 0),
+          "the same gyro did not match (or none did)");
   if (!d.resumed()) return;
-  require(d.gap >= 0 && d.gyro_matches == (r.gyro_id != 0), "resume with a bad gap or gyro match");
+  require(d.gap >= 0, "resume with a negative gap");
   const double gap_s = odo::to_seconds(d.gap);
   require(std::fabs(static_cast<double>(d.dl)) <=
               c.max_wheel_speed * gap_s / c.metres_per_count_left + 1.0,

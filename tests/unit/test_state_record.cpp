@@ -264,8 +264,9 @@ TEST(ResumeDecision, ResumesAcrossTheWrapWithTheGapsCounts) {
   EXPECT_EQ(resume_reason_name(d.reason), "resumed");
 }
 
-// The gyro's calibration goes only to the gyro it was learnt on: same nonzero id, and only
-// with the pose (a fresh start relearns everything).
+// The gyro's calibration goes only to the gyro it was learnt on (same nonzero id), in the same
+// boot and clock and within max_age; whether the pose resumes is another matter (the bias is
+// the chip's, not the encoders').
 TEST(ResumeDecision, GyroCalibrationGoesOnlyToTheSameGyro) {
   StateRecord r = sample_record(9);
   const EncoderSample ok = reading(r, 20, 88, 0.5);
@@ -279,11 +280,31 @@ TEST(ResumeDecision, GyroCalibrationGoesOnlyToTheSameGyro) {
   EXPECT_FALSE(decide_resume(r, c, ok).gyro_matches);
   r.gyro_id = 0;  // neither then nor now: nothing to restore
   EXPECT_FALSE(decide_resume(r, c, ok).gyro_matches);
+  // The pose starts fresh, the same gyro's calibration still goes: GPIO quadrature (counts
+  // lost while down), another calibration, a counter gone backwards.
   r = sample_record(9);
-  c = matching_context(r);
-  c.boot_id[0] ^= 1;
-  EXPECT_FALSE(decide_resume(r, c, ok).gyro_matches);
-  EXPECT_FALSE(decide_resume(r, c, ok).gyro_restored);  // the loop's to set, never the decision's
+  auto matches_when = [&](auto&& change_ctx, EncoderSample s, ResumeReason why) {
+    ResumeContext x = matching_context(r);
+    change_ctx(x);
+    const ResumeDecision e = decide_resume(r, x, s);
+    EXPECT_EQ(e.reason, why);
+    return e.gyro_matches;
+  };
+  EXPECT_TRUE(matches_when([](ResumeContext& x) { x.backend_continuous = false; }, ok,
+                           ResumeReason::kNotContinuous));
+  EXPECT_TRUE(matches_when([](ResumeContext& x) { x.calibration_sequence = 6; }, ok,
+                           ResumeReason::kOtherCalibration));
+  EXPECT_TRUE(
+      matches_when([](ResumeContext&) {}, reading(r, 20, -1600, 0.5), ResumeReason::kCounterJump));
+  // Not from another boot or clock, nor older than max_age: the chip may have cooled, been
+  // power-cycled or be another one.
+  EXPECT_FALSE(
+      matches_when([](ResumeContext& x) { x.boot_id[0] ^= 1; }, ok, ResumeReason::kOtherBoot));
+  EXPECT_FALSE(
+      matches_when([](ResumeContext& x) { x.clock_epoch = 1; }, ok, ResumeReason::kOtherClock));
+  EXPECT_FALSE(
+      matches_when([](ResumeContext& x) { x.max_age = 999'000'000; }, ok, ResumeReason::kStale));
+  EXPECT_FALSE(decide_resume(r, matching_context(r), ok).gyro_restored);  // the loop's to set
 }
 
 TEST(ResumeDecision, EveryFreshStartReason) {

@@ -240,6 +240,8 @@ class OdometryLoop {
   // apply_resume: decides on the reference reading `s`; on resume restores the record's state
   // and integrates the gap as one step.
   void apply_resume(const EncoderSample& s) noexcept;
+  // restore_gyro: the record's gyro calibration into the fusion when decide_resume matched it.
+  void restore_gyro() noexcept;
   StateRecord resume_rec_;
   ResumeContext resume_ctx_;
   bool resume_offered_ = false;

@@ -127,7 +127,9 @@ struct ResumeDecision {
   std::int64_t dl = 0;  // counts of each wheel during the gap (wrap rule)
   std::int64_t dr = 0;
   Pose2 pose;  // on kResumed: the pose the loop starts from (the record's plus the gap's step)
-  // On kResumed: the record's gyro calibration belongs to this loop's gyro (same nonzero id).
+  // The record's gyro calibration belongs to this loop's gyro (same nonzero id, same boot and
+  // clock, within max_age): set whether or not the pose resumes (the bias is the chip's, not
+  // the encoders').
   bool gyro_matches = false;
   bool gyro_restored = false;  // the loop restored it and its bias is valid
   GyroCalibration gyro;        // on gyro_restored: the fusion's calibration after the restore
@@ -138,7 +140,8 @@ struct ResumeDecision {
 // reading `current` after the restart. Checks in order: boot, clock, age, backend, continuity,
 // kinematics, calibration, reading health, counter plausibility (each wheel's travel during the
 // gap at most max_wheel_speed * gap plus one count, and that bound below half the counter range).
-// On kResumed also whether the record's gyro calibration is this gyro's (gyro_matches).
+// Also, for any reason after the age check, whether the record's gyro calibration is this
+// gyro's (gyro_matches).
 ResumeDecision decide_resume(const StateRecord& rec, const ResumeContext& ctx,
                              const EncoderSample& current) noexcept;
 
