@@ -257,16 +257,28 @@ template <bool kFull>
   return e;
 }
 
+inline void Gyrodometry::set_bias_time(double t) noexcept {
+  bias_time_ = std::min(t, p_.bias_tau);
+  bias_valid_ = bias_time_ >= p_.still_time;
+  update_b_res();
+}
+
+inline void Gyrodometry::accept_scale(double s) noexcept {
+  // Beyond 1 +- scale_max_error (or not a number) it is no scale error a gyro has: rejected.
+  if (std::fabs(s - 1.0) <= p_.scale_max_error) {
+    scale_ = s;
+    scale_valid_ = true;
+  }
+}
+
 void Gyrodometry::update_bias(double rate, bool rate_ok, double dt) noexcept {
   still_for_ += dt;
   // The first still_time of a standstill only confirms it (the robot may still rock after
   // braking); after that the gyro's mean is its bias: a running mean over the seconds averaged so
   // far, which becomes an exponential average of horizon bias_tau to follow the bias's drift.
   if (!rate_ok || still_for_ < p_.still_time) return;
-  bias_time_ = std::min(bias_time_ + dt, p_.bias_tau);
-  bias_valid_ = bias_time_ >= p_.still_time;
+  set_bias_time(bias_time_ + dt);
   bias_ += (rate - bias_) * dt / bias_time_;
-  update_b_res();
 }
 
 bool Gyrodometry::restore(const GyroCalibration& c) noexcept {
@@ -274,15 +286,10 @@ bool Gyrodometry::restore(const GyroCalibration& c) noexcept {
   // keeps the weight it had (its residual B_res included), capped as update_bias caps it.
   if (std::isfinite(c.bias) && std::isfinite(c.bias_time) && c.bias_time > 0.0) {
     bias_ = c.bias;
-    bias_time_ = std::min(c.bias_time, p_.bias_tau);
-    bias_valid_ = bias_time_ >= p_.still_time;
-    update_b_res();
+    set_bias_time(c.bias_time);
   }
   // Only a scale the estimator itself would have applied.
-  if (c.scale_valid && std::isfinite(c.scale) && std::fabs(c.scale - 1.0) <= p_.scale_max_error) {
-    scale_ = c.scale;
-    scale_valid_ = true;
-  }
+  if (c.scale_valid) accept_scale(c.scale);
   return bias_valid_;
 }
 
@@ -294,11 +301,7 @@ void Gyrodometry::update_scale(double odo, double raw_gyro, double dt) noexcept 
   scale_odo_ += sign * odo;
   scale_gyro_ += sign * raw_gyro;
   if (scale_odo_ < p_.scale_angle || !(scale_gyro_ > 0.0)) return;
-  const double s = scale_odo_ / scale_gyro_;
-  if (std::fabs(s - 1.0) <= p_.scale_max_error) {
-    scale_ = s;
-    scale_valid_ = true;
-  }
+  accept_scale(scale_odo_ / scale_gyro_);
 }
 
 inline std::uint32_t Gyrodometry::limit_flags(double abs_left, double abs_right) const noexcept {

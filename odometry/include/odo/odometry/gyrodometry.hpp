@@ -255,6 +255,10 @@ class Gyrodometry {
   // update_bias: a still tick of length dt [s] with the gyro's rate [rad/s] (usable if rate_ok).
   void update_bias(double rate, bool rate_ok, double dt) noexcept;
   void update_scale(double odo, double raw_gyro, double dt) noexcept;
+  // set_bias_time: t [s] of averaging behind bias_ (capped at bias_tau), and what follows from it
+  // (bias_valid_, B_res). accept_scale: s as the scale when within 1 +- scale_max_error.
+  void set_bias_time(double t) noexcept;
+  void accept_scale(double s) noexcept;
   void update_b_res() noexcept;
   // travel_step: the centre-travel correction [m] of this tick, after the interval's heading
   // corrections reached c [rad] (see the top of this file).
