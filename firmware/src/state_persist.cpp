@@ -15,7 +15,10 @@
 #include <cstring>
 #include <ctime>
 #include <iomanip>
+#include <span>
 #include <sstream>
+
+#include "odo/calibration/record.hpp"
 
 namespace odo::fw {
 namespace {
@@ -145,9 +148,10 @@ std::uint32_t gyro_id(const Config& cfg) {
       << c.offset << '|' << c.width << '|' << c.is_signed << '|' << name_of(c.byte_order) << '|'
       << c.scale << '|' << c.rate_offset;
   }
-  // FNV-1a (32 bit) of that text: configure time, and any change of it is another gyro.
-  std::uint32_t h = 2166136261u;
-  for (const char ch : t.str()) h = (h ^ static_cast<std::uint8_t>(ch)) * 16777619u;
+  // The records' own CRC-32 of that text: any change of it is another gyro.
+  const std::string text = t.str();
+  const std::uint32_t h = calib::crc32(std::span<const std::uint8_t>(
+      reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
   return h != 0 ? h : 1;  // 0 means "no gyro"
 }
 

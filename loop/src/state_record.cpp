@@ -112,8 +112,9 @@ Result<StateRecord> decode_state(std::span<const std::uint8_t> b) {
   if (get<std::uint32_t>(b, 0) != kStateMagic) return corrupt("bad magic (not a state record)");
   if ((version != 1 && version != kStateVersion) || get<std::uint16_t>(b, 6) != length)
     return corrupt("version " + std::to_string(version) + " length " +
-                   std::to_string(get<std::uint16_t>(b, 6)) +
-                   ", expected version 2 length 244 (or 1 and 212)");
+                   std::to_string(get<std::uint16_t>(b, 6)) + ", expected version " +
+                   std::to_string(kStateVersion) + " length " + std::to_string(kStateRecordBytes) +
+                   " (or 1 and " + std::to_string(kStateRecordBytesV1) + ")");
   // The CRC covers everything else: a write torn at any byte fails here.
   const std::size_t crc_at = length - 4;
   if (get<std::uint32_t>(b, crc_at) != calib::crc32(b.first(crc_at)))
