@@ -7,8 +7,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -64,6 +66,28 @@ inline bool wait_for_text(const std::string& path, const std::string& text, doub
 inline int run(const std::string& cmd) {
   const int rc = std::system(cmd.c_str());
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : 128;
+}
+
+// kI2cStubChips: every address at which a kernel test puts a chip on i2c-stub (the calibration
+// store's 24C02 EEPROM at 0x50, the BMG160 gyro at 0x68).
+inline constexpr std::array<int, 2> kI2cStubChips = {0x50, 0x68};
+
+// i2c_stub_bus: i2c-stub loaded with a chip at every address of kI2cStubChips; returns its
+// adapter (i2c-N), or "" when it cannot be loaded so. The module makes its chips only when it is
+// loaded (a second modprobe with other addresses does nothing), so every test loads it with the
+// whole list, and a module loaded with another list is unloaded first: the tests run in any order.
+inline std::string i2c_stub_bus() {
+  std::string list;
+  for (const int a : kI2cStubChips) list += (list.empty() ? "" : ",") + std::to_string(a);
+  // The module prints its (ten) addresses in decimal: "80,104,0,...".
+  const std::string loaded = slurp("/sys/module/i2c_stub/parameters/chip_addr");
+  if (!loaded.empty() && loaded.rfind(list + ",", 0) != 0 && run("rmmod i2c-stub") != 0) return "";
+  if (run("modprobe i2c-stub chip_addr=" + list) != 0) return "";
+  for (const auto& e : std::filesystem::directory_iterator("/sys/bus/i2c/devices")) {
+    if (slurp((e.path() / "name").string()).rfind("SMBus stub", 0) == 0)
+      return e.path().filename().string();
+  }
+  return "";
 }
 
 }  // namespace odo::test

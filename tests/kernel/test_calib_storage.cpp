@@ -39,11 +39,13 @@ std::string mtd_device() {
 // at24_nvmem: a 24C02 EEPROM (256 bytes) bound by the at24 driver on the i2c-stub adapter;
 // returns its nvmem attribute.
 std::string at24_nvmem() {
-  const char* setup =
-      "sh -c 'set -e; modprobe i2c-stub chip_addr=0x50; modprobe at24;"
+  const std::string bus = i2c_stub_bus();
+  if (bus.empty()) return "";
+  const std::string setup =
+      "sh -c 'set -e; modprobe at24;"
       "ls -d /sys/bus/nvmem/devices/*-0050*/nvmem >/dev/null 2>&1 && exit 0;"
-      "b=$(dirname $(grep -l \"SMBus stub\" /sys/bus/i2c/devices/i2c-*/name));"
-      "echo 24c02 0x50 > $b/new_device; sleep 0.3'";
+      "echo 24c02 0x50 > /sys/bus/i2c/devices/" +
+      bus + "/new_device; sleep 0.3'";
   if (run(setup) != 0) return "";
   for (const auto& e : std::filesystem::directory_iterator("/sys/bus/nvmem/devices"))
     if (e.path().filename().string().find("-0050") != std::string::npos)

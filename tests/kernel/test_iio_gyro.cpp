@@ -57,15 +57,13 @@ TimeNs monotonic_ns() {
 class StubBmg160 {
  public:
   StubBmg160() {
-    if (run("modprobe i2c-stub chip_addr=0x68 && modprobe i2c-dev && modprobe bmg160_i2c") != 0) {
-      error_ = "modprobe i2c-stub / i2c-dev / bmg160_i2c failed";
+    bus_ = i2c_stub_bus();
+    if (bus_.empty()) {
+      error_ = "i2c-stub cannot be loaded with the chips of kI2cStubChips (modprobe i2c-stub)";
       return;
     }
-    for (const auto& e : fs::directory_iterator("/sys/bus/i2c/devices")) {
-      if (slurp(e.path() / "name") == "SMBus stub driver") bus_ = e.path().filename().string();
-    }
-    if (bus_.empty()) {
-      error_ = "no i2c-stub adapter in /sys/bus/i2c/devices";
+    if (run("modprobe i2c-dev && modprobe bmg160_i2c") != 0) {
+      error_ = "modprobe i2c-dev / bmg160_i2c failed";
       return;
     }
     fd_ = ::open(("/dev/" + bus_).c_str(), O_RDWR);
