@@ -8,8 +8,12 @@
 #               (tools/vm-run.sh: vcan, gpio-sim, mtdram, at24); if the VM cannot start, the stage
 #               fails under CI; elsewhere those tests run on the host, where each one reports
 #               itself skipped with the reason
-#   debug-asan  Debug + AddressSanitizer + UndefinedBehaviorSanitizer: unit, sim, cli tiers
-#   tsan        ThreadSanitizer: unit, sim, cli tiers (every threaded test: TESTING.md)
+#   debug-asan  Debug + AddressSanitizer + UndefinedBehaviorSanitizer: unit, sim, cli tiers, then
+#               the kernel tier in the VM (the drivers on real kernel facilities) but for the
+#               repeated-SIGKILL tests; any sanitizer report, of a test or of a program it started,
+#               fails the stage
+#   tsan        ThreadSanitizer: unit, sim, cli tiers (every threaded test: TESTING.md), then the
+#               kernel tier in the VM as for debug-asan
 #   fuzz        clang-14 libFuzzer + ASan + UBSan: a short run of every fuzz target (ODO_FUZZ_ARGS,
 #               default -max_total_time=20 per target)
 #   cross-aarch64, cross-armhf
@@ -151,15 +155,31 @@ stage_soak() {
 # The VM harness; a test may point this at another script (tests/ci/test_ci_gate.sh).
 VM_RUN=${ODO_VM_RUN:-$ODO_ROOT/tools/vm-run.sh}
 
+# stage_kernel [TREE [NAME [CTEST_ARGS...]]]: the kernel tier of build/TREE (default: default) in
+# the VM. A name other than "kernel" is a sanitizer tree's run: the sanitizers write their reports
+# to files in build/TREE/sanitizer-reports (a program a test starts and kills reports there too,
+# where its stderr would be lost), and a report fails the stage.
 stage_kernel() {
-  local t0 r prep
-  echo "=== kernel tier (VM harness) ==="
+  local tree=${1:-default} name=${2:-kernel} t0 r prep reports
+  shift $(($# < 2 ? $# : 2))
+  echo "=== $name tier (VM harness) ==="
   t0=$(date +%s)
+  reports=$PWD/build/$tree/sanitizer-reports
+  rm -rf "$reports" && mkdir -p "$reports"
   if prep=$("$VM_RUN" --prepare 2>&1); then
-    # One vCPU: with two, gpio-sim edges can be lost under TCG (see tools/vm-run.md).
-    if ODO_IN_VM=1 gated kernel build/default/kernel.log "$VM_RUN" --cpus 1 --mem 1G \
-        --timeout 1800 -- ctest --test-dir build/default -L kernel --output-on-failure
+    # One vCPU: with two, gpio-sim edges can be lost under TCG (see tools/vm-run.md). 2G: the
+    # sanitizers' shadow memory.
+    if ODO_IN_VM=1 ASAN_OPTIONS=log_path=$reports/asan \
+        UBSAN_OPTIONS="log_path=$reports/ubsan print_stacktrace=1" \
+        TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 log_path=$reports/tsan" \
+        gated "$name" "build/$tree/kernel.log" "$VM_RUN" --cpus 1 --mem 2G --rw "$reports" \
+        --timeout 1800 -- ctest --test-dir "build/$tree" -L kernel --output-on-failure "$@"
     then r=ok; else r=FAILED; status=1; fi
+    if compgen -G "$reports/*" >/dev/null; then
+      echo "$name: sanitizer reports:"; head -n 30 "$reports"/*
+      failures+=("$name: sanitizer reports in $reports")
+      r=FAILED; status=1; n_fail=$((n_fail + 1))
+    fi
   elif in_ci; then
     # Under CI the kernel tier is not optional: a machine that cannot boot the VM fails the run.
     echo "kernel tier: FAILED under CI: the VM harness cannot start:"
@@ -169,10 +189,10 @@ stage_kernel() {
   else
     echo "kernel tier: the VM harness is unavailable; kernel tests will report SKIPPED:"
     echo "$prep" | tail -5
-    if counted build/default/kernel.log ctest --test-dir build/default -L kernel --output-on-failure
+    if counted "build/$tree/kernel.log" ctest --test-dir "build/$tree" -L kernel --output-on-failure "$@"
     then r="skipped (no VM)"; else r=FAILED; status=1; fi
   fi
-  summary+=("kernel: $r ($(($(date +%s) - t0)) s)")
+  summary+=("$name: $r ($(($(date +%s) - t0)) s)")
 }
 
 stage_fresh_install() {  # the amd64 package on a freshly bootstrapped Debian 12 chroot
@@ -222,6 +242,12 @@ main() {
     if [[ $c == default ]]; then
       if [[ ${ODO_SOAK:-1} == 1 ]]; then stage_soak; fi
       if [[ ${ODO_KERNEL:-1} == 1 ]]; then stage_kernel; fi
+    fi
+    # The sanitizer trees' kernel tier, but for the three tests that SIGKILL a program over and
+    # over (100 kills during motion, the store's writer killed at every point of a save): the
+    # same paths as their short neighbours, and 4-5 min of the sanitizers' 7 in the VM.
+    if [[ ($c == debug-asan || $c == tsan) && ${ODO_KERNEL:-1} == 1 ]]; then
+      stage_kernel "$c" "kernel $c" --exclude-regex "SigkilledWriter|HundredSigkills"
     fi
   done
   if [[ ${ODO_PACKAGES:-1} == 1 ]]; then

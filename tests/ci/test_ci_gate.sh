@@ -104,5 +104,31 @@ check "CI, no test ran: status 1" "$(echo "$out" | grep -qx 'status=1'; echo $?)
 check "CI, no test ran: the reason is printed" \
   "$(grep -q 'kernel: FAILED under CI: no test ran' "$tmp/stage.out"; echo $?)"
 
+# 7. A sanitizer tree's kernel tier: a report written by a program a test started (its test
+# passed: the program was killed, or its stderr went nowhere) fails the stage; the tests the
+# stage excludes do not run.
+mkdir -p "$tmp/w/build/debug-asan"
+cat >"$tmp/w/build/debug-asan/CTestTestfile.cmake" <<'CT'
+add_test(k_pass "/bin/true")
+set_tests_properties(k_pass PROPERTIES LABELS kernel)
+add_test(k_child "/bin/sh" "-c" "echo 'ERROR: AddressSanitizer: heap-use-after-free' >\"\${ASAN_OPTIONS#log_path=}.4242\"")
+set_tests_properties(k_child PROPERTIES LABELS kernel)
+add_test(k_repeated_kills "/bin/false")
+set_tests_properties(k_repeated_kills PROPERTIES LABELS kernel)
+CT
+out=$(cd "$tmp/w" && CI=true ODO_VM_RUN="$tmp/fake-vm-run.sh" bash -c '
+  . "$0"/tools/test.sh
+  stage_kernel debug-asan "kernel debug-asan" --exclude-regex repeated_kills >"$1"/stage.out 2>&1
+  printf "%s\n" "${summary[@]}" "${failures[@]}"
+  echo "all stages: $n_pass passed, $n_fail failed, $n_skip skipped"
+  echo "status=$status"' "$root" "$tmp")
+echo "$out"
+check "sanitizer report: status 1" "$(echo "$out" | grep -qx 'status=1'; echo $?)"
+check "sanitizer report: stage FAILED, named" \
+  "$(echo "$out" | grep -q '^kernel debug-asan: FAILED' && echo "$out" | grep -q 'kernel debug-asan: sanitizer reports in'; echo $?)"
+check "sanitizer report: printed" "$(grep -q 'heap-use-after-free' "$tmp/stage.out"; echo $?)"
+check "sanitizer report: the excluded test did not run (2 passed, 1 failed)" \
+  "$(echo "$out" | grep -qx 'all stages: 2 passed, 1 failed, 0 skipped'; echo $?)"
+
 echo "ci gate: $pass passed, $fail failed"
 [ "$fail" = 0 ]
