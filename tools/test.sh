@@ -156,9 +156,9 @@ stage_soak() {
 VM_RUN=${ODO_VM_RUN:-$ODO_ROOT/tools/vm-run.sh}
 
 # stage_kernel [TREE [NAME [CTEST_ARGS...]]]: the kernel tier of build/TREE (default: default) in
-# the VM. A name other than "kernel" is a sanitizer tree's run: the sanitizers write their reports
-# to files in build/TREE/sanitizer-reports (a program a test starts and kills reports there too,
-# where its stderr would be lost), and a report fails the stage.
+# the VM, named NAME (default: kernel) in the summary. In a sanitizer tree the sanitizers write
+# their reports to files in build/TREE/sanitizer-reports (a program a test starts and kills
+# reports there too, where its stderr would be lost); any report fails the stage.
 stage_kernel() {
   local tree=${1:-default} name=${2:-kernel} t0 r prep reports
   shift $(($# < 2 ? $# : 2))
