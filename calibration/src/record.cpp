@@ -8,20 +8,10 @@
 #include <sstream>
 
 #include "odo/hal/bytes.hpp"
+#include "odo/hal/crc.hpp"
 
 namespace odo::calib {
 namespace {
-
-constexpr std::array<std::uint32_t, 256> make_crc_table() {
-  std::array<std::uint32_t, 256> t{};
-  for (std::uint32_t i = 0; i < 256; ++i) {
-    std::uint32_t c = i;
-    for (int k = 0; k < 8; ++k) c = (c & 1U) ? 0xEDB88320U ^ (c >> 1) : c >> 1;
-    t[i] = c;
-  }
-  return t;
-}
-constexpr auto kCrcTable = make_crc_table();
 
 // Flag bits: which optional fields are present.
 constexpr std::uint32_t kFlagCleared = 1U << 0;
@@ -69,12 +59,6 @@ Status validate_fit(const FixFitProvenance& f) {
 }
 
 }  // namespace
-
-std::uint32_t crc32(std::span<const std::uint8_t> data) noexcept {
-  std::uint32_t c = 0xFFFFFFFFU;
-  for (std::uint8_t b : data) c = kCrcTable[(c ^ b) & 0xFFU] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFU;
-}
 
 Result<std::vector<std::uint8_t>> encode_record(const CalibrationRecord& r) {
   if (r.method.size() >= kMethodBytes)

@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "odo/calibration/record.hpp"
+#include "odo/hal/crc.hpp"
 
 namespace odo::fw {
 namespace {
@@ -150,7 +151,7 @@ std::uint32_t gyro_id(const Config& cfg) {
   }
   // The records' own CRC-32 of that text: any change of it is another gyro.
   const std::string text = t.str();
-  const std::uint32_t h = calib::crc32(std::span<const std::uint8_t>(
+  const std::uint32_t h = odo::crc32(std::span<const std::uint8_t>(
       reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
   return h != 0 ? h : 1;  // 0 means "no gyro"
 }

@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "odo/calibration/record.hpp"
 #include "odo/hal/bytes.hpp"
+#include "odo/hal/crc.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
 
@@ -85,7 +85,7 @@ void encode_state(const StateRecord& r, StateBytes& b) noexcept {
   put(b, kGyroBias, r.gyro.bias);
   put(b, kGyroBiasTime, r.gyro.bias_time);
   put(b, kGyroScale, r.gyro.scale);
-  put(b, kCrcOffset, calib::crc32(std::span<const std::uint8_t>(b.data(), kCrcOffset)));
+  put(b, kCrcOffset, odo::crc32(std::span<const std::uint8_t>(b.data(), kCrcOffset)));
 }
 
 // decode_gyro: version 2's gyro part of `b` into r.
@@ -117,7 +117,7 @@ Result<StateRecord> decode_state(std::span<const std::uint8_t> b) {
                    " (or 1 and " + std::to_string(kStateRecordBytesV1) + ")");
   // The CRC covers everything else: a write torn at any byte fails here.
   const std::size_t crc_at = length - 4;
-  if (get<std::uint32_t>(b, crc_at) != calib::crc32(b.first(crc_at)))
+  if (get<std::uint32_t>(b, crc_at) != odo::crc32(b.first(crc_at)))
     return corrupt("CRC mismatch (torn or damaged write)");
   StateRecord r;
   r.sequence = get<std::uint64_t>(b, 8);

@@ -5,13 +5,6 @@
 
 namespace odo {
 
-double wrap_angle(double a) noexcept {
-  constexpr double kPi = std::numbers::pi;
-  double r = std::remainder(a, 2.0 * kPi);  // in [-pi, pi]
-  if (r <= -kPi) r += 2.0 * kPi;            // -pi maps to +pi
-  return r;
-}
-
 Pose2 arc_step(const Pose2& p, double d_left, double d_right, double b) noexcept {
   // On an arc of chord angle dtheta the centre moves along the chord of length
   // ds * sinc(dtheta/2), pointing at the mean heading theta + dtheta/2.

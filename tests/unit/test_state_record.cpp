@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "odo/calibration/record.hpp"
+#include "odo/hal/crc.hpp"
 #include "odo/loop/state_record.hpp"
 
 namespace odo::loop {
@@ -110,7 +111,7 @@ TEST(StateRecord, VersionOneRecordIsStillRead) {
   // bytes [0, 208) at 208.
   b[4] = 1;
   b[6] = 212;
-  const std::uint32_t crc = calib::crc32(std::span<const std::uint8_t>(b.data(), 208));
+  const std::uint32_t crc = odo::crc32(std::span<const std::uint8_t>(b.data(), 208));
   for (int i = 0; i < 4; ++i) b[208 + i] = static_cast<std::uint8_t>(crc >> (8 * i));
   auto d = decode_state(std::span<const std::uint8_t>(b.data(), kStateRecordBytesV1));
   ASSERT_TRUE(d) << d.error().message;

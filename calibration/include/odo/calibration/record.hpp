@@ -68,9 +68,6 @@ inline constexpr std::size_t kRecordV1Bytes = 108;
 inline constexpr std::size_t kRecordV2Bytes = 148;
 inline constexpr std::size_t kMethodBytes = 16;
 
-// crc32: CRC-32/ISO-HDLC (zlib's crc32; "123456789" -> 0xCBF43926).
-std::uint32_t crc32(std::span<const std::uint8_t> data) noexcept;
-
 // encode_record: the bytes of `r`: version 1 (kRecordV1Bytes) without `fit`, version 2
 // (kRecordV2Bytes) with it. Fails when the method text is longer than 15 bytes or a value is
 // not finite.

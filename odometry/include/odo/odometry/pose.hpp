@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "odo/hal/angle.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
 
@@ -15,9 +16,6 @@ struct Pose2 {
   double y = 0.0;      // [m]
   double theta = 0.0;  // [rad], cumulative: two full CCW turns give 4*pi
 };
-
-// wrap_angle: maps any angle [rad] into (-pi, pi].
-double wrap_angle(double a) noexcept;
 
 // Below this half-angle [rad] half_angle() uses Taylor series, exact to double precision: the
 // first dropped terms are h^9/9! < 6e-18 (sin) and h^10/10! < 3e-20 (cos) for |h| <= 0.05.
