@@ -8,6 +8,7 @@
 #include "odo/firmware/toml_reader.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
+#include "odo/odometry/gyrodometry.hpp"
 #include "odo/protocol/can_protocol.hpp"
 #include "odo/ros2/config.hpp"
 
@@ -257,30 +258,34 @@ void read_selfcal(TableReader t, SelfCalSection& s) {
 }
 
 // ---- [gyro] ----
-// The numeric keys of [gyro] and their ranges: the one table the reader takes them from.
-struct GyroRange {
-  const char* key;
-  double GyroSection::*member;
-  double lo, hi;
-  const char* unit;
+// The numbers of [gyro] that belong to the gyro source (the fusion's own come from its table,
+// gyrodometry_range, through gyro_number below).
+constexpr RangeRow kGyroSourceRows[] = {
+    {"rate", 0.0, 100000.0, "Hz"},
+    {"stale_timeout", 0.001, 10.0, "s"},
 };
-constexpr GyroRange kGyroRanges[] = {
-    {"rate", &GyroSection::rate, 0.0, 100000.0, "Hz"},
-    {"stale_timeout", &GyroSection::stale_timeout, 0.001, 10.0, "s"},
-    {"noise_density", &GyroSection::noise_density, 0.0, 0.1, "rad/s/sqrt(Hz)"},
-    {"bias_instability", &GyroSection::bias_instability, 0.0, 0.1, "rad/s"},
-    {"scale_tolerance", &GyroSection::scale_tolerance, 0.0, 0.5, ""},
-    {"delay", &GyroSection::delay, 0.0, 1.0, "s"},
-    {"delay_tolerance", &GyroSection::delay_tolerance, 0.0, 1.0, "s"},
-    {"window", &GyroSection::window, 0.01, 10.0, "s"},
-    {"k_sigma", &GyroSection::k_sigma, 1.0, 20.0, ""},
-    {"max_wheel_speed", &GyroSection::max_wheel_speed, 0.01, 100.0, "m/s"},
-    {"max_wheel_accel", &GyroSection::max_wheel_accel, 0.01, 1000.0, "m/s^2"},
-    {"still_time", &GyroSection::still_time, 0.01, 60.0, "s"},
-    {"bias_tau", &GyroSection::bias_tau, 0.01, 86400.0, "s"},
-};
+constexpr double GyroSection::*kGyroSourceMembers[] = {&GyroSection::rate,
+                                                       &GyroSection::stale_timeout};
 
-void read_gyro(TableReader t, GyroSection& s) {
+// The section's field of each of the fusion's user-set parameters, in GyroParam order.
+constexpr double GyroSection::*kGyroFusionMembers[kGyroConfigParams] = {
+    &GyroSection::noise_density, &GyroSection::bias_instability, &GyroSection::scale_tolerance,
+    &GyroSection::delay,         &GyroSection::delay_tolerance,  &GyroSection::window,
+    &GyroSection::k_sigma,       &GyroSection::max_wheel_speed,  &GyroSection::max_wheel_accel,
+    &GyroSection::still_time,    &GyroSection::bias_tau};
+
+// read_gyro_numbers: the source's numbers, then the fusion's against its own limits at this
+// loop's tick (bias_tau after still_time: its lower limit is the still_time just read).
+void read_gyro_numbers(TableReader& t, GyroSection& s, double loop_hz) {
+  for (std::size_t i = 0; i < std::size(kGyroSourceRows); ++i)
+    s.*kGyroSourceMembers[i] = t.number(s.*kGyroSourceMembers[i], kGyroSourceRows[i]);
+  for (std::size_t i = 0; i < kGyroConfigParams; ++i) {
+    const RangeRow r = gyrodometry_range(static_cast<GyroParam>(i), 1.0 / loop_hz, s.still_time);
+    s.*kGyroFusionMembers[i] = t.number(s.*kGyroFusionMembers[i], r);
+  }
+}
+
+void read_gyro(TableReader t, GyroSection& s, double loop_hz) {
   s.backend = t.choice("backend", s.backend);
   s.device = t.string("device", s.device);
   s.axis = t.choice("axis", s.axis);
@@ -294,11 +299,7 @@ void read_gyro(TableReader t, GyroSection& s) {
   s.buffer_length = static_cast<int>(t.integer("buffer_length", s.buffer_length, 2, 65536));
   s.model = t.choice("model", s.model);
   s.seed = t.integer("seed", s.seed, 0, INT64_MAX);
-  for (const GyroRange& r : kGyroRanges)
-    s.*r.member = t.number(r.key, s.*r.member, r.lo, r.hi, r.unit);
-  if (s.bias_tau < s.still_time)
-    t.reject("bias_tau", "= " + std::to_string(s.bias_tau) + " s must be at least still_time (" +
-                             std::to_string(s.still_time) + " s)");
+  read_gyro_numbers(t, s, loop_hz);
   s.scale_estimation = t.boolean("scale_estimation", s.scale_estimation);
   if (s.backend == GyroBackend::kIio && s.device.empty())
     t.reject("device",
@@ -402,7 +403,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   c.ros2 = std::make_shared<const ros2::Config>(std::move(ros2_cfg));
   read_resume(root.sub("resume"), c.resume, c.loop.rate_hz);
   read_selfcal(root.sub("selfcal"), c.selfcal);
-  read_gyro(root.sub("gyro"), c.gyro);
+  read_gyro(root.sub("gyro"), c.gyro, c.loop.rate_hz);
   read_can_gyro(root.sub("can_gyro"), c.can_gyro);
   check_gyro_robot(root, c);
   root.finish();

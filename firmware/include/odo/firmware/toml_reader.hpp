@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "odo/firmware/config.hpp"
+#include "odo/hal/field_range.hpp"
 
 namespace odo::fw {
 
@@ -23,6 +24,8 @@ class TableReader {
 
   // number: a float or integer in [lo, hi]; `unit` is printed in messages.
   double number(std::string_view key, double def, double lo, double hi, std::string_view unit);
+  // number: the value of row.key, checked against the row's range (a range table's row).
+  double number(double def, const RangeRow& row);
   // integer: an integer in [lo, hi].
   std::int64_t integer(std::string_view key, std::int64_t def, std::int64_t lo, std::int64_t hi);
   bool boolean(std::string_view key, bool def);
