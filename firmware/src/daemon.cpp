@@ -346,8 +346,7 @@ int Daemon::configure() {
   if (!can) return fail(cfg_->source + ": " + can.error().message);
   can_ = std::move(can).value();
   // ROS 2 output ([ros2] enabled): an observer of the loop plus the DDS thread.
-  auto ros2 = Ros2Output::create(cfg_->ros2.get(), cfg_->loop.rate_hz,
-                                 calibrated->params().wheelbase, cfg_->error_model, *loop_);
+  auto ros2 = Ros2Output::create(cfg_->ros2.get(), cfg_->loop.rate_hz, cfg_->error_model, *loop_);
   if (!ros2) return fail(cfg_->source + ": " + ros2.error().message);
   ros2_ = std::move(ros2).value();
   if (selfcal_) selfcal_->attach(*loop_, can_.get());

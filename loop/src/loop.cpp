@@ -179,6 +179,7 @@ TimeNs OdometryLoop::wait_for_deadline() noexcept {
   const std::int64_t dl = wrap_delta(prev_left_, s.left, bits_);
   const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
   const double dt = to_seconds(s.stamp - prev_stamp_);
+  motion_.dt = dt;
   if (fusion_) {
     integrate_fused(dl, dr, dt, s.stamp);
   } else {
@@ -213,6 +214,8 @@ void OdometryLoop::take_reference(const EncoderSample& s) noexcept {
   in.wheelbase = k.wheelbase();
   const FusedTick f = fusion_->step(in);
   last_fusion_flags_ = f.flags;
+  motion_.gyro_heading = (f.flags & kFusionGyroUsed) != 0;
+  motion_.gyro_var_heading = f.var_heading;
   if ((f.flags & kFusionGyroUsed) == 0) {
     // Odometry's own increment and no travel correction: the plain path, which computes exactly
     // what advance_fused would for it (Odometry::update_fused's contract), at the plain cost.
@@ -241,6 +244,10 @@ void OdometryLoop::record_wakeup(TimeNs latency) noexcept {
   snap.pose = odom_.pose();
   snap.v = odom_.linear_velocity();
   snap.w = odom_.angular_velocity();
+  snap.motion = motion_;
+  snap.motion.d_left = odom_.last_d_left();
+  snap.motion.d_right = odom_.last_d_right();
+  snap.motion.wheelbase = odom_.kinematics().wheelbase();
   snap.distance = odom_.distance();
   snap.cov = odom_.covariance();
   snap.has_cov = true;

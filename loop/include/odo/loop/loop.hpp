@@ -58,11 +58,14 @@ struct LoopGyroStatus {
 // What one tick produced; observers and the status thread see this.
 struct LoopSnapshot {
   std::uint64_t tick = 0;
-  TimeNs stamp = 0;                 // sample time of the encoder reading [ns]
-  TimeNs loop_time = 0;             // time since the loop started [ns]
-  Pose2 pose;                       // cumulative heading
-  double v = 0.0;                   // [m/s]
-  double w = 0.0;                   // [rad/s]
+  TimeNs stamp = 0;      // sample time of the encoder reading [ns]
+  TimeNs loop_time = 0;  // time since the loop started [ns]
+  Pose2 pose;            // cumulative heading
+  double v = 0.0;        // [m/s]
+  double w = 0.0;        // [rad/s]
+  // What this tick measured (wheel travels, their interval, the wheelbase in use, the gyro's
+  // heading variance on a fused tick): consumers derive from it, never invert (v, w).
+  TickMotion motion;
   double distance = 0.0;            // path length of the centre point [m]
   std::uint32_t encoder_flags = 0;  // EncoderFlag bits of the last sample
   EncoderCounters encoder_counters;
@@ -208,6 +211,7 @@ class OdometryLoop {
   // read into it directly (a 64-byte GyroSample copied once a tick, not twice).
   FusionInput fused_in_;
   std::uint32_t last_fusion_flags_ = 0;
+  TickMotion motion_;  // the last integrated tick's (fill_snapshot copies it)
   std::array<TickObserver*, kMaxObservers> observers_{};
   std::size_t n_observers_ = 0;
 
