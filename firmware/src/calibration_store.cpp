@@ -10,22 +10,8 @@ using calib::CalibrationRecord;
 using calib::LoadResult;
 using calib::StoreStatus;
 
-Result<OpenStore> open_calibration_store(const std::string& path, StoreBackend backend) {
-  drivers::NvBackend k = drivers::NvBackend::kAuto;
-  switch (backend) {
-    case StoreBackend::kAuto:
-      k = drivers::detect_nv_backend(path);
-      break;
-    case StoreBackend::kFile:
-      k = drivers::NvBackend::kFile;
-      break;
-    case StoreBackend::kNvmem:
-      k = drivers::NvBackend::kNvmem;
-      break;
-    case StoreBackend::kMtd:
-      k = drivers::NvBackend::kMtd;
-      break;
-  }
+Result<OpenStore> open_calibration_store(const std::string& path, NvBackend backend) {
+  const NvBackend k = backend == NvBackend::kAuto ? drivers::detect_nv_backend(path) : backend;
   OpenStore o;
   o.backend = drivers::nv_backend_name(k);
   auto m = drivers::open_nv_storage(path, k);
@@ -91,7 +77,7 @@ AppliedCalibration apply_calibration(const KinematicParams& nominal,
 }
 
 AppliedCalibration read_and_apply(const KinematicParams& nominal, const std::string& path,
-                                  StoreBackend backend) {
+                                  NvBackend backend) {
   if (path.empty()) {
     AppliedCalibration a;
     a.params = nominal;

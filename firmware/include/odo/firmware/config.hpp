@@ -13,6 +13,7 @@
 
 #include "odo/hal/angle.hpp"
 #include "odo/hal/choice.hpp"
+#include "odo/hal/nv_storage.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
@@ -36,7 +37,6 @@ enum class HctlLatch : std::uint8_t { kNone, kLsb };
 enum class CanEncoderBus : std::uint8_t { kSocketCan, kSim };
 enum class CanEncoderProtocol : std::uint8_t { kOdrive, kGeneric };
 enum class ByteOrder : std::uint8_t { kLittle, kBig };
-enum class StoreBackend : std::uint8_t { kAuto, kFile, kNvmem, kMtd };
 enum class CanBusKind : std::uint8_t { kSim, kSocketCan, kNone };
 enum class GyroBackend : std::uint8_t { kNone, kSim, kIio, kCan };
 enum class GyroAxis : std::uint8_t { kX, kY, kZ };
@@ -62,10 +62,6 @@ inline constexpr Choice<CanEncoderProtocol> kCanEncoderProtocols[] = {
     {CanEncoderProtocol::kOdrive, "odrive"}, {CanEncoderProtocol::kGeneric, "generic"}};
 inline constexpr Choice<ByteOrder> kByteOrders[] = {{ByteOrder::kLittle, "little"},
                                                     {ByteOrder::kBig, "big"}};
-inline constexpr Choice<StoreBackend> kStoreBackends[] = {{StoreBackend::kAuto, "auto"},
-                                                          {StoreBackend::kFile, "file"},
-                                                          {StoreBackend::kNvmem, "nvmem"},
-                                                          {StoreBackend::kMtd, "mtd"}};
 inline constexpr Choice<CanBusKind> kCanBusKinds[] = {
     {CanBusKind::kSim, "sim"}, {CanBusKind::kSocketCan, "socketcan"}, {CanBusKind::kNone, "none"}};
 inline constexpr Choice<GyroBackend> kGyroBackends[] = {{GyroBackend::kNone, "none"},
@@ -89,7 +85,7 @@ inline constexpr std::tuple kChoiceTables{
     std::span<const Choice<CanEncoderBus>>(kCanEncoderBuses),
     std::span<const Choice<CanEncoderProtocol>>(kCanEncoderProtocols),
     std::span<const Choice<ByteOrder>>(kByteOrders),
-    std::span<const Choice<StoreBackend>>(kStoreBackends),
+    std::span<const Choice<NvBackend>>(kNvBackends),
     std::span<const Choice<CanBusKind>>(kCanBusKinds),
     std::span<const Choice<GyroBackend>>(kGyroBackends),
     std::span<const Choice<GyroAxis>>(kGyroAxes),
@@ -230,7 +226,7 @@ struct RealtimeSection {
 // Where the calibration record lives ([calibration]); see calibration_io.hpp.
 struct CalibrationSection {
   std::string store = "/var/lib/odometryd/calibration.bin";  // "" = no store: nominal values
-  StoreBackend backend = StoreBackend::kAuto;
+  NvBackend backend = NvBackend::kAuto;
 };
 
 // [can]: the CAN pose broadcast (README "CAN protocol"). Rates must divide the loop rate.
