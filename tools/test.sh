@@ -24,8 +24,10 @@
 #               tests/package/check_deb.sh; the amd64 one is installed, run, verified with
 #               systemd-analyze, removed and purged on this machine (CI is throw-away), and
 #               installed with apt on a fresh debootstrap chroot (tests/package/fresh_install.sh)
+#   rules       after default: tools/check_core.sh (the core rooms portable: no OS header, thread
+#               or stream, built with -fno-exceptions -fno-rtti; no function over 60 lines)
 # Environment: ODO_JOBS (parallel build jobs, default nproc), ODO_CONFIGS (space-separated
-# subset of the configurations above), ODO_SOAK=0, ODO_KERNEL=0, ODO_PACKAGES=0 (skip those
+# subset of the configurations above), ODO_RULES=0, ODO_SOAK=0, ODO_KERNEL=0, ODO_PACKAGES=0 (skip those
 # stages), ODO_FRESH_INSTALL=0 (no chroot install).
 #
 # A skip is for a developer's machine that lacks something, never for CI: with CI=true (as CI
@@ -230,6 +232,21 @@ stage_package() {  # the Debian package of one build tree
   fi
 }
 
+# stage_rules: the house rules no compiler checks (tools/check_core.sh): the core rooms portable
+# (no OS header, thread or stream; built with -fno-exceptions -fno-rtti) and no function over
+# 60 lines. A broken rule fails the run like a failed test.
+stage_rules() {
+  local t0=$SECONDS
+  if tools/check_core.sh portable functions 2>&1 | tee build/rules.log; then
+    summary+=("rules: ok ($((SECONDS - t0)) s)")
+    n_pass=$((n_pass + 1))
+  else
+    summary+=("rules: FAILED ($((SECONDS - t0)) s; build/rules.log)")
+    failures+=("rules: $(grep -m1 '^check_core:' build/rules.log || echo 'see build/rules.log')")
+    n_fail=$((n_fail + 1)) status=1
+  fi
+}
+
 main() {
   cd "$ODO_ROOT"
   jobs=${ODO_JOBS:-$(nproc)}
@@ -240,6 +257,7 @@ main() {
   for c in $configs; do
     stage_config "$c"
     if [[ $c == default ]]; then
+      if [[ ${ODO_RULES:-1} == 1 ]]; then stage_rules; fi
       if [[ ${ODO_SOAK:-1} == 1 ]]; then stage_soak; fi
       if [[ ${ODO_KERNEL:-1} == 1 ]]; then stage_kernel; fi
     fi
