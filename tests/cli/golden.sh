@@ -199,13 +199,20 @@ if [ "$mode" = record ]; then
   echo "golden: recorded $(ls "$golden" | wc -l) files into $golden"
   exit 0
 fi
+# The status of each comparison is taken before the message is built: a command substitution in
+# check's first argument would otherwise set the $? that its second argument reads (every
+# comparison then counted as passed, whatever it found: the case until stop 36).
 for f in "$golden"/*; do
   b=$(basename "$f")
   cmp -s "$f" "$got/$b"
-  check "$b identical$( [ -e "$got/$b" ] && diff "$f" "$got/$b" | head -6 | sed 's/^/\n  /' | tr -d '\r')" $?
+  rc=$?
+  check "$b identical$( [ -e "$got/$b" ] && diff "$f" "$got/$b" | head -6 | sed 's/^/\n  /' | tr -d '\r')" $rc
 done
 for f in "$got"/*; do
-  [ -e "$golden/$(basename "$f")" ]; check "$(basename "$f") has a golden file" $?
+  b=$(basename "$f")
+  [ -e "$golden/$b" ]
+  rc=$?
+  check "$b has a golden file" $rc
 done
 echo "golden cli: $pass passed, $fail failed"
 [ "$fail" = 0 ]
