@@ -50,6 +50,10 @@ void PoseIntegrator::step_arc(double ds, double dth) noexcept {
   integrate(d_l, d_r, 0.5 * (d_l + d_r), (d_r - d_l) / k_.wheelbase(), dt);
 }
 
+[[gnu::flatten]] void Odometry::update_travel(double d_l, double d_r, double dt) noexcept {
+  integrate(d_l, d_r, 0.5 * (d_l + d_r), (d_r - d_l) / k_.wheelbase(), dt);
+}
+
 void Odometry::update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
                             double ds_correction) noexcept {
   const double d_l = static_cast<double>(dn_left) * k_.metres_per_count_left();
@@ -57,10 +61,10 @@ void Odometry::update_fused(std::int64_t dn_left, std::int64_t dn_right, double 
   integrate(d_l, d_r, 0.5 * (d_l + d_r) + ds_correction, dtheta, dt);
 }
 
-void Odometry::advance_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
-                             double ds_correction, bool gyro_heading, double var_heading) noexcept {
+void Odometry::advance_fused(double d_l, double d_r, double dt, double dtheta, double ds_correction,
+                             bool gyro_heading, double var_heading) noexcept {
   const double s0 = sin_theta(), c0 = cos_theta();
-  update_fused(dn_left, dn_right, dt, dtheta, ds_correction);
+  integrate(d_l, d_r, 0.5 * (d_l + d_r) + ds_correction, dtheta, dt);
   if (gyro_heading) {
     cov_.step_gyro_sc(s0, c0, d_left_, d_right_, dtheta, var_heading);
   } else {

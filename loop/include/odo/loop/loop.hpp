@@ -186,8 +186,9 @@ class OdometryLoop {
   void record_wakeup(TimeNs latency) noexcept;
   // fill_snapshot: this tick's snapshot in the back slot (every field that changes).
   LoopSnapshot& fill_snapshot(const EncoderSample& s, TimeNs woke) noexcept;
-  // fill_gyro_status: the gyro and fusion part of the snapshot.
-  void fill_gyro_status(LoopGyroStatus& g) const noexcept;
+  // fill_gyro_status: the gyro and fusion part of the snapshot (its status, the motion's gyro
+  // fields).
+  void fill_gyro_status(LoopSnapshot& snap) const noexcept;
   // record_compute: the tick's compute time from `woke` to `done` [ns] into the statistics.
   void record_compute(LoopSnapshot& snap, TimeNs latency, TimeNs woke, TimeNs done) noexcept;
   // schedule_next: the next deadline; after an overrun the missed periods are skipped.
@@ -211,7 +212,8 @@ class OdometryLoop {
   // read into it directly (a 64-byte GyroSample copied once a tick, not twice).
   FusionInput fused_in_;
   std::uint32_t last_fusion_flags_ = 0;
-  TickMotion motion_;  // the last integrated tick's (fill_snapshot copies it)
+  double last_dt_ = 0.0;           // [s] interval of the last integrated tick (TickMotion::dt)
+  double last_var_heading_ = 0.0;  // [rad^2] its fused heading increment's variance
   std::array<TickObserver*, kMaxObservers> observers_{};
   std::size_t n_observers_ = 0;
 
