@@ -40,8 +40,15 @@ void run_replay(const ReplayOpts& o, int& exit_code) {
     exit_code = kExitBadInput;
     return;
   }
-  analysis::ReplayGyro gyro;  // the loop's default fusion parameters (README "Gyro")
+  auto fusion = fusion_params(o.kin);  // odometryd's [gyro] with --config, else the defaults
+  if (!fusion) {
+    std::cerr << "odomctl replay: " << fusion.error().message << "\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  analysis::ReplayGyro gyro;
   gyro.use = !o.no_gyro;
+  gyro.params = *fusion;
   auto r = analysis::replay_ticks(in, o.ticks, *k, o.kin.bits, gyro);
   if (!r) {
     std::cerr << "odomctl replay: " << r.error().message << "\n";

@@ -1,22 +1,52 @@
 // The kinematics options shared by the log commands (replay, calib fit-fixes): written once so
 // that both take the same names, defaults and checks.
 #include "commands.hpp"
+#include "odo/firmware/calibration_store.hpp"
+#include "odo/firmware/config.hpp"
 
 namespace odo::ctl {
 
 void add_kinematics_options(CLI::App& c, KinematicsOpts& k, const KinematicsHelp& help) {
-  c.add_option("--wheel-diameter", k.wheel_diameter, "nominal wheel diameter Dn [m]")->required();
-  c.add_option("--counts-per-rev", k.counts_per_rev,
-               "encoder counts per motor revolution after quadrature (Ce)")
-      ->required();
-  c.add_option("--gear-ratio", k.gear_ratio, "motor revolutions per wheel revolution (n)");
-  c.add_option("--wheelbase", k.wheelbase, help.wheelbase)->required();
-  c.add_option("--cl", k.cl, help.cl);
-  c.add_option("--cr", k.cr, help.cr);
+  CLI::Option* config = c.add_option(
+      "--config", k.config,
+      "odometryd's config file: its [robot] (with the calibration store it names), "
+      "[error_model] and [gyro], as odometryd runs them; instead of the geometry options");
+  // Without --config the geometry is required: checked in make_kinematics, since CLI11's
+  // required() cannot depend on another option.
+  CLI::Option* geometry[] = {
+      c.add_option("--wheel-diameter", k.wheel_diameter, "nominal wheel diameter Dn [m]"),
+      c.add_option("--counts-per-rev", k.counts_per_rev,
+                   "encoder counts per motor revolution after quadrature (Ce)"),
+      c.add_option("--gear-ratio", k.gear_ratio, "motor revolutions per wheel revolution (n)"),
+      c.add_option("--wheelbase", k.wheelbase, help.wheelbase),
+      c.add_option("--cl", k.cl, help.cl),
+      c.add_option("--cr", k.cr, help.cr)};
+  for (CLI::Option* o : geometry) o->excludes(config);
   c.add_option("--counter-bits", k.bits, "counter width in bits, 16..64 (default 64)");
 }
 
+namespace {
+
+// config_kinematics: the kinematics odometryd runs with under `path`: [robot] with the stored
+// calibration applied (a missing or blank store: the nominal values, as odometryd).
+Result<Kinematics> config_kinematics(const std::string& path) {
+  auto cfg = fw::load_config(path);
+  if (!cfg) return std::move(cfg).error();
+  const fw::AppliedCalibration a =
+      fw::read_and_apply(cfg->robot, cfg->calibration.store, cfg->calibration.backend);
+  return Kinematics::create(a.params);
+}
+
+}  // namespace
+
 Result<Kinematics> make_kinematics(const KinematicsOpts& k) {
+  if (!k.config.empty()) return config_kinematics(k.config);
+  for (auto [name, v] : {std::pair{"--wheel-diameter", k.wheel_diameter},
+                         {"--counts-per-rev", k.counts_per_rev},
+                         {"--wheelbase", k.wheelbase}})
+    if (v == 0.0)
+      return make_error(Errc::kInvalidArgument,
+                        std::string(name) + " is required (or --config FILE: odometryd's config)");
   KinematicParams p;
   p.wheel_diameter = k.wheel_diameter;
   p.counts_per_rev = k.counts_per_rev;
@@ -26,6 +56,15 @@ Result<Kinematics> make_kinematics(const KinematicsOpts& k) {
   p.c_l = k.cl;
   p.c_r = k.cr;
   return Kinematics::create(p);
+}
+
+Result<GyrodometryParams> fusion_params(const KinematicsOpts& k) {
+  if (k.config.empty()) return GyrodometryParams{};
+  auto cfg = fw::load_config(k.config);
+  if (!cfg) return std::move(cfg).error();
+  GyrodometryParams p = fw::gyrodometry_params(*cfg);
+  p.odometry_noise = cfg->error_model;
+  return p;
 }
 
 }  // namespace odo::ctl

@@ -16,6 +16,7 @@
 #include "odo/hal/nv_storage.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/error_model.hpp"
+#include "odo/odometry/gyrodometry.hpp"
 #include "odo/odometry/kinematics.hpp"
 
 namespace odo::ros2 {
@@ -363,6 +364,10 @@ Config default_config();
 
 // parse_config: parses TOML text; `source` names it in messages. Unknown keys are errors.
 Result<Config> parse_config(std::string_view text, std::string_view source);
+
+// gyrodometry_params: the fusion's parameters from [gyro]; keys left unset take the simulated
+// model's figures (simulated_gyro) or the consumer-class defaults (GyroNoiseModel).
+GyrodometryParams gyrodometry_params(const Config& cfg);
 
 // load_config: reads and parses a file.
 Result<Config> load_config(const std::string& path);
