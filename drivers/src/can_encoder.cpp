@@ -76,8 +76,8 @@ Result<CanEncoderSource> CanEncoderSource::create(CanBus& bus, const CanEncoderC
   if (cfg.timeout <= 0) return bad("timeout must be > 0 s");
   if (!(cfg.max_counts_per_s > 0.0 && cfg.max_counts_per_s <= 1e9))
     return bad("max_counts_per_s must be in (0, 1e9] counts/s");
-  if (cfg.max_frames_per_read < 1 || cfg.max_frames_per_read > 4096)
-    return bad("max_frames_per_read must be in [1, 4096]");
+  if (auto s = check_row(kCanMaxFramesPerRead, "", cfg.max_frames_per_read); !s)
+    return std::move(s).error();
   if (cfg.request_period < 0) return bad("request_period must be >= 0 s");
   return CanEncoderSource(bus, cfg);
 }

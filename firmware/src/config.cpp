@@ -5,6 +5,9 @@
 #include <cstring>
 #include <sstream>
 
+#include "odo/drivers/can_encoder.hpp"
+#include "odo/drivers/gpio_quadrature.hpp"
+#include "odo/drivers/hctl1100_encoder.hpp"
 #include "odo/firmware/toml_reader.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
@@ -97,8 +100,8 @@ void read_hctl1100(TableReader t, Hctl1100Section& s) {
   s.control_active_low = t.boolean("control_active_low", s.control_active_low);
   s.settle = t.number("settle", s.settle, 0.0, 0.1, "s");
   s.max_speed = t.number("max_speed", s.max_speed, 0.01, 100.0, "m/s");
-  s.agree_window = static_cast<int>(t.integer("agree_window", s.agree_window, 0, 64));
-  s.max_attempts = static_cast<int>(t.integer("max_attempts", s.max_attempts, 2, 16));
+  s.agree_window = static_cast<int>(t.integer(s.agree_window, drivers::kHctlAgreeWindow));
+  s.max_attempts = static_cast<int>(t.integer(s.max_attempts, drivers::kHctlMaxAttempts));
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
   s.reverse_right = t.boolean("reverse_right", s.reverse_right);
   s.latch = t.choice("latch", s.latch);
@@ -117,7 +120,7 @@ void read_gpio(TableReader t, GpioSection& s) {
   s.active_low = t.boolean("active_low", s.active_low);
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
   s.reverse_right = t.boolean("reverse_right", s.reverse_right);
-  s.batch = static_cast<int>(t.integer("batch", s.batch, 1, 1024));
+  s.batch = static_cast<int>(t.integer(s.batch, drivers::kGpioBatch));
   s.reorder_window = t.number("reorder_window", s.reorder_window, 0.0, 0.1, "s");
   s.idle_check = t.number("idle_check", s.idle_check, 0.01, 10.0, "s");
   t.finish();
@@ -135,7 +138,7 @@ void read_can_encoder(TableReader t, CanEncoderSection& s) {
   s.max_speed = t.number("max_speed", s.max_speed, 0.01, 100.0, "m/s");
   s.request_rate = t.number("request_rate", s.request_rate, 0.0, 1000.0, "Hz");
   s.max_frames_per_read =
-      static_cast<int>(t.integer("max_frames_per_read", s.max_frames_per_read, 1, 4096));
+      static_cast<int>(t.integer(s.max_frames_per_read, drivers::kCanMaxFramesPerRead));
   s.extended = t.boolean("extended", s.extended);
   const std::int64_t max_id = s.extended ? 0x1FFFFFFF : 0x7FF;
   s.left_id = t.integer("left_id", s.left_id, 0, max_id);
@@ -323,7 +326,7 @@ void read_can_gyro(TableReader t, CanGyroSection& s) {
   s.scale = t.number("scale", s.scale, 1e-9, 1.0, "rad/s per LSB");
   s.rate_offset = t.number("rate_offset", s.rate_offset, -1000.0, 1000.0, "rad/s");
   s.max_frames_per_read =
-      static_cast<int>(t.integer("max_frames_per_read", s.max_frames_per_read, 1, 4096));
+      static_cast<int>(t.integer(s.max_frames_per_read, drivers::kCanMaxFramesPerRead));
   s.sim_stop_after = t.number("sim_stop_after", s.sim_stop_after, -1.0, 1e6, "s");
   t.finish();
 }

@@ -67,6 +67,10 @@ CanDecode decode_count(const CanFrame& f, const CanCountLayout& layout, std::int
 // check_layout: configure-time validation of a layout; the message names the field.
 Status check_layout(const CanCountLayout& layout);
 
+// The range of max_frames_per_read of the CAN sources (encoder counts, gyro), checked by their
+// create() and by the config reader ([can_encoder], [can_gyro]).
+inline constexpr RangeRow kCanMaxFramesPerRead{"max_frames_per_read", 1, 4096, "frames"};
+
 struct CanEncoderConfig {
   CanCountLayout left;
   CanCountLayout right;

@@ -28,6 +28,11 @@ class TableReader {
   double number(double def, const RangeRow& row);
   // integer: an integer in [lo, hi].
   std::int64_t integer(std::string_view key, std::int64_t def, std::int64_t lo, std::int64_t hi);
+  // integer: the whole number at row.key, within the row's (whole) limits.
+  std::int64_t integer(std::int64_t def, const RangeRow& row) {
+    return integer(row.key, def, static_cast<std::int64_t>(row.lo),
+                   static_cast<std::int64_t>(row.hi));
+  }
   bool boolean(std::string_view key, bool def);
   std::string string(std::string_view key, std::string def);
   // strings: an array of strings (may be empty).
