@@ -212,6 +212,8 @@ ResumeDecision decide_resume(const StateRecord& rec, const ResumeContext& ctx,
   const double max_l = ctx.max_wheel_speed * gap_s / ctx.metres_per_count_left + 1.0;
   const double max_r = ctx.max_wheel_speed * gap_s / ctx.metres_per_count_right + 1.0;
   const double half_range = std::ldexp(1.0, ctx.counter_bits - 1);
+  d.max_dl = max_l;
+  d.max_dr = max_r;
   if (max_l >= half_range || max_r >= half_range) return fresh(ResumeReason::kStale);
   if (std::fabs(static_cast<double>(d.dl)) > max_l || std::fabs(static_cast<double>(d.dr)) > max_r)
     return fresh(ResumeReason::kCounterJump);
