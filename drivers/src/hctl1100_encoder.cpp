@@ -108,6 +108,8 @@ EncoderSample Hctl1100Encoder::read(TimeNs now) noexcept {
   }
   s.left = out[0];
   s.right = out[1];
+  s.left_rejected = wheel_[0].offset;  // the chip holds out + offset (24-bit wrap)
+  s.right_rejected = wheel_[1].offset;
   s.counters = counters_;
   return s;
 }

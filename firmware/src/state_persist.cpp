@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include <iomanip>
 #include <span>
 #include <sstream>
+#include <utility>
 
 #include "odo/calibration/record.hpp"
 #include "odo/hal/crc.hpp"
@@ -172,11 +174,28 @@ bool counters_survive_restart(const Config& cfg) {
 
 // ---- StatePersister ----
 
+namespace {
+
+// make_state_directory: creates the state file's directory when it is missing (one level: run by
+// hand there is no systemd to make /run/odometryd), with the mode systemd's RuntimeDirectory=
+// gives it, 0755 whatever the umask; true if it was made.
+bool make_state_directory(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos || slash == 0) return false;
+  const std::string dir = path.substr(0, slash);
+  if (::mkdir(dir.c_str(), 0755) != 0) return false;
+  return ::chmod(dir.c_str(), 0755) == 0;
+}
+
+}  // namespace
+
 Result<std::unique_ptr<StatePersister>> StatePersister::create(const std::string& path,
                                                                double rate_hz, double loop_hz,
                                                                const loop::OdometryLoop& loop,
                                                                const loop::StateRecord& identity) {
-  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0 && errno == ENOENT && make_state_directory(path))
+    fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd < 0) return io_error("cannot open the state file", path);
   // Both slots exist from the start; the older record in them stays readable until replaced.
   struct stat st {};
@@ -253,6 +272,27 @@ void StatePersister::write_newest() noexcept {
   }
 }
 
+namespace {
+
+// counter_jump_text: appends to the `n` bytes in `line` which wheel jumped and how far, against
+// the most it could move in the gap (issue 39); returns the new length.
+int counter_jump_text(const loop::ResumeDecision& d, char* line, std::size_t size, int n) {
+  const std::array<std::pair<const char*, std::int64_t>, 2> wheels{
+      {{"left", d.dl}, {"right", d.dr}}};
+  const std::array<double, 2> bound{d.max_dl, d.max_dr};
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (std::fabs(static_cast<double>(wheels[i].second)) <= bound[i]) continue;
+    n = std::clamp(n, 0, static_cast<int>(size) - 1);
+    n += std::snprintf(line + n, size - static_cast<std::size_t>(n),
+                       ": %s wheel %+lld counts in the %.3f s gap, at most %.0f at max_speed",
+                       wheels[i].first, static_cast<long long>(wheels[i].second), to_seconds(d.gap),
+                       std::floor(bound[i]));
+  }
+  return n;
+}
+
+}  // namespace
+
 void StatePersister::run(std::ostream& log, std::optional<loop::ResumeReason> fixed,
                          const std::string& note) {
   bool told = false;
@@ -286,6 +326,7 @@ void StatePersister::run(std::ostream& log, std::optional<loop::ResumeReason> fi
         const std::string_view name = loop::resume_reason_name(why);
         n = std::snprintf(line, sizeof line, "odometryd: resume: fresh start (%.*s)%s",
                           static_cast<int>(name.size()), name.data(), note.c_str());
+        if (why == loop::ResumeReason::kCounterJump) n = counter_jump_text(d, line, sizeof line, n);
         // A fresh pose may still come with the gyro's calibration (same chip, same boot): told
         // when it does; why the pose did not resume is the reason already.
         tell_gyro = !fixed && d.gyro_restored;

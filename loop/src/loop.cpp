@@ -73,6 +73,8 @@ void OdometryLoop::start() noexcept {
   if (gyro_ != nullptr) fused_in_.gyro = gyro_->read(clock_->now());
   prev_left_ = s.left;
   prev_right_ = s.right;
+  prev_rejected_left_ = s.left_rejected;
+  prev_rejected_right_ = s.right_rejected;
   prev_stamp_ = s.stamp;
   unreferenced_ = s.flags & (kEncoderStaleLeft | kEncoderStaleRight);
   // Loop time starts once the reference counts are latched, however long that read took; the
@@ -187,6 +189,8 @@ TimeNs OdometryLoop::wait_for_deadline() noexcept {
   }
   prev_left_ = s.left;
   prev_right_ = s.right;
+  prev_rejected_left_ = s.left_rejected;
+  prev_rejected_right_ = s.right_rejected;
   prev_stamp_ = s.stamp;
 }
 

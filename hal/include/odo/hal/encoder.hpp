@@ -34,6 +34,11 @@ struct EncoderSample {
   TimeNs stamp = 0;         // when the counts were latched [ns, clock of the loop]
   std::uint32_t flags = 0;  // EncoderFlag bits for this sample
   EncoderCounters counters;
+  // Counts of implausible jumps this backend rejected since it started (wrap rule): the counter
+  // itself holds left + left_rejected. The loop integrates left/right; the state record keeps
+  // the counter's own value, so a restart sees only the motion made while nobody listened.
+  std::int64_t left_rejected = 0;
+  std::int64_t right_rejected = 0;
 };
 
 class EncoderSource {

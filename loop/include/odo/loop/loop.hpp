@@ -21,6 +21,7 @@
 #include "odo/loop/latency_histogram.hpp"
 #include "odo/loop/state_record.hpp"
 #include "odo/loop/triple_buffer.hpp"
+#include "odo/odometry/count_delta.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/gyrodometry.hpp"
 #include "odo/odometry/kinematics.hpp"
@@ -135,6 +136,14 @@ class OdometryLoop {
   std::int64_t last_left() const noexcept { return prev_left_; }
   std::int64_t last_right() const noexcept { return prev_right_; }
   TimeNs last_stamp() const noexcept { return prev_stamp_; }
+  // The counters' own values at the last integrated sample (last_left/right plus the counts of
+  // the jumps the backend rejected, wrap rule): what a restarted process will read.
+  std::int64_t last_counter_left() const noexcept {
+    return counter_value(prev_left_, prev_rejected_left_, bits_);
+  }
+  std::int64_t last_counter_right() const noexcept {
+    return counter_value(prev_right_, prev_rejected_right_, bits_);
+  }
   int counter_bits() const noexcept { return bits_; }
   calib::StoreStatus calibration() const noexcept { return calibration_; }
   // tick: runs one period of the loop (sleeps until the deadline first).
@@ -221,6 +230,8 @@ class OdometryLoop {
   TimeNs deadline_ = 0;
   std::int64_t prev_left_ = 0;
   std::int64_t prev_right_ = 0;
+  std::int64_t prev_rejected_left_ = 0;  // the last integrated sample's left/right_rejected
+  std::int64_t prev_rejected_right_ = 0;
   // Stale flags of wheels that have not had a fresh reading since start(): their reference
   // count is taken from their first fresh reading, not integrated from the stale one.
   std::uint32_t unreferenced_ = 0;

@@ -126,6 +126,10 @@ struct ResumeDecision {
   TimeNs gap = 0;       // sample time of `current` minus the record's [ns]
   std::int64_t dl = 0;  // counts of each wheel during the gap (wrap rule)
   std::int64_t dr = 0;
+  // The most counts each wheel could make in the gap (set from the plausibility check on;
+  // with dl/dr they say which wheel jumped and how far on kCounterJump) [counts].
+  double max_dl = 0.0;
+  double max_dr = 0.0;
   Pose2 pose;  // on kResumed: the pose the loop starts from (the record's plus the gap's step)
   // The record's gyro calibration belongs to this loop's gyro (same nonzero id, same boot and
   // clock, within max_age): set whether or not the pose resumes (the bias is the chip's, not
