@@ -46,7 +46,9 @@ int open_raw(const std::string& path, speed_t code) noexcept {
   t.c_cflag |= CLOCAL | CREAD;
   t.c_cflag &= ~static_cast<tcflag_t>(CSTOPB | CRTSCTS);
   t.c_iflag &= ~static_cast<tcflag_t>(IXON | IXOFF | IXANY);
-  t.c_cc[VMIN] = 0;
+  // VMIN 1 with O_NONBLOCK: no data is EAGAIN, so that a read of 0 means hang-up only (with
+  // VMIN 0 a read returns 0 whenever nothing is there, indistinguishable from an unplugged board).
+  t.c_cc[VMIN] = 1;
   t.c_cc[VTIME] = 0;
   ::cfsetispeed(&t, code);
   ::cfsetospeed(&t, code);
