@@ -26,7 +26,7 @@ void SerialPeerModel::reset(TimeNs t, std::int64_t left, std::int64_t right) noe
   base_right_ = right;
   boot_ = t;
   seq_ = 0;
-  booted_records_ = 10;
+  booted_records_ = 100;
   pending_reads_ = pending_resets_ = 0;
   cmd_len_ = 0;
 }

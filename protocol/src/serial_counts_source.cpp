@@ -120,6 +120,11 @@ void SerialCountsSource::on_record(const SerialCounts& c, TimeNs now,
     clock_.reset();
     controller_ns_ = 0;
     have_record_ = false;  // no gap to count against the old sequence
+  } else if (!primed_ && (c.flags & kSerialFlagBooted) != 0) {
+    // The first record says the controller has just booted: its counts began at 0 since this
+    // process last saw them, so a state record of before cannot be continued (resume decision).
+    ++counters_.controller_resets;
+    flags |= kEncoderControllerReset;
   }
   if (have_record_) {
     const auto expected = static_cast<std::uint16_t>(last_seq_ + 1);

@@ -23,12 +23,15 @@ start_wait = 3.0
 [calibration]
 store = "$tmp/cal.bin"
 backend = "file"
+[resume]
+path = "$tmp/state.bin"
 TOML
 }
 
 one_protocol() {  # one_protocol PROTOCOL
   local p=$1
   config "$p" "$tmp/board"
+  rm -f "$tmp/state.bin"
   "$SERIAL_PEER" --link "$tmp/board" --protocol "$p" --duration 9.5 --log "$tmp/$p.csv" \
     --garbage-at 2.0 --unplug-at 3.5 --unplug-for 0.5 --garbage-at 5.5 --reset-at 6.5 \
     --move-until 8.0 2>"$tmp/peer-$p.err" &
@@ -62,6 +65,24 @@ PY
 one_protocol diffodom
 one_protocol arduino-bridge
 cat "$tmp"/peer-*.err >&2
+
+# Resume across a restart of odometryd while the board keeps counting (and moving), then a
+# restart right after the controller rebooted: a fresh start with reason controller-reset.
+config diffodom "$tmp/board"
+rm -f "$tmp/state.bin"
+"$SERIAL_PEER" --link "$tmp/board" --protocol diffodom --duration 9 --reset-at 6.0 \
+  --step-every 0.05 --start-after 0 2>/dev/null &
+peer=$!
+poll 5 test -e "$tmp/board"
+run "$ODOMETRYD" --config "$tmp/serial.toml" --duration 2 --json --quiet >"$tmp/r1.json" 2>/dev/null
+run "$ODOMETRYD" --config "$tmp/serial.toml" --duration 2 --json --quiet >"$tmp/r2.json" 2>"$tmp/r2.err"
+[ "$(jget "$tmp/r2.json" resume.reason)" = resumed ]
+check "restart while the board counts: resumed ($(grep 'resume:' "$tmp/r2.err"))" $?
+sleep 2.3  # past the controller's reboot at 6.0 s, within its 1 s of booted records
+run "$ODOMETRYD" --config "$tmp/serial.toml" --duration 1 --json --quiet >"$tmp/r3.json" 2>"$tmp/r3.err"
+[ "$(jget "$tmp/r3.json" resume.reason)" = controller-reset ]
+check "restart after a controller reset: fresh start, controller-reset ($(grep 'resume:' "$tmp/r3.err"))" $?
+wait "$peer"
 
 # A board that never answers: odometryd runs, the wheels are stale, nothing moves.
 config arduino-bridge "$tmp/board"

@@ -114,6 +114,19 @@ TEST(SerialSourceStream, CountsAndFaults) {
   EXPECT_EQ(s.counters.stale_events, 1u);
 }
 
+TEST(SerialSourceStream, FirstRecordOfABootedControllerIsAReset) {
+  // odometryd (re)starts right after the controller booted: the first sample says so, for the
+  // resume decision (controller-reset: a fresh start, never the old record's counts continued).
+  FakeLink link;
+  SerialCountsSource src(link, stream_config());
+  link.send(rec(0, 1000, 2, 3, kSerialFlagBooted));
+  const EncoderSample s = src.read(10 * kMs);
+  EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kEncoderControllerReset));
+  EXPECT_EQ(s.counters.controller_resets, 1u);
+  EXPECT_EQ(s.left, 2);
+  EXPECT_EQ(s.right, 3);
+}
+
 TEST(SerialSourceStream, UnplugReopenAndWrongBaud) {
   FakeLink link;
   SerialSourceConfig c = stream_config();

@@ -40,9 +40,11 @@ class SerialPeerModel {
   std::int64_t base_right_ = 0;
   TimeNs boot_ = 0;  // clock of the last reset
   std::uint16_t seq_ = 0;
-  int booted_records_ = 10;  // records still to carry the booted flag
-  int pending_reads_ = 0;    // "e" commands received, not answered
-  int pending_resets_ = 0;   // "r" commands received, not done
+  // Records still to carry the booted flag (100 after reset(): 1 s at 100 Hz); 0 at first: the
+  // model starts as a controller that has been running for a while.
+  int booted_records_ = 0;
+  int pending_reads_ = 0;   // "e" commands received, not answered
+  int pending_resets_ = 0;  // "r" commands received, not done
   std::array<char, 16> cmd_{};
   std::size_t cmd_len_ = 0;
 };
