@@ -188,7 +188,7 @@ class SerialSimBackend final : public EncoderBackend, public EncoderSource, publ
     return source_.read(now);
   }
   int counter_bits() const noexcept override { return source_.counter_bits(); }
-  int read(std::span<std::uint8_t> out) noexcept override {
+  int read(std::span<std::uint8_t> out, TimeNs& /*arrival: the read's*/) noexcept override {
     std::size_t n = 0;
     for (; n < out.size() && tail_ != head_; ++n, ++tail_) out[n] = ring_[tail_ % ring_.size()];
     return static_cast<int>(n);
@@ -258,7 +258,7 @@ protocol::SerialSourceConfig serial_source_config(const SerialSection& s,
 Result<std::unique_ptr<EncoderBackend>> make_serial_tty_backend(const Config& cfg,
                                                                 const Kinematics& k) {
   const SerialSection& s = cfg.serial;
-  auto port = drivers::SerialPort::open(s.device, s.baud);
+  auto port = drivers::SerialPort::open(s.device, s.baud, from_seconds(s.reopen_period));
   if (!port) {
     Error e = std::move(port).error();
     e.message = s.device_where + " " + e.message;

@@ -106,7 +106,7 @@ void SerialCountsSource::accept(std::int64_t left, std::int64_t right, TimeNs st
   ++valid_since_open_;
 }
 
-void SerialCountsSource::on_record(const SerialCounts& c, TimeNs now,
+void SerialCountsSource::on_record(const SerialCounts& c, TimeNs now, TimeNs arrival,
                                    std::uint32_t& flags) noexcept {
   const auto back = static_cast<std::int32_t>(c.time_us - last_time_us_);
   const bool booted_now =
@@ -139,11 +139,11 @@ void SerialCountsSource::on_record(const SerialCounts& c, TimeNs now,
   last_seq_ = c.seq;
   last_time_us_ = c.time_us;
   last_flags_ = c.flags;
-  accept(c.left, c.right, clock_.map(controller_ns_, now), flags);
+  accept(c.left, c.right, clock_.map(controller_ns_, arrival), flags);
   last_valid_ = now;
 }
 
-void SerialCountsSource::on_byte_diffodom(std::uint8_t b, TimeNs now,
+void SerialCountsSource::on_byte_diffodom(std::uint8_t b, TimeNs now, TimeNs arrival,
                                           std::uint32_t& flags) noexcept {
   const SerialDecodeResult r = decoder_.push(b);
   if (r == SerialDecodeResult::kNeedMore) return;
@@ -151,12 +151,12 @@ void SerialCountsSource::on_byte_diffodom(std::uint8_t b, TimeNs now,
   const bool first = !synced_;
   synced_ = true;
   if (r == SerialDecodeResult::kFrame)
-    on_record(decoder_.counts(), now, flags);
+    on_record(decoder_.counts(), now, arrival, flags);
   else if (!first)
     link_error(r == SerialDecodeResult::kCrcMismatch, flags);
 }
 
-void SerialCountsSource::on_line(TimeNs now, std::uint32_t& flags) noexcept {
+void SerialCountsSource::on_line(TimeNs now, TimeNs arrival, std::uint32_t& flags) noexcept {
   const char* p = line_.data();
   const char* end = p + line_len_;
   if (end > p && end[-1] == '\r') --end;
@@ -169,8 +169,8 @@ void SerialCountsSource::on_line(TimeNs now, std::uint32_t& flags) noexcept {
     link_error(false, flags);
     return;
   }
-  // The counts were latched between the request and the read that saw the answer.
-  const TimeNs stamp = awaiting_ ? request_time_ + (now - request_time_) / 2 : now;
+  // The counts were latched between the request and the answer's arrival.
+  const TimeNs stamp = awaiting_ ? request_time_ + (arrival - request_time_) / 2 : arrival;
   awaiting_ = false;
   if (primed_ && l == 0 && r == 0 && (wheel_[0].last_raw != 0 || wheel_[1].last_raw != 0)) {
     // Both counters back at exactly 0: the board restarted (reset, or re-opened: an Arduino
@@ -183,14 +183,15 @@ void SerialCountsSource::on_line(TimeNs now, std::uint32_t& flags) noexcept {
   last_valid_ = now;
 }
 
-void SerialCountsSource::on_byte_bridge(std::uint8_t b, TimeNs now, std::uint32_t& flags) noexcept {
+void SerialCountsSource::on_byte_bridge(std::uint8_t b, TimeNs now, TimeNs arrival,
+                                        std::uint32_t& flags) noexcept {
   if (b == '\n') {
     const bool first = !synced_;
     synced_ = true;
     if (line_overrun_)
       link_error(false, flags);
     else if (!first || awaiting_)  // an unasked first line may have been joined halfway
-      on_line(now, flags);
+      on_line(now, arrival, flags);
     line_len_ = 0;
     line_overrun_ = false;
     return;
@@ -203,8 +204,9 @@ void SerialCountsSource::on_byte_bridge(std::uint8_t b, TimeNs now, std::uint32_
 
 void SerialCountsSource::drain(TimeNs now, std::uint32_t& flags) noexcept {
   // Bounded: a babbling line cannot hold the loop (the rest is read next tick).
-  for (int k = 0; k < 8; ++k) {
-    const int n = link_->read(rx_);
+  for (int k = 0; k < 64; ++k) {
+    TimeNs arrival = now;  // links that do not stamp their input: the read's time
+    const int n = link_->read(rx_, arrival);
     if (n < 0) {
       link_gone(now, flags);
       return;
@@ -215,9 +217,9 @@ void SerialCountsSource::drain(TimeNs now, std::uint32_t& flags) noexcept {
     for (int i = 0; i < n; ++i) {
       const std::uint8_t b = rx_[static_cast<std::size_t>(i)];
       if (cfg_.protocol == SerialProtocol::kDiffodom)
-        on_byte_diffodom(b, now, flags);
+        on_byte_diffodom(b, now, arrival, flags);
       else
-        on_byte_bridge(b, now, flags);
+        on_byte_bridge(b, now, arrival, flags);
     }
   }
 }

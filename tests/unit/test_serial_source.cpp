@@ -21,7 +21,7 @@ struct FakeLink final : ByteLink {
   bool gone = false;
   bool can_reopen = true;
   int reopens = 0;
-  int read(std::span<std::uint8_t> out) noexcept override {
+  int read(std::span<std::uint8_t> out, TimeNs& /*arrival*/) noexcept override {
     if (gone) return -1;
     std::size_t n = 0;
     for (; n < out.size() && !in.empty(); ++n) {

@@ -9,14 +9,16 @@
 //   the read that saw the answer.
 //
 // read(now) runs on the loop thread: non-blocking link reads into a fixed buffer (no
-// allocation); a vanished link (a USB board unplugged, a pty closed) is re-opened every
-// reopen_period (by path: a /dev/serial/by-id link finds the board under its new name). Counts are
-// the controller's own counters (after `reverse`, each wheel unwrapped from its width into a 64-bit
-// count starting at the first reading), so they continue across restarts of odometryd. Faults are
-// counted in EncoderCounters and flagged per sample: link errors (CRC, framing, garbage lines),
-// sequence gaps, controller resets (booted flag, clock going back, or arduino-bridge counts both
-// returning to exactly 0: the counts are re-based, the motion since the boot kept: a jump, not a
-// spin), reconnects, stale (no valid sample within the timeout, a board that never answers), and
+// allocation), each chunk with its arrival time when the link stamps them (SerialPort's reader
+// thread does: the sample times are then the bytes' arrival, not the tick that reads them); a
+// vanished link (a USB board unplugged, a pty closed) is re-opened every reopen_period (by path: a
+// /dev/serial/by-id link finds the board under its new name). Counts are the controller's own
+// counters (after `reverse`, each wheel unwrapped from its width into a 64-bit count starting at
+// the first reading), so they continue across restarts of odometryd. Faults are counted in
+// EncoderCounters and flagged per sample: link errors (CRC, framing, garbage lines), sequence gaps,
+// controller resets (booted flag, clock going back, or arduino-bridge counts both returning to
+// exactly 0: the counts are re-based, the motion since the boot kept: a jump, not a spin),
+// reconnects, stale (no valid sample within the timeout, a board that never answers), and
 // kEncoderNoValidData while bytes arrive but none is valid (the typical sign of a wrong baud rate).
 #pragma once
 
@@ -79,10 +81,11 @@ class SerialCountsSource final : public EncoderSource {
   void link_gone(TimeNs now, std::uint32_t& flags) noexcept;
   void try_reopen(TimeNs now, std::uint32_t& flags) noexcept;
   void drain(TimeNs now, std::uint32_t& flags) noexcept;
-  void on_byte_diffodom(std::uint8_t b, TimeNs now, std::uint32_t& flags) noexcept;
-  void on_byte_bridge(std::uint8_t b, TimeNs now, std::uint32_t& flags) noexcept;
-  void on_line(TimeNs now, std::uint32_t& flags) noexcept;
-  void on_record(const protocol::SerialCounts& c, TimeNs now, std::uint32_t& flags) noexcept;
+  // now: the loop's read time; arrival: when the bytes arrived (the link's stamp, else now).
+  void on_byte_diffodom(std::uint8_t b, TimeNs now, TimeNs arrival, std::uint32_t& flags) noexcept;
+  void on_byte_bridge(std::uint8_t b, TimeNs now, TimeNs arrival, std::uint32_t& flags) noexcept;
+  void on_line(TimeNs now, TimeNs arrival, std::uint32_t& flags) noexcept;
+  void on_record(const SerialCounts& c, TimeNs now, TimeNs arrival, std::uint32_t& flags) noexcept;
   void accept(std::int64_t left, std::int64_t right, TimeNs stamp, std::uint32_t& flags) noexcept;
   void link_error(bool crc, std::uint32_t& flags) noexcept;
   void poll(TimeNs now) noexcept;
