@@ -51,7 +51,15 @@ print(p, {k: d[k] for k in ("x", "y", "theta_cumulative", "link_errors", "sequen
       "controller_resets", "reconnects", "read_errors", "implausible_jumps", "stale_events")},
       "replay", {k: r[k] for k in ("x", "y", "theta", "samples")})
 assert r["distance"] > 0.05, r  # the robot did move (about 30 steps of ~2 mm)
-assert (d["x"], d["y"], d["theta_cumulative"]) == (r["x"], r["y"], r["theta"]), (d, r)
+# Each tick integrates one record or none, like the replay row by row: equal to the bit. A tick
+# that came late (a loaded machine: missed deadlines) integrates the records of its wait in one
+# step, which on a curve differs from the replay's steps in the last bits: then within 1e-9.
+got, want = (d["x"], d["y"], d["theta_cumulative"]), (r["x"], r["y"], r["theta"])
+if d["missed_deadlines"] == 0:
+    assert got == want, (d, r)
+else:
+    assert all(abs(a - b) < 1e-9 for a, b in zip(got, want)), (d, r)
+    print("(late ticks:", d["missed_deadlines"], "- compared within 1e-9)")
 assert d["reconnects"] >= 1 and d["read_errors"] >= 1, d
 assert d["link_errors"] >= 1, d
 assert d["controller_resets"] == 1, d
