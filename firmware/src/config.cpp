@@ -8,6 +8,7 @@
 #include "odo/drivers/can_encoder.hpp"
 #include "odo/drivers/gpio_quadrature.hpp"
 #include "odo/drivers/hctl1100_encoder.hpp"
+#include "odo/drivers/serial_port.hpp"
 #include "odo/firmware/toml_reader.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
@@ -163,6 +164,29 @@ void read_can_encoder(TableReader t, CanEncoderSection& s) {
   s.sim_period = t.number("sim_period", s.sim_period, 0.001, 1.0, "s");
   s.sim_stop_left_after = t.number("sim_stop_left_after", s.sim_stop_left_after, -1.0, 1e6, "s");
   s.sim_stop_right_after = t.number("sim_stop_right_after", s.sim_stop_right_after, -1.0, 1e6, "s");
+  t.finish();
+}
+
+void read_serial(TableReader t, SerialSection& s) {
+  s.link = t.choice("link", s.link);
+  s.device = t.string("device", s.device);
+  s.device_where = t.location("device");
+  s.protocol = t.choice("protocol", s.protocol);
+  s.baud = static_cast<int>(t.integer("baud", s.baud, 1, 4000000));
+  if (!drivers::supported_baud(s.baud))
+    t.reject("baud", "= " + std::to_string(s.baud) + " is not a supported baud rate (" +
+                         drivers::baud_list() + ")");
+  s.bits_left = static_cast<int>(t.integer("bits_left", s.bits_left, 8, 32));
+  s.bits_right = static_cast<int>(t.integer("bits_right", s.bits_right, 8, 32));
+  s.reverse_left = t.boolean("reverse_left", s.reverse_left);
+  s.reverse_right = t.boolean("reverse_right", s.reverse_right);
+  s.timeout = t.number("timeout", s.timeout, 0.005, 10.0, "s");
+  s.reopen_period = t.number("reopen_period", s.reopen_period, 0.01, 60.0, "s");
+  s.poll_rate = t.number("poll_rate", s.poll_rate, 1.0, 1000.0, "Hz");
+  s.max_speed = t.number("max_speed", s.max_speed, 0.01, 100.0, "m/s");
+  s.clock_window = t.number("clock_window", s.clock_window, 0.05, 60.0, "s");
+  s.start_wait = t.number("start_wait", s.start_wait, 0.0, 30.0, "s");
+  s.sim_period = t.number("sim_period", s.sim_period, 0.001, 1.0, "s");
   t.finish();
 }
 
@@ -399,6 +423,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_hctl1100(root.sub("hctl1100"), c.hctl1100);
   read_gpio(root.sub("gpio"), c.gpio);
   read_can_encoder(root.sub("can_encoder"), c.can_encoder);
+  read_serial(root.sub("serial"), c.serial);
   read_error_model(root.sub("error_model"), c.error_model);
   read_can(root.sub("can"), c.can, c.loop.rate_hz);
   ros2::Config ros2_cfg;
@@ -418,7 +443,8 @@ bool simulated_robot(const Config& cfg) {
   const EncoderKind be = cfg.encoder.backend;
   return be == EncoderKind::kSim ||
          (be == EncoderKind::kHctl1100 && cfg.hctl1100.bus == HctlBus::kSim) ||
-         (be == EncoderKind::kCan && cfg.can_encoder.bus == CanEncoderBus::kSim);
+         (be == EncoderKind::kCan && cfg.can_encoder.bus == CanEncoderBus::kSim) ||
+         (be == EncoderKind::kSerial && cfg.serial.link == SerialLink::kSim);
 }
 
 bool simulated_gyro(const Config& cfg) {

@@ -120,6 +120,7 @@ Result<std::unique_ptr<EncoderBackend>> hardware_backend(const Config& cfg, cons
                           std::string(name_of(be)) + "\")");
   return be == EncoderKind::kGpio       ? make_gpio_backend(cfg)
          : be == EncoderKind::kHctl1100 ? make_hctl_gpio_backend(cfg, k)
+         : be == EncoderKind::kSerial   ? make_serial_tty_backend(cfg, k)
                                         : make_can_socketcan_backend(cfg, k);
 }
 
@@ -181,9 +182,11 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
   if (modelled) {
     const TimeNs epoch = virtual_time ? 0 : impl->clock->now();
     impl->sim_epoch = epoch;
-    auto b = cfg.encoder.backend == EncoderKind::kHctl1100
+    const EncoderKind be = cfg.encoder.backend;
+    auto b = be == EncoderKind::kHctl1100
                  ? make_hctl_sim_backend(cfg, k, *impl->robot, *impl->clock, epoch)
-                 : make_can_sim_backend(cfg, k, *impl->robot, epoch);
+             : be == EncoderKind::kSerial ? make_serial_sim_backend(cfg, k, *impl->robot, epoch)
+                                          : make_can_sim_backend(cfg, k, *impl->robot, epoch);
     if (!b) return std::move(b).error();
     impl->backend = std::move(b).value();
     impl->encoder = &impl->backend->encoder();

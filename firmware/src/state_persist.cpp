@@ -46,6 +46,7 @@ std::uint8_t backend_id(const Config& cfg) {
     id |= static_cast<std::uint8_t>(cfg.hctl1100.bus);
   if (cfg.encoder.backend == EncoderKind::kCan)
     id |= static_cast<std::uint8_t>(cfg.can_encoder.bus);
+  if (cfg.encoder.backend == EncoderKind::kSerial) id |= static_cast<std::uint8_t>(cfg.serial.link);
   return id;
 }
 
@@ -165,6 +166,9 @@ bool counters_survive_restart(const Config& cfg) {
     case EncoderKind::kCan:
       // The driver reports the controllers' own counters (drivers/can_encoder.hpp).
       return cfg.can_encoder.bus == CanEncoderBus::kSocketCan;
+    case EncoderKind::kSerial:
+      // The microcontroller's own counters (protocol/serial_counts_source.hpp).
+      return cfg.serial.link == SerialLink::kTty;
     case EncoderKind::kGpio:  // decoded by this process: edges are lost while it is down
     case EncoderKind::kSim:   // restarts with the process
       return false;
@@ -371,8 +375,9 @@ ResumeWiring prepare_resume(const Config& cfg, loop::OdometryLoop& loop,
     c.metres_per_count_right = k.metres_per_count_right();
     c.wheelbase = k.wheelbase();
     c.gyro_id = identity.gyro_id;
-    c.max_wheel_speed = cfg.encoder.backend == EncoderKind::kCan ? cfg.can_encoder.max_speed
-                                                                 : cfg.hctl1100.max_speed;
+    c.max_wheel_speed = cfg.encoder.backend == EncoderKind::kCan      ? cfg.can_encoder.max_speed
+                        : cfg.encoder.backend == EncoderKind::kSerial ? cfg.serial.max_speed
+                                                                      : cfg.hctl1100.max_speed;
     loop.resume_from(*rec, c);
     w.offered = true;
   } else if (!rec) {

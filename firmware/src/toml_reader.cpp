@@ -26,6 +26,12 @@ void TableReader::fail(const toml::node* n, std::string_view key, const std::str
   *error_ = o.str();
 }
 
+std::string TableReader::location(std::string_view key) const {
+  const toml::node* n = table_ != nullptr ? table_->get(key) : nullptr;
+  return where(n != nullptr ? n : table_) + ": " + path_ + (path_.empty() ? "" : ".") +
+         std::string(key);
+}
+
 void TableReader::reject(std::string_view key, const std::string& what) {
   fail(table_ != nullptr ? table_->get(key) : nullptr, key, what);
 }

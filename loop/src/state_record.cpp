@@ -199,6 +199,9 @@ ResumeDecision decide_resume(const StateRecord& rec, const ResumeContext& ctx,
     return fresh(ResumeReason::kOtherKinematics);
   if (rec.calibration_sequence != ctx.calibration_sequence)
     return fresh(ResumeReason::kOtherCalibration);
+  // The controller's counts restarted at its boot: whatever they read, they are not the
+  // record's counts continued.
+  if ((current.flags & kEncoderControllerReset) != 0) return fresh(ResumeReason::kControllerReset);
   if ((current.flags & (kEncoderReadError | kEncoderStaleLeft | kEncoderStaleRight)) != 0)
     return fresh(ResumeReason::kEncoderNotReady);
   // The record holds the counters' own values: compared with the counters' own values now (the

@@ -377,9 +377,15 @@ TEST(ResumeDecision, EveryFreshStartReason) {
                 },
                 reading(r, 20, 88, 11.0)),
             ResumeReason::kStale);
+  // A serial controller that says it rebooted (diffodom booted flag): fresh, even though its
+  // counts lie within the gap's bound (they restarted from 0 near the record's counts).
+  EncoderSample rebooted = ok;
+  rebooted.flags = kEncoderControllerReset;
+  EXPECT_EQ(reason(none, rebooted), ResumeReason::kControllerReset);
   EXPECT_EQ(resume_reason_name(ResumeReason::kCounterJump), "counter-jump");
+  EXPECT_EQ(resume_reason_name(ResumeReason::kControllerReset), "controller-reset");
   EXPECT_EQ(std::size(kResumeReasonNames),
-            static_cast<std::size_t>(ResumeReason::kCounterJump) + 1);
+            static_cast<std::size_t>(ResumeReason::kControllerReset) + 1);
 }
 
 }  // namespace

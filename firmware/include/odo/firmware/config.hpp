@@ -30,7 +30,10 @@ namespace odo::fw {
 template <class E>
 using Choice = odo::Choice<E>;  // hal/choice.hpp; the name as written in the file
 
-enum class EncoderKind : std::uint8_t { kSim, kHctl1100, kGpio, kCan };
+enum class EncoderKind : std::uint8_t { kSim, kHctl1100, kGpio, kCan, kSerial };
+// [serial] protocol (the backend maps it onto protocol::SerialProtocol, same order).
+enum class SerialProtocol : std::uint8_t { kDiffodom, kArduinoBridge };
+enum class SerialLink : std::uint8_t { kTty, kSim };
 enum class SimRobotKind : std::uint8_t { kLabmate, kNominal };
 enum class SimScenario : std::uint8_t { kSquareCcw, kSquareCw, kSquares, kIdle };
 enum class HctlBus : std::uint8_t { kGpio, kSim };
@@ -47,7 +50,8 @@ enum class GyroModelKind : std::uint8_t { kConsumer, kIndustrial };
 inline constexpr Choice<EncoderKind> kEncoderKinds[] = {{EncoderKind::kSim, "sim"},
                                                         {EncoderKind::kHctl1100, "hctl1100"},
                                                         {EncoderKind::kGpio, "gpio"},
-                                                        {EncoderKind::kCan, "can"}};
+                                                        {EncoderKind::kCan, "can"},
+                                                        {EncoderKind::kSerial, "serial"}};
 inline constexpr Choice<SimRobotKind> kSimRobotKinds[] = {{SimRobotKind::kLabmate, "labmate"},
                                                           {SimRobotKind::kNominal, "nominal"}};
 inline constexpr Choice<SimScenario> kSimScenarios[] = {{SimScenario::kSquareCcw, "square-ccw"},
@@ -61,6 +65,10 @@ inline constexpr Choice<CanEncoderBus> kCanEncoderBuses[] = {
     {CanEncoderBus::kSocketCan, "socketcan"}, {CanEncoderBus::kSim, "sim"}};
 inline constexpr Choice<CanEncoderProtocol> kCanEncoderProtocols[] = {
     {CanEncoderProtocol::kOdrive, "odrive"}, {CanEncoderProtocol::kGeneric, "generic"}};
+inline constexpr Choice<SerialProtocol> kSerialProtocols[] = {
+    {SerialProtocol::kDiffodom, "diffodom"}, {SerialProtocol::kArduinoBridge, "arduino-bridge"}};
+inline constexpr Choice<SerialLink> kSerialLinks[] = {{SerialLink::kTty, "tty"},
+                                                      {SerialLink::kSim, "sim"}};
 inline constexpr Choice<ByteOrder> kByteOrders[] = {{ByteOrder::kLittle, "little"},
                                                     {ByteOrder::kBig, "big"}};
 inline constexpr Choice<CanBusKind> kCanBusKinds[] = {
@@ -85,6 +93,8 @@ inline constexpr std::tuple kChoiceTables{
     std::span<const Choice<HctlLatch>>(kHctlLatches),
     std::span<const Choice<CanEncoderBus>>(kCanEncoderBuses),
     std::span<const Choice<CanEncoderProtocol>>(kCanEncoderProtocols),
+    std::span<const Choice<SerialProtocol>>(kSerialProtocols),
+    std::span<const Choice<SerialLink>>(kSerialLinks),
     std::span<const Choice<ByteOrder>>(kByteOrders),
     std::span<const Choice<NvBackend>>(kNvBackends),
     std::span<const Choice<CanBusKind>>(kCanBusKinds),
@@ -208,6 +218,29 @@ struct CanEncoderSection {
   double sim_period = 0.01;           // [s] cyclic message period of the simulated controllers
   double sim_stop_left_after = -1.0;  // [s] the left axis stops sending after this; < 0 never
   double sim_stop_right_after = -1.0;
+};
+
+// [serial]: counts from a microcontroller on a serial line (README "Serial counts"; issue 37).
+// link = "tty": the device; link = "sim": the simulated robot behind a simulated peer speaking
+// the protocol (in-process bytes, through the same source).
+struct SerialSection {
+  SerialLink link = SerialLink::kTty;
+  std::string device = "/dev/ttyACM0";  // a tty; /dev/serial/by-id/... links are followed
+  std::string device_where;             // "file:line: serial.device", for errors at open
+  int baud = 115200;                    // one of drivers::kSerialBaudRates
+  SerialProtocol protocol = SerialProtocol::kDiffodom;
+  int bits_left = 32;  // [bits] 8..32: the controller's counter width per wheel
+  int bits_right = 32;
+  bool reverse_left = false;  // negate the wheel's count
+  bool reverse_right = false;
+  double timeout = 0.1;        // [s] no valid sample for this long: stale
+  double reopen_period = 0.5;  // [s] between attempts to reopen a vanished device
+  double poll_rate = 100.0;    // [Hz] arduino-bridge: "e" requests per second
+  double max_speed = 3.0;      // [m/s] physical maximum wheel surface speed (jump check)
+  double clock_window = 1.0;   // [s] diffodom: window of the clock mapping's minimum
+  double start_wait = 2.5;     // [s] the first sample may take this long (an Arduino reboots)
+  // link = "sim" only
+  double sim_period = 0.01;  // [s] sample period of the simulated controller
 };
 
 struct EncoderSection {
@@ -348,6 +381,7 @@ struct Config {
   Hctl1100Section hctl1100;
   GpioSection gpio;
   CanEncoderSection can_encoder;
+  SerialSection serial;
   ErrorModelParams error_model;  // [error_model]: Chong-Kleeman k_L, k_R [m^(1/2)]
   CanSection can;
   // [ros2]: the ROS 2 output over DDS (README "ROS 2"), off unless enabled = true; null when

@@ -47,6 +47,9 @@ class TableReader {
   }
   // reject: reports a problem found across settings at the line of `key` (or of the table).
   void reject(std::string_view key, const std::string& what);
+  // location: "file:line: path.key" of `key` (the table's line when the key is absent), for
+  // errors found later, when the value is used (a serial device that is not there).
+  std::string location(std::string_view key) const;
   // sub: a nested table (may be absent).
   TableReader sub(std::string_view key);
   // finish: reports the first key of this table that no getter asked for.

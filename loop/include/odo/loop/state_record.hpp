@@ -92,13 +92,14 @@ enum class ResumeReason : std::uint8_t {
   kNotContinuous,     // this backend's counts are lost while nobody listens (GPIO)
   kEncoderNotReady,   // the first reading is stale or failed
   kCounterJump,       // a counter went backwards (or forwards) beyond the wrap rule
+  kControllerReset,   // the counting controller says it rebooted since (serial: booted flag)
 };
 
 inline constexpr std::string_view kResumeReasonNames[] = {
-    "resumed",           "disabled",      "no-record",      "corrupt",
-    "other-boot",        "other-clock",   "stale",          "other-kinematics",
-    "other-calibration", "other-backend", "not-continuous", "encoder-not-ready",
-    "counter-jump"};
+    "resumed",           "disabled",        "no-record",      "corrupt",
+    "other-boot",        "other-clock",     "stale",          "other-kinematics",
+    "other-calibration", "other-backend",   "not-continuous", "encoder-not-ready",
+    "counter-jump",      "controller-reset"};
 
 // resume_reason_name: how logs, --json and odomctl spell `r`.
 std::string_view resume_reason_name(ResumeReason r) noexcept;
