@@ -2,6 +2,7 @@
 
 #include <ctime>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -187,7 +188,8 @@ Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
   if (flags & kFlagEmaxBefore) r.e_max_before = v[5];
   if (flags & kFlagEmaxAfter) r.e_max_after = v[6];
   const auto* m = reinterpret_cast<const char*>(bytes.data() + 88);
-  r.method.assign(m, strnlen(m, kMethodBytes - 1));
+  // std::find, not POSIX strnlen (not declared by a bare-metal C library in strict C++20).
+  r.method.assign(m, std::find(m, m + (kMethodBytes - 1), '\0'));
   if (flags & kFlagFit) {
     auto f = decode_fit(bytes, version, length);
     if (!f) return std::move(f).error();
