@@ -6,7 +6,8 @@
 #               faults in virtual time (ODO_SOAK=0 skips it)
 #   mcu         (after default) the microcontroller firmware: preset mcu-stm32f405 built, then
 #               tests/mcu/test_mcu_qemu.sh in qemu-system-arm (ODO_MCU=0 skips it; under CI a
-#               missing toolchain or QEMU fails it)
+#               missing toolchain or QEMU fails it); the kernel tier's kernel_mcu_slcan uses its
+#               image
 #   kernel      the `kernel` tier of the default build, inside a QEMU VM with Debian's kernel
 #               (tools/vm-run.sh: vcan, gpio-sim, mtdram, at24); if the VM cannot start, the stage
 #               fails under CI; elsewhere those tests run on the host, where each one reports
@@ -278,8 +279,9 @@ main() {
     stage_config "$c"
     if [[ $c == default ]]; then
       if [[ ${ODO_SOAK:-1} == 1 ]]; then stage_soak; fi
-      if [[ ${ODO_KERNEL:-1} == 1 ]]; then stage_kernel; fi
+      # mcu before kernel: the kernel tier's kernel_mcu_slcan runs the image stage mcu builds.
       if [[ ${ODO_MCU:-1} == 1 ]]; then stage_mcu; fi  # needs the default tree's odometryd
+      if [[ ${ODO_KERNEL:-1} == 1 ]]; then stage_kernel; fi
     fi
     # The ASan tree's kernel tier (the drivers' parsing of what the kernel hands them), but for
     # the three tests that SIGKILL a program over and over (100 kills during motion, the store's
