@@ -4,12 +4,14 @@
 // encoder mode (a real board). Options (QEMU, through semihosting's command line):
 //   --duration S  run S seconds of loop time (default: the scenario plus 1 s, as odometryd
 //                 --virtual-time; 0 = forever)   --fault  end in a bus fault after start-up
+//   --serial-hz H the serial counts stream's rate on USART2 [Hz], loop rate / whole number, 0 off
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <optional>
 
 #include "odo/board/board_config.hpp"
+#include "odo/board/serial_stream.hpp"
 #include "odo/board/slcan_link.hpp"
 #include "odo/board/stm32f4.hpp"
 #include "odo/board/system.hpp"
@@ -29,6 +31,7 @@ namespace {
 struct Options {
   double duration = -1.0;  // [s]; < 0: the scenario's own
   bool fault = false;
+  double serial_hz = -1.0;  // [Hz] serial counts stream on USART2; < 0: BoardConfig's
 };
 
 // parse_options: the semihosting command line's words after the program name.
@@ -40,6 +43,9 @@ Options parse_options() noexcept {
     if (std::strcmp(w, "--fault") == 0) o.fault = true;
     if (std::strcmp(w, "--duration") == 0) {
       if (char* v = std::strtok(nullptr, " ")) o.duration = std::strtod(v, nullptr);
+    }
+    if (std::strcmp(w, "--serial-hz") == 0) {
+      if (char* v = std::strtok(nullptr, " ")) o.serial_hz = std::strtod(v, nullptr);
     }
   }
   return o;
@@ -89,7 +95,8 @@ EncoderWiring make_encoders(const BoardConfig& cfg, const Kinematics& k) noexcep
 }
 
 // report_end: the run's figures as a '#'-line (tests and benchmarks read it).
-void report_end(const loop::OdometryLoop& lp, const PoseBroadcaster& bc) noexcept {
+void report_end(const loop::OdometryLoop& lp, const PoseBroadcaster& bc,
+                const SerialStream& st) noexcept {
   const loop::LoopStats& s = lp.stats();
   Line l;
   l.add("# end ticks=").num(static_cast<std::int64_t>(s.ticks));
@@ -98,6 +105,7 @@ void report_end(const loop::OdometryLoop& lp, const PoseBroadcaster& bc) noexcep
   l.add(" wakeup_max_ns=").num(s.wakeup_latency_max);
   l.add(" frames=").num(bc.sent()).add(" dropped=").num(bc.dropped());
   l.add(" set_pose=").num(bc.set_pose_applied());
+  l.add(" serial_records=").num(st.sent());
   l.add(" allocations=").num(heap_allocations());
   say(l);
 }
@@ -141,6 +149,12 @@ int main() {
   bo.status_div = static_cast<std::uint32_t>(protocol::divisor_for(cfg.rate_hz, cfg.status_hz));
   static PoseBroadcaster bc(bo, bus, lp->commands());
   lp->add_observer(&bc);
+  uart2().init(ci.apb1_hz, cfg.baud, kIrqUsart2);
+  const double serial_hz = opt.serial_hz >= 0.0 ? opt.serial_hz : cfg.serial_hz;
+  const std::int64_t serial_div = protocol::divisor_for(cfg.rate_hz, serial_hz);
+  if (serial_div < 0) fail("--serial-hz: not the loop rate divided by a whole number");
+  static SerialStream stream(*lp, uart2(), static_cast<std::uint32_t>(serial_div));
+  lp->add_observer(&stream);
   clock.configure(lp->period(), ci.tim_hz);
   latched.latch(0);  // the reference reading: time 0, where the clock stands until the first sleep
   clock.set_latch(&latched);
@@ -154,7 +168,7 @@ int main() {
   const std::atomic<bool> stop{false};
   lp->run(from_seconds(duration), stop);
   bc.send_final(lp->snapshot());
-  report_end(*lp, bc);
+  report_end(*lp, bc, stream);
   uart1().flush();
   semihost_exit(0);
 }

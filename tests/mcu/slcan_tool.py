@@ -74,3 +74,50 @@ if __name__ == "__main__":
         candump(sys.argv[2], sys.argv[3])
     elif sys.argv[1] == "setpose":
         sys.exit(setpose(sys.argv[2], *map(float, sys.argv[3:6])))
+
+
+def crc16_ccitt_false(data):
+    crc = 0xFFFF
+    for b in data:
+        crc ^= b << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1021) if crc & 0x8000 else crc << 1
+            crc &= 0xFFFF
+    return crc
+
+
+def cobs_decode(block):
+    out, i = bytearray(), 0
+    while i < len(block):
+        code = block[i]
+        if code == 0 or i + code > len(block) + (0 if code > 1 else 0):
+            raise ValueError("bad COBS")
+        out += block[i + 1:i + code]
+        i += code
+        if code < 0xFF and i < len(block):
+            out.append(0)
+    return bytes(out)
+
+
+def serial_records(path):
+    """The serial counts records (issue 37's wire format, written from its spec, not its code):
+    COBS frames ending in 0x00; u8 version, u8 flags, u16 seq, u32 time_us, i32 left, i32 right
+    little-endian, then CRC-16/CCITT-FALSE of those bytes, little-endian."""
+    import struct
+    recs = []
+    for block in open(path, "rb").read().split(b"\0")[:-1]:
+        rec = cobs_decode(block)
+        body, crc = rec[:-2], struct.unpack("<H", rec[-2:])[0]
+        if crc != crc16_ccitt_false(body):
+            raise ValueError(f"CRC mismatch in record {len(recs)}")
+        recs.append(struct.unpack("<BBHIii", body[:16]))
+    return recs
+
+
+if __name__ == "__main__" and sys.argv[1] == "serial":
+    # serial FILE: prints "records first_flags other_flags seq_ok time_ok last_left last_right"
+    r = serial_records(sys.argv[2])
+    seq_ok = all(r[i][2] == (r[0][2] + i) & 0xFFFF for i in range(len(r)))
+    dt = {r[i + 1][3] - r[i][3] for i in range(len(r) - 1)}
+    print(len(r), r[0][1], max((x[1] for x in r[1:]), default=0), int(seq_ok), sorted(dt),
+          r[-1][0], r[-1][4], r[-1][5])

@@ -7,6 +7,7 @@
 #     frames (converted to candump -L).
 #  2. Set-pose over SLCAN: decoded with protocol/, posted to the loop; the next pose frames start
 #     from it and the status frame acknowledges it.
+#     USART2 carries the serial counts stream (issue 37) at 100 Hz, checked record by record.
 #  3. A bus fault: the fault handler reports the registers on USART1 and QEMU exits with 3.
 # usage: test_mcu_qemu.sh SOURCE_DIR MCU_ELF   (env ODOMETRYD, ODOMCTL)
 set -u
@@ -20,7 +21,7 @@ qemu() {  # qemu OUT ARGS...: the firmware with USART1 into OUT; its exit code
   local args=arg=odo
   for a in "$@"; do args="$args,arg=$a"; done
   timeout 300 qemu-system-arm -M netduinoplus2 -display none -monitor none \
-    -serial "file:$out" -kernel "$elf" -icount shift=0,sleep=off \
+    -serial "file:$out" -serial "file:$out.usart2" -kernel "$elf" -icount shift=0,sleep=off \
     -semihosting-config "enable=on,target=native,$args"
 }
 
@@ -47,6 +48,13 @@ check "odomctl decode reads the firmware's frames" $?
 [ "$(tail -1 "$tmp/mcu.log" | sed 's/.* //')" = "$(tail -1 "$tmp/host.log" | sed 's/.* //')" ] ||
   "$ODOMCTL" decode --csv "$tmp/mcu.log" | grep -q 'Status,stopping,1'
 check "stopping status frame" $?
+
+# USART2: the serial counts stream (issue 37's format, decoded from its spec by slcan_tool.py):
+# one record a tick at the default 100 Hz, the first flagged 'booted', seq +1 and time +10 ms.
+read -r n f0 fmax seq_ok dts ver _ <<<"$(python3 "$tool" serial "$tmp/usart1.txt.usart2")"
+ticks=$(sed -E 's/.* ticks=([0-9]+) .*/\1/' "$tmp/end")
+[ "$n" = "$ticks" ] && [ "$f0" = 4 ] && [ "$fmax" = 0 ] && [ "$seq_ok" = 1 ] && [ "$dts" = "[10000]" ] && [ "$ver" = 1 ]
+check "serial counts on USART2: $n records of $ticks ticks, CRC and COBS valid, seq and 10 ms steps" $?
 
 # 2. Set-pose (10 m, 20 m, 1 rad) after 100 pose frames.
 python3 "$tool" setpose "$elf" 10 20 1 >"$tmp/after.log" 2>"$tmp/after.err"

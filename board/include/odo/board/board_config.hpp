@@ -22,9 +22,10 @@ struct BoardConfig {
   // [can]
   std::uint32_t base_id = protocol::kDefaultBaseId;
   int node_id = protocol::kDefaultNodeId;
-  double pose_hz = 50.0;                // [Hz] PoseX + PoseYTheta
-  double status_hz = 10.0;              // [Hz] Status
-  std::uint32_t baud = 115200;          // USART1 (SLCAN) [bit/s]
+  double pose_hz = 50.0;        // [Hz] PoseX + PoseYTheta
+  double status_hz = 10.0;      // [Hz] Status
+  std::uint32_t baud = 115200;  // USART1 (SLCAN) and USART2 (serial counts) [bit/s]
+  double serial_hz = 100.0;  // [Hz] serial counts records on USART2 (0: off; 576/s max at 115200)
   std::uint32_t iwdg_timeout_ms = 100;  // watchdog: no tick for this long resets the chip
 };
 
