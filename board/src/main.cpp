@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "odo/board/board_config.hpp"
+#include "odo/board/pins.hpp"
 #include "odo/board/serial_stream.hpp"
 #include "odo/board/slcan_link.hpp"
 #include "odo/board/stm32f4.hpp"
@@ -118,6 +119,7 @@ int main() {
   using namespace odo::board;
   static const BoardConfig cfg;
   const ClockInfo ci = clock_init();
+  pins_init();
   uart1().init(ci.apb2_hz, cfg.baud, kIrqUsart1);
   const Options opt = parse_options();
   Line banner;

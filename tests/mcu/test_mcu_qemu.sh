@@ -31,7 +31,8 @@ check "firmware exits 0 after the square" $?
 tr '\r' '\n' <"$tmp/usart1.txt" | grep '^# end' >"$tmp/end"
 check "firmware's final report" $?
 grep -q ' missed=0 ' "$tmp/end" && grep -q ' dropped=0 ' "$tmp/end"
-check "no missed deadline, no dropped frame: $(cat "$tmp/end")" $?
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "no missed deadline, no dropped frame: $(cat "$tmp/end")" $rc
 "$ODOMETRYD" --virtual-time --can-log "$tmp/host.log" >/dev/null 2>"$tmp/host.err"
 check "odometryd --virtual-time exit 0" $?
 python3 "$tool" candump "$tmp/usart1.txt" "$tmp/mcu.log"
@@ -39,9 +40,11 @@ pose() { grep -E ' (410|411)#' "$1" | sed 's/.* //'; }
 pose "$tmp/host.log" >"$tmp/host.pose"
 pose "$tmp/mcu.log" >"$tmp/mcu.pose"
 [ -s "$tmp/host.pose" ] && cmp -s "$tmp/host.pose" "$tmp/mcu.pose"
-check "all $(wc -l <"$tmp/host.pose") pose frames bit-identical to odometryd's" $?
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "all $(wc -l <"$tmp/host.pose") pose frames bit-identical to odometryd's" $rc
 [ "$(tail -2 "$tmp/host.pose")" = "$(tail -2 "$tmp/mcu.pose")" ]
-check "final broadcast pose identical: $(tail -2 "$tmp/mcu.pose" | tr '\n' ' ')" $?
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "final broadcast pose identical: $(tail -2 "$tmp/mcu.pose" | tr '\n' ' ')" $rc
 "$ODOMCTL" decode "$tmp/mcu.log" >"$tmp/decoded" 2>&1 && grep -q ' PoseYTheta .*theta=' "$tmp/decoded"
 check "odomctl decode reads the firmware's frames" $?
 # The stopping status (last frame): its stopping flag set, as odometryd's.
@@ -84,7 +87,8 @@ qemu "$tmp/fault.txt" --fault
 [ $? = 3 ]
 check "bus fault: exit code 3" $?
 tr '\r' '\n' <"$tmp/fault.txt" | grep -E '^# FAULT exc=0x00000003 .* pc=0x0800[0-9A-F]{4} .*cfsr=0x0000..00 hfsr=0x40000000' >/dev/null
-check "fault handler prints the registers ($(tr '\r' '\n' <"$tmp/fault.txt" | grep FAULT | cut -c1-60)...)" $?
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "fault handler prints the registers ($(tr '\r' '\n' <"$tmp/fault.txt" | grep FAULT | cut -c1-60)...)" $rc
 
 echo "test_mcu_qemu: $pass passed, $fail failed"
 [ "$fail" = 0 ]
