@@ -11,14 +11,15 @@
 #include <optional>
 
 #include "odo/board/board_config.hpp"
+#include "odo/board/mmio_bus.hpp"
 #include "odo/board/pins.hpp"
 #include "odo/board/serial_stream.hpp"
 #include "odo/board/slcan_link.hpp"
+#include "odo/board/stm32_encoder_timers.hpp"
 #include "odo/board/stm32f4.hpp"
 #include "odo/board/system.hpp"
 #include "odo/board/text.hpp"
 #include "odo/board/timer_clock.hpp"
-#include "odo/board/timer_encoder.hpp"
 #include "odo/board/uart.hpp"
 #include "odo/loop/loop.hpp"
 #if ODO_BOARD_SIM
@@ -89,7 +90,8 @@ EncoderWiring make_encoders(const BoardConfig& cfg, const Kinematics& k) noexcep
 #else
   (void)cfg;
   (void)k;
-  static TimerEncoder enc;
+  static MmioBus mmio;
+  static Stm32EncoderTimers enc(mmio);
   enc.init();
   return {&enc, 0.0};
 #endif

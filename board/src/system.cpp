@@ -33,10 +33,10 @@ bool g_heap_locked = false;
 
 ClockInfo clock_init() noexcept {
   ClockInfo info;
-  reg(rcc::kApb1Enr) |= (1u << 0) | (1u << 17) | (1u << 28);  // TIM2, USART2, PWR
-  reg(rcc::kApb2Enr) |= 1u << 4;                              // USART1
-  reg(rcc::kCr) |= 1u << 16;                                  // HSEON
-  if (!wait_bit(rcc::kCr, 1u << 17, 1u << 17, 100000)) {      // HSERDY
+  reg(rcc::kApb1Enr) |= (1u << 1) | (1u << 2) | (1u << 17) | (1u << 28);  // TIM3/4, USART2, PWR
+  reg(rcc::kApb2Enr) |= 1u << 4;                                          // USART1
+  reg(rcc::kCr) |= 1u << 16;                                              // HSEON
+  if (!wait_bit(rcc::kCr, 1u << 17, 1u << 17, 100000)) {                  // HSERDY
     // No crystal, or QEMU (no RCC model): its SysTick counts at 168 MHz whatever RCC says.
     if (ODO_BOARD_QEMU) info.tim_hz = 168000000u;
     return info;
