@@ -16,11 +16,14 @@
 #include "odo/board/serial_stream.hpp"
 #include "odo/board/slcan_link.hpp"
 #include "odo/board/stm32_encoder_timers.hpp"
+#include "odo/board/stm32_flash.hpp"
 #include "odo/board/stm32f4.hpp"
 #include "odo/board/system.hpp"
 #include "odo/board/text.hpp"
 #include "odo/board/timer_clock.hpp"
 #include "odo/board/uart.hpp"
+#include "odo/calibration/record.hpp"
+#include "odo/calibration/store.hpp"
 #include "odo/loop/loop.hpp"
 #if ODO_BOARD_SIM
 #include "odo/sim/robot.hpp"
@@ -97,6 +100,45 @@ EncoderWiring make_encoders(const BoardConfig& cfg, const Kinematics& k) noexcep
 #endif
 }
 
+// StoredCalibration: the kinematics the loop runs on and the store's status.
+struct StoredCalibration {
+  KinematicParams params;
+  calib::StoreStatus status = calib::StoreStatus::kUncalibrated;
+};
+
+// load_calibration: the A/B store in flash sectors 10 and 11 (read-only at start-up: reads are
+// plain memory reads, so this works in QEMU, whose flash is the image plus -device loader
+// data); the record applied to `nominal` as odometryd applies it, nominal values otherwise.
+StoredCalibration load_calibration(const KinematicParams& nominal) noexcept {
+  static MmioBus mmio;
+  static Stm32Flash flash(mmio);
+  static FlashNvStorage nv(flash, 10, 2);
+  StoredCalibration c{nominal, calib::StoreStatus::kUncalibrated};
+  Line l;
+  l.add("# calibration (flash sectors 10-11): ");
+  auto store = calib::CalibrationStore::create(nv);
+  auto loaded = store ? store->load() : Result<calib::LoadResult>(std::move(store).error());
+  if (!loaded || loaded->status == calib::StoreStatus::kCorrupt) {
+    c.status = calib::StoreStatus::kCorrupt;
+    say(l.add("ERROR: store unreadable or corrupt; running on NOMINAL values"));
+    return c;
+  }
+  if (loaded->status != calib::StoreStatus::kOk || !loaded->record) {
+    say(l.add("uncalibrated; running on nominal values"));
+    return c;
+  }
+  auto p = calib::apply_record(nominal, *loaded->record);
+  if (!p) {
+    c.status = calib::StoreStatus::kCorrupt;
+    say(l.add("ERROR: stored values rejected; running on NOMINAL values"));
+    return c;
+  }
+  c.params = *p;
+  c.status = calib::StoreStatus::kOk;
+  say(l.add("ok, sequence ").num(static_cast<std::int64_t>(loaded->record->sequence)));
+  return c;
+}
+
 // report_end: the run's figures as a '#'-line (tests and benchmarks read it).
 void report_end(const loop::OdometryLoop& lp, const PoseBroadcaster& bc,
                 const SerialStream& st) noexcept {
@@ -136,13 +178,18 @@ int main() {
           .add(" Hz"));
   auto k = Kinematics::create(cfg.robot);
   if (!k) fail("kinematics");
+  // The robot follows the nominal kinematics (as odometryd's rig); the loop runs on the store's.
   const EncoderWiring enc = make_encoders(cfg, *k);
+  const StoredCalibration cal = load_calibration(cfg.robot);
+  auto kc = Kinematics::create(cal.params);
+  if (!kc) fail("calibrated kinematics");
   static LatchedEncoder latched(*enc.source);
   loop::LoopConfig lc;
   lc.rate_hz = cfg.rate_hz;
   lc.error_model = cfg.error_model;
+  lc.calibration = cal.status;
   TimerClock& clock = timer_clock();
-  auto created = loop::OdometryLoop::create(lc, *k, latched, clock);
+  auto created = loop::OdometryLoop::create(lc, *kc, latched, clock);
   if (!created) fail("loop configuration");
   static std::unique_ptr<loop::OdometryLoop> lp = std::move(created).value();
   static SlcanBus bus(uart1());

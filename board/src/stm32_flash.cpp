@@ -88,18 +88,16 @@ Status Stm32Flash::program(std::uint32_t addr, std::span<const std::uint32_t> wo
 }
 
 NvGeometry FlashNvStorage::geometry() const noexcept {
-  const std::size_t sector = Stm32Flash::sector_size(first_);
-  return NvGeometry{sector * static_cast<std::size_t>(count_), sector, 4};
+  return NvGeometry{kWindow * static_cast<std::size_t>(count_), kWindow, 4};
 }
 
 Status FlashNvStorage::read(std::size_t off, std::span<std::uint8_t> out) {
   if (off + out.size() > geometry().size)
     return make_error(Errc::kInvalidArgument, "flash: read past the end");
   for (std::size_t i = 0; i < out.size(); ++i) {
-    const std::size_t a = off + i;
-    const std::uint32_t w =
-        flash_->read_word(base() + static_cast<std::uint32_t>(a & ~std::size_t{3}));
-    out[i] = static_cast<std::uint8_t>(w >> (8 * (a & 3)));
+    const std::size_t o = off + i;
+    const std::uint32_t w = flash_->read_word(address(o & ~std::size_t{3}));
+    out[i] = static_cast<std::uint8_t>(w >> (8 * (o & 3)));
   }
   return Ok{};
 }
@@ -111,18 +109,17 @@ Status FlashNvStorage::write(std::size_t off, std::span<const std::uint8_t> data
     // Little-endian, as the chip reads its flash: byte k of the medium is byte k of the word.
     const std::uint32_t w = data[i] | (data[i + 1] << 8) | (data[i + 2] << 16) |
                             (static_cast<std::uint32_t>(data[i + 3]) << 24);
-    const std::uint32_t a = base() + static_cast<std::uint32_t>(off + i);
-    if (auto s = flash_->program(a, std::span<const std::uint32_t>(&w, 1)); !s) return s;
+    if (auto s = flash_->program(address(off + i), std::span<const std::uint32_t>(&w, 1)); !s)
+      return s;
   }
   return Ok{};
 }
 
 Status FlashNvStorage::erase(std::size_t off, std::size_t len) {
-  const std::size_t sector = Stm32Flash::sector_size(first_);
-  if (off % sector != 0 || len % sector != 0 || off + len > geometry().size)
-    return make_error(Errc::kInvalidArgument, "flash: erase not whole sectors inside the medium");
-  for (std::size_t s = off / sector; s < (off + len) / sector; ++s) {
-    if (auto st = flash_->erase_sector(first_ + static_cast<int>(s)); !st) return st;
+  if (off % kWindow != 0 || len % kWindow != 0 || off + len > geometry().size)
+    return make_error(Errc::kInvalidArgument, "flash: erase not whole blocks inside the medium");
+  for (std::size_t b = off / kWindow; b < (off + len) / kWindow; ++b) {
+    if (auto st = flash_->erase_sector(first_ + static_cast<int>(b)); !st) return st;
   }
   return Ok{};
 }

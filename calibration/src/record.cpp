@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "odo/hal/bytes.hpp"
+#include "odo/odometry/kinematics.hpp"
 
 namespace odo::calib {
 namespace {
@@ -196,6 +197,17 @@ Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
     r.fit = *f;
   }
   return r;
+}
+
+Result<KinematicParams> apply_record(const KinematicParams& nominal, const CalibrationRecord& r) {
+  if (auto range = validate_record(r); !range) return std::move(range).error();
+  KinematicParams p = nominal;
+  p.c_l = r.c_l;
+  p.c_r = r.c_r;
+  if (r.wheelbase) p.wheelbase = *r.wheelbase;
+  if (r.wheel_diameter) p.wheel_diameter = *r.wheel_diameter;
+  if (auto ok = Kinematics::create(p); !ok) return std::move(ok).error();
+  return p;
 }
 
 Status validate_record(const CalibrationRecord& r) {

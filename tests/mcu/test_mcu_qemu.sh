@@ -9,6 +9,8 @@
 #     from it and the status frame acknowledges it.
 #     USART2 carries the serial counts stream (issue 37) at 100 Hz, checked record by record.
 #  3. A bus fault: the fault handler reports the registers on USART1 and QEMU exits with 3.
+#  4. Calibrated from a flash image (-device loader at sector 10): equal to odometryd with the
+#     same store file; without the image the firmware runs uncalibrated.
 # usage: test_mcu_qemu.sh SOURCE_DIR MCU_ELF   (env ODOMETRYD, ODOMCTL)
 set -u
 src=$1
@@ -81,6 +83,43 @@ PY
 check "set-pose over SLCAN: next pose frames start at (10, 20), status acknowledges" $?
 grep -q ' set_pose=1 ' "$tmp/after.err"
 check "firmware counted one set-pose" $?
+
+# 4. Calibrated from flash: a store written by odomctl calib set, its slot A placed at flash
+# sector 10 (0x080C0000, -device loader; the rest of sectors 10-11 erased, 0xFF): the firmware
+# reports the record and its pose frames equal odometryd's with the same store file.
+"$ODOMCTL" calib set --store "$tmp/cal.bin" --cl 0.998 --cr 1.002 --wheelbase 0.337 >/dev/null
+check "odomctl calib set" $?
+python3 - "$tmp/cal.bin" "$tmp/calimg.bin" <<'PY'
+import sys
+d = open(sys.argv[1], "rb").read()
+n = int.from_bytes(d[6:8], "little")  # the record's length field (slot A starts the file)
+img = bytearray(b"\xff" * (2 * 128 * 1024))
+img[:n] = d[:n]
+open(sys.argv[2], "wb").write(img)
+PY
+sed "s|^store = .*|store = \"$tmp/cal.bin\"|" "$src/firmware/config/odometryd.toml" >"$tmp/cal.toml"
+"$ODOMETRYD" --config "$tmp/cal.toml" --virtual-time --can-log "$tmp/hostcal.log" >"$tmp/hostcal.err" 2>&1
+check "odometryd with the store exit 0" $?
+grep -q 'calibration.*ok, sequence 1' "$tmp/hostcal.err"
+check "odometryd runs calibrated" $?
+timeout 300 qemu-system-arm -M netduinoplus2 -display none -monitor none \
+  -serial "file:$tmp/cal.txt" -serial null -kernel "$elf" -icount shift=0,sleep=off \
+  -device "loader,file=$tmp/calimg.bin,addr=0x080C0000" \
+  -semihosting-config enable=on,target=native,arg=odo
+check "calibrated firmware exits 0" $?
+tr '\r' '\n' <"$tmp/cal.txt" | grep -q '^# calibration (flash sectors 10-11): ok, sequence 1'
+check "firmware loads the record from flash" $?
+python3 "$tool" candump "$tmp/cal.txt" "$tmp/mcucal.log"
+pose "$tmp/hostcal.log" >"$tmp/hostcal.pose"
+pose "$tmp/mcucal.log" >"$tmp/mcucal.pose"
+[ -s "$tmp/hostcal.pose" ] && cmp -s "$tmp/hostcal.pose" "$tmp/mcucal.pose" &&
+  ! cmp -s "$tmp/hostcal.pose" "$tmp/host.pose"
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "calibrated: $(wc -l <"$tmp/mcucal.pose") pose frames equal odometryd's, unlike the uncalibrated run" $rc
+"$ODOMCTL" decode --csv "$tmp/mcucal.log" | grep 'Status,calibration_state,' | tail -1 | grep -q ',1$'
+check "Status says calibrated" $?
+tr '\r' '\n' <"$tmp/usart1.txt" | grep -q '^# calibration (flash sectors 10-11): uncalibrated'
+check "without the image: uncalibrated" $?
 
 # 3. Fault report.
 qemu "$tmp/fault.txt" --fault

@@ -362,8 +362,9 @@ TEST(CalibStoreFaults, SeededRandomBitFlipsAndTornWrites) {
 
 // F4FlashMedium: the store on the microcontroller's stack: board::FlashNvStorage over the
 // register-level flash driver over sim_hal's flash-controller model, sectors 2 and 3 (16 KB each,
-// the F405's smallest). Its steps are the model's: a sector erase, a programmed word. Copyable as
-// SimNvStorage is (a copy's driver talks to the copy's model).
+// the F405's smallest; the store's slots are their first 512 bytes). Its steps are the model's: a
+// sector erase, a programmed word. Copyable as SimNvStorage is (a copy's driver talks to the copy's
+// model).
 class F4FlashMedium final : public NvStorage {
  public:
   F4FlashMedium() : model_(0x08008000, 16384, 2, 2), flash_(model_), nv_(flash_, 2, 2) {}
@@ -378,7 +379,11 @@ class F4FlashMedium final : public NvStorage {
   void cut_power_after(std::uint64_t n) noexcept { model_.cut_power_after(n); }
   void set_tear(bool on, std::uint64_t seed) noexcept { model_.set_tear(on, seed); }
   void power_on() noexcept { model_.power_on(); }
-  void flip_bit(std::size_t byte, int bit) noexcept { model_.flip_bit(byte, bit); }
+  // flip_bit: bit `bit` of the medium's byte `byte` (block i is the start of sector 2 + i).
+  void flip_bit(std::size_t byte, int bit) noexcept {
+    const std::size_t w = board::FlashNvStorage::kWindow;
+    model_.flip_bit(byte / w * 16384 + byte % w, bit);
+  }
   std::uint64_t steps() const noexcept { return model_.steps(); }
 
  private:

@@ -41,10 +41,14 @@ class Stm32Flash {
   RegisterBus* bus_;
 };
 
-// FlashNvStorage: sectors [first, first + count) of equal size as an NvStorage (erase block: a
-// sector, write unit: a word). The calibration store's A/B slots then each take a sector.
+// FlashNvStorage: sectors [first, first + count) as an NvStorage of `count` erase blocks of
+// `window` bytes each: block i is the first `window` bytes of sector first + i (erasing the
+// block erases the whole sector; the rest of the sector is never used). Write unit: a word. The
+// calibration store's A/B slots then each take a sector, and a slot is `window` bytes (the store
+// reads a slot whole: 128 KB sectors would not fit in RAM).
 class FlashNvStorage final : public NvStorage {
  public:
+  static constexpr std::size_t kWindow = 512;  // >= the largest record (148 bytes)
   FlashNvStorage(Stm32Flash& flash, int first, int count) noexcept
       : flash_(&flash), first_(first), count_(count) {}
   NvGeometry geometry() const noexcept override;
@@ -53,7 +57,11 @@ class FlashNvStorage final : public NvStorage {
   Status erase(std::size_t off, std::size_t len) override;
 
  private:
-  std::uint32_t base() const noexcept { return Stm32Flash::sector_base(first_); }
+  // address: the flash address of medium offset `off`.
+  std::uint32_t address(std::size_t off) const noexcept {
+    return Stm32Flash::sector_base(first_ + static_cast<int>(off / kWindow)) +
+           static_cast<std::uint32_t>(off % kWindow);
+  }
   Stm32Flash* flash_;
   int first_;
   int count_;
