@@ -4,6 +4,10 @@
 #   default     RelWithDebInfo: unit, sim, cli tiers and the UMBmark noise study (label study)
 #   soak        the `soak` tier of the default build: 24 h of simulated driving with random
 #               faults in virtual time (ODO_SOAK=0 skips it)
+#   mcu         (after default) the microcontroller firmware: preset mcu-stm32f405 built, then
+#               tests/mcu/test_mcu_qemu.sh in qemu-system-arm (ODO_MCU=0 skips it; under CI a
+#               missing toolchain or QEMU fails it); the kernel tier's kernel_mcu_slcan uses its
+#               image
 #   kernel      the `kernel` tier of the default build, inside a QEMU VM with Debian's kernel
 #               (tools/vm-run.sh: vcan, gpio-sim, mtdram, at24); if the VM cannot start, the stage
 #               fails under CI; elsewhere those tests run on the host, where each one reports
@@ -27,7 +31,7 @@
 #   rules       after default: tools/check_core.sh (the core rooms portable: no OS header, thread
 #               or stream, built with -fno-exceptions -fno-rtti; no function over 60 lines)
 # Environment: ODO_JOBS (parallel build jobs, default nproc), ODO_CONFIGS (space-separated
-# subset of the configurations above), ODO_RULES=0, ODO_SOAK=0, ODO_KERNEL=0, ODO_PACKAGES=0 (skip those
+# subset of the configurations above), ODO_RULES=0, ODO_SOAK=0, ODO_KERNEL=0, ODO_MCU=0, ODO_PACKAGES=0 (skip those
 # stages), ODO_FRESH_INSTALL=0 (no chroot install).
 #
 # A skip is for a developer's machine that lacks something, never for CI: with CI=true (as CI
@@ -211,6 +215,40 @@ stage_fresh_install() {  # the amd64 package on a freshly bootstrapped Debian 12
   summary+=("fresh install amd64: $r ($(($(date +%s) - t0)) s)")
 }
 
+stage_mcu() {  # the microcontroller firmware (issue 36): its preset's build, the QEMU tests
+  local t0 r=ok log=build/mcu.log line p f
+  echo "=== mcu ==="
+  t0=$(date +%s)
+  if ! command -v qemu-system-arm >/dev/null || ! command -v arm-none-eabi-g++ >/dev/null; then
+    # setup.sh --tests installs both: a machine without them cannot run the stage.
+    if in_ci; then r="FAILED under CI (qemu-system-arm or arm-none-eabi-g++ missing)"; status=1
+      n_fail=$((n_fail + 1))
+    else r="skipped (qemu-system-arm or arm-none-eabi-g++ missing)"; n_skip=$((n_skip + 1)); fi
+    summary+=("mcu: $r ($(($(date +%s) - t0)) s)")
+    return 0
+  fi
+  set +e
+  {
+    cmake --preset mcu-stm32f405 -DODO_WERROR="$(in_ci && echo ON || echo OFF)" &&
+      cmake --build --preset mcu-stm32f405 -j "$jobs" &&
+      ODOMETRYD=build/default/firmware/odometryd ODOMCTL=build/default/odomctl/odomctl \
+        tests/mcu/test_mcu_qemu.sh "$ODO_ROOT" build/mcu-stm32f405/board/odo_mcu_qemu.elf
+  } >"$log" 2>&1
+  local rc=$?
+  set -e
+  grep -E '^(FAIL|test_mcu_qemu)|odo_mcu(_qemu)?\.elf$' "$log" || true
+  line=$(grep -E '^test_mcu_qemu: [0-9]+ passed, [0-9]+ failed' "$log" | tail -1 || true)
+  if [[ -n $line ]]; then
+    p=$(sed -E 's/.*: ([0-9]+) passed.*/\1/' <<<"$line") f=$(sed -E 's/.* ([0-9]+) failed.*/\1/' <<<"$line")
+    n_pass=$((n_pass + p)) n_fail=$((n_fail + f))
+  fi
+  if [[ $rc != 0 ]]; then
+    r="FAILED (see $log)"; status=1
+    [[ -n $line ]] || n_fail=$((n_fail + 1))  # the build failed before any check ran
+  fi
+  summary+=("mcu: $r ($(($(date +%s) - t0)) s)")
+}
+
 stage_package() {  # the Debian package of one build tree
   local c=$1 t0 r log
   echo "=== package of $c ==="
@@ -259,6 +297,8 @@ main() {
     if [[ $c == default ]]; then
       if [[ ${ODO_RULES:-1} == 1 ]]; then stage_rules; fi
       if [[ ${ODO_SOAK:-1} == 1 ]]; then stage_soak; fi
+      # mcu before kernel: the kernel tier's kernel_mcu_slcan runs the image stage mcu builds.
+      if [[ ${ODO_MCU:-1} == 1 ]]; then stage_mcu; fi  # needs the default tree's odometryd
       if [[ ${ODO_KERNEL:-1} == 1 ]]; then stage_kernel; fi
     fi
     # The ASan tree's kernel tier (the drivers' parsing of what the kernel hands them), but for

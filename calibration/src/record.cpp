@@ -2,6 +2,7 @@
 
 #include <ctime>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -9,6 +10,7 @@
 
 #include "odo/hal/bytes.hpp"
 #include "odo/hal/crc.hpp"
+#include "odo/odometry/kinematics.hpp"
 
 namespace odo::calib {
 namespace {
@@ -171,13 +173,25 @@ Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
   if (flags & kFlagEmaxBefore) r.e_max_before = v[5];
   if (flags & kFlagEmaxAfter) r.e_max_after = v[6];
   const auto* m = reinterpret_cast<const char*>(bytes.data() + 88);
-  r.method.assign(m, strnlen(m, kMethodBytes - 1));
+  // std::find, not POSIX strnlen (not declared by a bare-metal C library in strict C++20).
+  r.method.assign(m, std::find(m, m + (kMethodBytes - 1), '\0'));
   if (flags & kFlagFit) {
     auto f = decode_fit(bytes, version, length);
     if (!f) return std::move(f).error();
     r.fit = *f;
   }
   return r;
+}
+
+Result<KinematicParams> apply_record(const KinematicParams& nominal, const CalibrationRecord& r) {
+  if (auto range = validate_record(r); !range) return std::move(range).error();
+  KinematicParams p = nominal;
+  p.c_l = r.c_l;
+  p.c_r = r.c_r;
+  if (r.wheelbase) p.wheelbase = *r.wheelbase;
+  if (r.wheel_diameter) p.wheel_diameter = *r.wheel_diameter;
+  if (auto ok = Kinematics::create(p); !ok) return std::move(ok).error();
+  return p;
 }
 
 Status validate_record(const CalibrationRecord& r) {

@@ -51,20 +51,15 @@ AppliedCalibration apply_calibration(const KinematicParams& nominal,
     return a;
   }
   const CalibrationRecord& r = *l.record;
-  KinematicParams p = nominal;
-  p.c_l = r.c_l;
-  p.c_r = r.c_r;
-  if (r.wheelbase) p.wheelbase = *r.wheelbase;
-  if (r.wheel_diameter) p.wheel_diameter = *r.wheel_diameter;
-  auto ok = Kinematics::create(p);
-  auto range = calib::validate_record(r);
-  if (!ok || !range) {
+  auto applied = calib::apply_record(nominal, r);
+  if (!applied) {
     a.state = StoreStatus::kCorrupt;
-    m << "ERROR: stored values rejected (" << (!range ? range.error().message : ok.error().message)
+    m << "ERROR: stored values rejected (" << applied.error().message
       << "); running on NOMINAL values";
     a.report = m.str();
     return a;
   }
+  const KinematicParams p = *applied;
   a.params = p;
   a.state = StoreStatus::kOk;
   a.sequence = r.sequence;

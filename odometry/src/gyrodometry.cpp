@@ -346,7 +346,8 @@ void Gyrodometry::update_scale(double odo, double raw_gyro, double dt) noexcept 
 inline std::uint32_t Gyrodometry::limit_flags(double abs_left, double abs_right) const noexcept {
   // Speeds per tick: one count of quantisation is m / tick (0.046 m/s for 0.23 mm at 200 Hz),
   // far below any useful limit. The travels are finite (step() checked): max is the || of the two.
-  std::uint32_t f = std::max(abs_left, abs_right) > v_max_tick_ ? kFusionSpeedLimit : 0u;
+  std::uint32_t f =
+      std::max(abs_left, abs_right) > v_max_tick_ ? kFusionSpeedLimit : std::uint32_t{0};
   if (filled_ == size_) {
     // Accelerations from the mean speeds of the two halves of the window: a count per half is
     // 2 m / T_h^2 of acceleration (0.18 m/s^2 for 0.23 mm and T_h = 0.05 s), per tick it would be
@@ -378,7 +379,7 @@ std::uint32_t Gyrodometry::disagree_flag() const noexcept {
   const double abs_err = std::fabs(sums_.err);
   const bool flag =
       sums_.bad == 0 && filled_ == size_ && abs_err > base_threshold_ && abs_err > threshold();
-  return flag ? kFusionDisagree : 0u;
+  return flag ? kFusionDisagree : std::uint32_t{0};
 }
 
 FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
