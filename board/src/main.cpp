@@ -155,6 +155,30 @@ void report_end(const loop::OdometryLoop& lp, const PoseBroadcaster& bc,
   say(l);
 }
 
+// say_banner: the start-up line: clocks and loop rate.
+void say_banner(const ClockInfo& ci, const BoardConfig& cfg) {
+  Line banner;
+  say(banner.add("# diffodom mcu: sysclk ")
+          .num(ci.sysclk_hz)
+          .add(" Hz")
+          .add(ci.pll ? "" : " (HSI)")
+          .add(", SysTick ")
+          .num(ci.tim_hz)
+          .add(" Hz, loop ")
+          .num(static_cast<int>(cfg.rate_hz))
+          .add(" Hz"));
+}
+
+// broadcast_options: the CAN ids and the pose and Status rates (as loop-tick divisors) of cfg.
+BroadcastOptions broadcast_options(const BoardConfig& cfg) {
+  BroadcastOptions bo;
+  bo.base_id = cfg.base_id;
+  bo.node_id = cfg.node_id;
+  bo.pose_div = static_cast<std::uint32_t>(protocol::divisor_for(cfg.rate_hz, cfg.pose_hz));
+  bo.status_div = static_cast<std::uint32_t>(protocol::divisor_for(cfg.rate_hz, cfg.status_hz));
+  return bo;
+}
+
 }  // namespace
 }  // namespace odo::board
 
@@ -166,16 +190,7 @@ int main() {
   pins_init();
   uart1().init(ci.apb2_hz, cfg.baud, kIrqUsart1);
   const Options opt = parse_options();
-  Line banner;
-  say(banner.add("# diffodom mcu: sysclk ")
-          .num(ci.sysclk_hz)
-          .add(" Hz")
-          .add(ci.pll ? "" : " (HSI)")
-          .add(", SysTick ")
-          .num(ci.tim_hz)
-          .add(" Hz, loop ")
-          .num(static_cast<int>(cfg.rate_hz))
-          .add(" Hz"));
+  say_banner(ci, cfg);
   auto k = Kinematics::create(cfg.robot);
   if (!k) fail("kinematics");
   // The robot follows the nominal kinematics (as odometryd's rig); the loop runs on the store's.
@@ -193,12 +208,7 @@ int main() {
   if (!created) fail("loop configuration");
   static std::unique_ptr<loop::OdometryLoop> lp = std::move(created).value();
   static SlcanBus bus(uart1());
-  BroadcastOptions bo;
-  bo.base_id = cfg.base_id;
-  bo.node_id = cfg.node_id;
-  bo.pose_div = static_cast<std::uint32_t>(protocol::divisor_for(cfg.rate_hz, cfg.pose_hz));
-  bo.status_div = static_cast<std::uint32_t>(protocol::divisor_for(cfg.rate_hz, cfg.status_hz));
-  static PoseBroadcaster bc(bo, bus, lp->commands());
+  static PoseBroadcaster bc(broadcast_options(cfg), bus, lp->commands());
   lp->add_observer(&bc);
   uart2().init(ci.apb1_hz, cfg.baud, kIrqUsart2);
   const double serial_hz = opt.serial_hz >= 0.0 ? opt.serial_hz : cfg.serial_hz;
