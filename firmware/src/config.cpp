@@ -180,13 +180,7 @@ void read_serial(TableReader t, SerialSection& s) {
   s.bits_right = static_cast<int>(t.integer("bits_right", s.bits_right, 8, 32));
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
   s.reverse_right = t.boolean("reverse_right", s.reverse_right);
-  s.timeout = t.number("timeout", s.timeout, 0.005, 10.0, "s");
-  s.reopen_period = t.number("reopen_period", s.reopen_period, 0.01, 60.0, "s");
-  s.poll_rate = t.number("poll_rate", s.poll_rate, 1.0, 1000.0, "Hz");
-  s.max_speed = t.number("max_speed", s.max_speed, 0.01, 100.0, "m/s");
-  s.clock_window = t.number("clock_window", s.clock_window, 0.05, 60.0, "s");
-  s.start_wait = t.number("start_wait", s.start_wait, 0.0, 30.0, "s");
-  s.sim_period = t.number("sim_period", s.sim_period, 0.001, 1.0, "s");
+  for (const auto& n : kSerialNumbers) s.*n.member = t.number(s.*n.member, n.row);
   t.finish();
 }
 
@@ -285,15 +279,6 @@ void read_selfcal(TableReader t, SelfCalSection& s) {
 }
 
 // ---- [gyro] ----
-// The numbers of [gyro] that belong to the gyro source (the fusion's own come from its table,
-// gyrodometry_range, through gyro_number below).
-constexpr RangeRow kGyroSourceRows[] = {
-    {"rate", 0.0, 100000.0, "Hz"},
-    {"stale_timeout", 0.001, 10.0, "s"},
-};
-constexpr double GyroSection::*kGyroSourceMembers[] = {&GyroSection::rate,
-                                                       &GyroSection::stale_timeout};
-
 // The section's field of each of the fusion's user-set parameters, in GyroParam order.
 constexpr double GyroSection::*kGyroFusionMembers[kGyroConfigParams] = {
     &GyroSection::noise_density, &GyroSection::bias_instability, &GyroSection::scale_tolerance,
@@ -304,8 +289,7 @@ constexpr double GyroSection::*kGyroFusionMembers[kGyroConfigParams] = {
 // read_gyro_numbers: the source's numbers, then the fusion's against its own limits at this
 // loop's tick (bias_tau after still_time: its lower limit is the still_time just read).
 void read_gyro_numbers(TableReader& t, GyroSection& s, double loop_hz) {
-  for (std::size_t i = 0; i < std::size(kGyroSourceRows); ++i)
-    s.*kGyroSourceMembers[i] = t.number(s.*kGyroSourceMembers[i], kGyroSourceRows[i]);
+  for (const auto& n : kGyroSourceNumbers) s.*n.member = t.number(s.*n.member, n.row);
   for (std::size_t i = 0; i < kGyroConfigParams; ++i) {
     const RangeRow r = gyrodometry_range(static_cast<GyroParam>(i), 1.0 / loop_hz, s.still_time);
     s.*kGyroFusionMembers[i] = t.number(s.*kGyroFusionMembers[i], r);

@@ -251,14 +251,18 @@ void expect_boundaries(const std::string& table, const RangeRow& r) {
 }
 
 // [gyro]: the fusion's numbers from its own table (gyrodometry_range at the default loop rate and
-// still_time, as a file that sets only that key sees them), the source's two by hand.
+// still_time, as a file that sets only that key sees them), the source's from config.hpp.
 TEST(ConfigErrors, GyroEveryNumberAtBothLimitsFromTheFusionsTable) {
   const Config def = default_config();
   for (std::size_t i = 0; i < kGyroConfigParams; ++i)
     expect_boundaries("gyro", gyrodometry_range(static_cast<GyroParam>(i), 1.0 / def.loop.rate_hz,
                                                 def.gyro.still_time));
-  expect_boundaries("gyro", {"rate", 0.0, 100000.0, "Hz"});
-  expect_boundaries("gyro", {"stale_timeout", 0.001, 10.0, "s"});
+  for (const auto& n : kGyroSourceNumbers) expect_boundaries("gyro", n.row);
+}
+
+// [serial]: every number of its table (config.hpp, kSerialNumbers).
+TEST(ConfigErrors, SerialEveryNumberAtBothLimitsFromItsTable) {
+  for (const auto& n : kSerialNumbers) expect_boundaries("serial", n.row);
 }
 
 // [selfcal]: every number of its table (config.hpp, kSelfCalNumbers / kSelfCalIntegers).

@@ -13,6 +13,7 @@
 
 #include "odo/hal/angle.hpp"
 #include "odo/hal/choice.hpp"
+#include "odo/hal/field_range.hpp"
 #include "odo/hal/nv_storage.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/error_model.hpp"
@@ -243,6 +244,25 @@ struct SerialSection {
   double sim_period = 0.01;  // [s] sample period of the simulated controller
 };
 
+// SectionNumber: one number key of a section: its range row (key, limits, unit) and the field it
+// sets. A section's table of these is the only place its ranges are written: the reader and the
+// config error tests take them from there.
+template <class S>
+struct SectionNumber {
+  RangeRow row;
+  double S::*member;
+};
+
+// [serial]'s numbers.
+inline constexpr SectionNumber<SerialSection> kSerialNumbers[] = {
+    {{"timeout", 0.005, 10.0, "s"}, &SerialSection::timeout},
+    {{"reopen_period", 0.01, 60.0, "s"}, &SerialSection::reopen_period},
+    {{"poll_rate", 1.0, 1000.0, "Hz"}, &SerialSection::poll_rate},
+    {{"max_speed", 0.01, 100.0, "m/s"}, &SerialSection::max_speed},
+    {{"clock_window", 0.05, 60.0, "s"}, &SerialSection::clock_window},
+    {{"start_wait", 0.0, 30.0, "s"}, &SerialSection::start_wait},
+    {{"sim_period", 0.001, 1.0, "s"}, &SerialSection::sim_period}};
+
 struct EncoderSection {
   EncoderKind backend = EncoderKind::kSim;
 };
@@ -350,6 +370,13 @@ struct GyroSection {
   double bias_tau = 60.0;         // [s]
   bool scale_estimation = true;   // estimate the scale factor on turns once calibrated
   static constexpr double kNotSet = -1.0;
+};
+
+// [gyro]'s numbers that belong to the gyro source (the fusion's own are its table,
+// gyrodometry_range).
+inline constexpr SectionNumber<GyroSection> kGyroSourceNumbers[] = {
+    {{"rate", 0.0, 100000.0, "Hz"}, &GyroSection::rate},
+    {{"stale_timeout", 0.001, 10.0, "s"}, &GyroSection::stale_timeout},
 };
 
 // [can_gyro]: the yaw rate of a CAN IMU ([gyro] backend = "can"; drivers/can_gyro.hpp).
