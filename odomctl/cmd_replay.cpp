@@ -28,9 +28,9 @@ nlohmann::json gyro_json(const FusionCounters& c) {
 
 // run_replay: `odomctl ... replay` once its options are parsed; sets exit_code.
 void run_replay(const ReplayOpts& o, int& exit_code) {
-  auto k = make_kinematics(o.kin);
-  if (!k) {
-    std::cerr << "odomctl replay: " << k.error().message << "\n";
+  auto run = log_run(o.kin);
+  if (!run) {
+    std::cerr << "odomctl replay: " << run.error().message << "\n";
     exit_code = kExitBadInput;
     return;
   }
@@ -40,16 +40,10 @@ void run_replay(const ReplayOpts& o, int& exit_code) {
     exit_code = kExitBadInput;
     return;
   }
-  auto fusion = fusion_params(o.kin);  // odometryd's [gyro] with --config, else the defaults
-  if (!fusion) {
-    std::cerr << "odomctl replay: " << fusion.error().message << "\n";
-    exit_code = kExitBadInput;
-    return;
-  }
   analysis::ReplayGyro gyro;
   gyro.use = !o.no_gyro;
-  gyro.params = *fusion;
-  auto r = analysis::replay_ticks(in, o.ticks, *k, o.kin.bits, gyro);
+  gyro.params = run->fusion;
+  auto r = analysis::replay_ticks(in, o.ticks, run->kinematics, o.kin.bits, gyro);
   if (!r) {
     std::cerr << "odomctl replay: " << r.error().message << "\n";
     exit_code = kExitBadInput;

@@ -88,10 +88,16 @@ void add_kinematics_options(CLI::App& c, KinematicsOpts& k, const KinematicsHelp
 // field and its range, or the config file's line.
 Result<Kinematics> make_kinematics(const KinematicsOpts& k);
 
-// fusion_params: the gyrodometry parameters odometryd would run with: its config's [gyro] and
-// [error_model] with --config, else the fusion's defaults (tick and heading_quantum are set by
-// the caller, as the loop sets them from its rate and kinematics).
-Result<GyrodometryParams> fusion_params(const KinematicsOpts& k);
+// LogRun: what a log command runs the loop's code with: the kinematics, and the gyrodometry
+// parameters odometryd would run with (its config's [gyro] and [error_model] with --config,
+// else the fusion's defaults; tick and heading_quantum are set by the caller, as the loop sets
+// them from its rate and kinematics).
+struct LogRun {
+  Kinematics kinematics;
+  GyrodometryParams fusion;
+};
+// log_run: the LogRun of `k`, reading --config once; errors as make_kinematics.
+Result<LogRun> log_run(const KinematicsOpts& k);
 
 // add_replay: `odomctl replay` (integrate a log of raw counts).
 void add_replay(CLI::App& app, int& exit_code);

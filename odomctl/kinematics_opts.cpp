@@ -27,20 +27,23 @@ void add_kinematics_options(CLI::App& c, KinematicsOpts& k, const KinematicsHelp
 
 namespace {
 
-// config_kinematics: the kinematics odometryd runs with under `path`: [robot] with the stored
-// calibration applied (a missing or blank store: the nominal values, as odometryd).
-Result<Kinematics> config_kinematics(const std::string& path) {
+// config_run: what odometryd runs with under `path`, from one read of the file: [robot] with the
+// stored calibration applied (a missing or blank store: the nominal values, as odometryd), and
+// the fusion's [gyro] with [error_model].
+Result<LogRun> config_run(const std::string& path) {
   auto cfg = fw::load_config(path);
   if (!cfg) return std::move(cfg).error();
   const fw::AppliedCalibration a =
       fw::read_and_apply(cfg->robot, cfg->calibration.store, cfg->calibration.backend);
-  return Kinematics::create(a.params);
+  auto k = Kinematics::create(a.params);
+  if (!k) return std::move(k).error();
+  GyrodometryParams p = fw::gyrodometry_params(*cfg);
+  p.odometry_noise = cfg->error_model;
+  return LogRun{*k, p};
 }
 
-}  // namespace
-
-Result<Kinematics> make_kinematics(const KinematicsOpts& k) {
-  if (!k.config.empty()) return config_kinematics(k.config);
+// options_kinematics: the kinematics of the geometry options.
+Result<Kinematics> options_kinematics(const KinematicsOpts& k) {
   for (auto [name, v] : {std::pair{"--wheel-diameter", k.wheel_diameter},
                          {"--counts-per-rev", k.counts_per_rev},
                          {"--wheelbase", k.wheelbase}})
@@ -58,13 +61,19 @@ Result<Kinematics> make_kinematics(const KinematicsOpts& k) {
   return Kinematics::create(p);
 }
 
-Result<GyrodometryParams> fusion_params(const KinematicsOpts& k) {
-  if (k.config.empty()) return GyrodometryParams{};
-  auto cfg = fw::load_config(k.config);
-  if (!cfg) return std::move(cfg).error();
-  GyrodometryParams p = fw::gyrodometry_params(*cfg);
-  p.odometry_noise = cfg->error_model;
-  return p;
+}  // namespace
+
+Result<LogRun> log_run(const KinematicsOpts& k) {
+  if (!k.config.empty()) return config_run(k.config);
+  auto kin = options_kinematics(k);
+  if (!kin) return std::move(kin).error();
+  return LogRun{*kin, GyrodometryParams{}};
+}
+
+Result<Kinematics> make_kinematics(const KinematicsOpts& k) {
+  auto r = log_run(k);
+  if (!r) return std::move(r).error();
+  return r->kinematics;
 }
 
 }  // namespace odo::ctl
