@@ -32,7 +32,7 @@ one_protocol() {  # one_protocol PROTOCOL
   local p=$1
   config "$p" "$tmp/board"
   rm -f "$tmp/state.bin"
-  "$SERIAL_PEER" --link "$tmp/board" --protocol "$p" --duration 9.5 --log "$tmp/$p.csv" \
+  run "$SERIAL_PEER" --link "$tmp/board" --protocol "$p" --duration 9.5 --log "$tmp/$p.csv" \
     --garbage-at 2.0 --unplug-at 3.5 --unplug-for 0.5 --garbage-at 5.5 --reset-at 6.5 \
     --move-until 8.0 2>"$tmp/peer-$p.err" &
   local peer=$!
@@ -78,7 +78,7 @@ cat "$tmp"/peer-*.err >&2
 # restart right after the controller rebooted: a fresh start with reason controller-reset.
 config diffodom "$tmp/board"
 rm -f "$tmp/state.bin"
-"$SERIAL_PEER" --link "$tmp/board" --protocol diffodom --duration 9 --reset-at 6.0 \
+run "$SERIAL_PEER" --link "$tmp/board" --protocol diffodom --duration 9 --reset-at 6.0 \
   --step-every 0.05 --start-after 0 2>/dev/null &
 peer=$!
 poll 5 test -e "$tmp/board"
@@ -94,7 +94,7 @@ wait "$peer"
 
 # A board that never answers: odometryd runs, the wheels are stale, nothing moves.
 config arduino-bridge "$tmp/board"
-"$SERIAL_PEER" --link "$tmp/board" --protocol arduino-bridge --duration 4 --silent \
+run "$SERIAL_PEER" --link "$tmp/board" --protocol arduino-bridge --duration 4 --silent \
   2>/dev/null &
 peer=$!
 poll 5 test -e "$tmp/board"
