@@ -8,9 +8,11 @@
 // Motion: the wheels move in steps every --step-every seconds (a different step each time) and
 // stand still in between, and around every fault: a tick of odometryd then integrates either
 // nothing or exactly one step, as a replay of the log does: the poses are equal to the bit.
-// Faults: --unplug-at T (the pty is closed, gone for --unplug-for s, then a new pty under the
-// same link: another /dev/pts name), --garbage-at T (a burst of garbage bytes), --reset-at T
-// (the controller reboots: counters, clock and sequence restart at 0, the booted flag), and
+// Times count from when the host first opens the line. Faults: --unplug-at T (the pty is closed,
+// gone for --unplug-for s, then a new pty under the same link: another /dev/pts name), --garbage-at
+// T (a burst of garbage bytes), --reset-at T (the controller reboots: counters, clock and sequence
+// restart at 0, the booted flag; SIGUSR1 does the same at once, for a test that must reboot it
+// between two events, not at a time), and
 // --silent (never answers / never sends: a board that does not talk).
 //
 // usage: serial_peer --link PATH --protocol diffodom|arduino-bridge --duration S [--period S]
@@ -23,6 +25,7 @@
 
 #include <array>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -42,6 +45,8 @@ struct Options {
   std::vector<double> garbage_at;
   bool silent = false;
 };
+
+volatile std::sig_atomic_t g_reset_requested = 0;  // set by SIGUSR1
 
 double now_s() {
   timespec ts{};
@@ -63,8 +68,25 @@ int open_pty(const std::string& link) {
     std::perror("serial_peer: link");
     return -1;
   }
+  // Open and close the slave once: from then on the master polls POLLHUP while no host has the
+  // line open (a never-opened slave reports nothing), which wait_for_host reads.
+  const int s = ::open(ptsname(m), O_RDWR | O_NOCTTY);
+  if (s >= 0) ::close(s);
   std::fprintf(stderr, "serial_peer: %s -> %s\n", link.c_str(), ptsname(m));
   return m;
+}
+
+// wait_for_host: returns once a host has opened the line (at most `limit` s). The scenario's
+// clock starts then, not at the peer's own start: a host started under a cross build's emulator
+// takes a second or more to open it, and motion before that would precede its first record.
+void wait_for_host(int m, double limit) {
+  const double start = now_s();
+  for (;;) {
+    pollfd p{m, 0, 0};
+    if (::poll(&p, 1, 0) >= 0 && !(p.revents & POLLHUP)) return;
+    if (now_s() - start > limit) return;
+    usleep(1000);
+  }
 }
 
 bool parse(int argc, char** argv, Options& o) {
@@ -132,11 +154,13 @@ int main(int argc, char** argv) {
   // The board has been counting before: physical counts start away from 0.
   std::int64_t left = 100000, right = -50000;
   int k = 0;
+  wait_for_host(m, o.duration);
   const double t0 = now_s();
   double next_step = o.step_every, next_send = 0;
   std::size_t garbage_done = 0;
   bool unplugged = false, reset_done = false;
   std::srand(37);
+  std::signal(SIGUSR1, [](int) { g_reset_requested = 1; });
   for (;;) {
     const double t = now_s() - t0;
     if (t >= o.duration) break;
@@ -149,9 +173,10 @@ int main(int argc, char** argv) {
       }
       next_step += o.step_every;
     }
-    if (o.reset_at >= 0 && !reset_done && t >= o.reset_at) {
+    if ((o.reset_at >= 0 && !reset_done && t >= o.reset_at) || g_reset_requested) {
       model.reset(tn, left, right);
       reset_done = true;
+      g_reset_requested = 0;
     }
     if (o.unplug_at >= 0 && !unplugged && t >= o.unplug_at) {
       ::close(m);
