@@ -221,6 +221,12 @@ void CanBroadcaster::send_timing(const loop::LoopSnapshot& s) noexcept {
   send(f, s.loop_time);
 }
 
+void CanBroadcaster::send_encoder_faults(const loop::LoopSnapshot& s) noexcept {
+  CanFrame f;
+  protocol::encode_encoder_faults(id(protocol::Msg::kEncoderFaults), s.encoder_counters, f);
+  send(f, s.loop_time);
+}
+
 void CanBroadcaster::on_tick(const loop::LoopSnapshot& s) noexcept {
   // Commands taken last tick were applied at the start of this one: acknowledge them now, so a
   // receiver that sees the ack also sees the new pose in the same or a later pose group.
@@ -245,7 +251,11 @@ void CanBroadcaster::send_due(const loop::LoopSnapshot& s) noexcept {
   if (d.pose != 0 && t % d.pose == 0) send_pose_group(s);
   if (d.velocity != 0 && t % d.velocity == 0) send_velocity(s);
   if (d.uncertainty != 0 && t % d.uncertainty == 0) send_uncertainty(s);
-  if (d.status != 0 && t % d.status == 0) send_status(s, false);
+  if (d.status != 0 && t % d.status == 0) {
+    // The counters behind the Status frame's encoder flags, at its rate and just before it.
+    send_encoder_faults(s);
+    send_status(s, false);
+  }
   if (d.timing != 0 && t % d.timing == 0) send_timing(s);
   // The next tick that is a multiple of an enabled divisor; none enabled: never.
   std::uint64_t next = UINT64_MAX;
@@ -263,6 +273,7 @@ void CanBroadcaster::send_final(const loop::LoopSnapshot& s) noexcept {
   send_velocity(s);
   send_uncertainty(s);
   send_timing(s);
+  send_encoder_faults(s);
   send_status(s, true);
 }
 

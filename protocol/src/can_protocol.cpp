@@ -56,10 +56,14 @@ bool split_id(std::uint32_t base_id, const CanFrame& f, int& node, Msg& m) noexc
   const std::uint32_t rel = f.id - base_id;
   if (rel / 16 > static_cast<std::uint32_t>(kMaxNodeId)) return false;
   const std::uint32_t off = rel % 16;
-  if (off > 5 && (off < 8 || off > 10)) return false;
-  node = static_cast<int>(rel / 16);
-  m = static_cast<Msg>(off);
-  return true;
+  // Ours are the offsets the message table lists; the others belong to no message.
+  for (const MessageSpec& s : kMessages) {
+    if (static_cast<std::uint32_t>(s.msg) != off) continue;
+    node = static_cast<int>(rel / 16);
+    m = s.msg;
+    return true;
+  }
+  return false;
 }
 
 std::int64_t divisor_for(double loop_hz, double rate_hz) noexcept {
@@ -132,6 +136,11 @@ void encode_timing(std::uint32_t id, const TimingMsg& t, CanFrame& f) noexcept {
   put_count(f, sig::tx_dropped, t.tx_dropped);
 }
 
+void encode_encoder_faults(std::uint32_t id, const EncoderCounters& c, CanFrame& f) noexcept {
+  start(id, f);
+  for (const auto& s : sig::kEncoderFaultFields) put_count(f, *s.signal, c.*s.field);
+}
+
 void encode_set_pose(std::uint32_t id, const SetPoseCmd& c, CanFrame& f) noexcept {
   start(id, f);
   if (c.reset) {
@@ -195,6 +204,13 @@ bool decode_timing(const CanFrame& f, TimingMsg& t) noexcept {
   t.wakeup_max = get_value(f, sig::wakeup_max);
   t.compute_max = get_value(f, sig::compute_max);
   t.tx_dropped = static_cast<std::uint32_t>(get_raw(f, sig::tx_dropped));
+  return true;
+}
+
+bool decode_encoder_faults(const CanFrame& f, EncoderCounters& c) noexcept {
+  if (f.len != 8) return false;
+  for (const auto& s : sig::kEncoderFaultFields)
+    c.*s.field = static_cast<std::uint64_t>(get_raw(f, *s.signal));
   return true;
 }
 

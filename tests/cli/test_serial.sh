@@ -38,8 +38,22 @@ one_protocol() {  # one_protocol PROTOCOL
   local peer=$!
   poll 5 test -e "$tmp/board"
   run "$ODOMETRYD" --config "$tmp/serial.toml" --duration 8.8 --json --quiet \
-    >"$tmp/$p.json" 2>"$tmp/$p.err"
+    --can-log "$tmp/$p.can" >"$tmp/$p.json" 2>"$tmp/$p.err"
   check "$p: odometryd exit 0" $?
+  # The CAN side counts the same faults: the last EncoderFaults frame (sent with the stopping
+  # Status) carries --json's counters.
+  run "$ODOMCTL" decode --csv "$tmp/$p.can" >"$tmp/$p-can.csv"
+  python3 - "$tmp/$p.json" "$tmp/$p-can.csv" <<'PY'
+import csv, json, sys
+d = json.load(open(sys.argv[1]))
+last = {r["signal"]: int(float(r["value"])) for r in csv.DictReader(open(sys.argv[2]))
+        if r["message"] == "EncoderFaults"}
+keys = ("invalid_transitions", "implausible_jumps", "stale_events", "read_errors", "link_errors",
+        "sequence_gaps", "controller_resets", "reconnects")
+assert last == {k: min(d[k], 255) for k in keys}, (last, d)
+assert last["link_errors"] >= 1 and last["controller_resets"] == 1, last
+PY
+  check "$p: the CAN EncoderFaults frame counts what --json counts" $?
   wait "$peer"
   run "$ODOMCTL" replay --ticks "$tmp/$p.csv" --wheel-diameter 0.15 --counts-per-rev 2048 \
     --gear-ratio 16 --wheelbase 0.34 --json >"$tmp/$p-replay.json"

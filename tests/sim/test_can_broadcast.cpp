@@ -91,6 +91,7 @@ TEST(CanBroadcast, FramesAtTheirRatesAndPoseGroupsShareTheirSequence) {
   EXPECT_EQ(n[3], 10u);
   EXPECT_EQ(n[4], 10u);
   EXPECT_EQ(n[5], 1u);
+  EXPECT_EQ(n[6], 10u);  // EncoderFaults, with each Status
   // PoseX is immediately followed by PoseYTheta with the same seq; seq steps by one.
   for (std::size_t i = 0; i + 1 < fs.size(); ++i) {
     if (fs[i].id != id(Msg::kPoseX)) continue;
@@ -143,15 +144,26 @@ TEST(CanBroadcast, RatesFollowTheTickNumberWhenItRepeatsJumpsOrGoesBack) {
   EXPECT_GT(frames, 60u);
 }
 
+// StatusBench: a broadcaster that sends Status (and EncoderFaults with it) on every tick and
+// nothing else, fed snapshots by hand.
+struct StatusBench {
+  StatusBench() { port.connect_wire(); }
+  static fw::CanBroadcastOptions opts() {
+    fw::CanBroadcastOptions o;
+    o.div = fw::CanDivisors{0, 0, 0, 1, 0};
+    return o;
+  }
+  sim::SimCanPort port{64, 16};
+  fw::CanFrameRing ring{1 << 10};
+  fw::CanBroadcaster bc{opts(), port, nullptr, &ring};
+};
+
 // gyro_state in the Status frame (protocol/odometry.dbc: 0 none, 1 fusing, 2 learning the bias or
 // waiting for the first sample, 3 fault), one snapshot per case on a status-every-tick bus.
 TEST(CanBroadcast, GyroStateFollowsTheGyroAndTheFusion) {
-  sim::SimCanPort port(64, 16);
-  fw::CanFrameRing ring{1 << 10};
-  fw::CanBroadcastOptions o;
-  o.div = fw::CanDivisors{0, 0, 0, 1, 0};  // status only, every tick
-  port.connect_wire();
-  fw::CanBroadcaster bc(o, port, nullptr, &ring);
+  StatusBench b;
+  fw::CanFrameRing& ring = b.ring;
+  fw::CanBroadcaster& bc = b.bc;
   struct Case {
     bool enabled;
     std::uint32_t gyro_flags, fusion_flags;
@@ -179,10 +191,44 @@ TEST(CanBroadcast, GyroStateFollowsTheGyroAndTheFusion) {
     CanFrame f;
     protocol::StatusMsg st;
     ASSERT_TRUE(ring.pop(f));
+    ASSERT_EQ(f.id, id(Msg::kEncoderFaults));  // the counters go just before each Status
+    ASSERT_TRUE(ring.pop(f));
     ASSERT_EQ(f.id, id(Msg::kStatus));
     ASSERT_TRUE(protocol::decode_status(f, st));
     EXPECT_EQ(st.gyro_state, c.want) << "case " << s.tick;
     EXPECT_FALSE(ring.pop(f));
+  }
+}
+
+// EncoderFaults (issue 37): the backend's counters of the snapshot, one byte each, saturating at
+// 255, sent just before each Status frame; they follow the counters as these grow.
+TEST(CanBroadcast, EncoderFaultsCarryTheBackendsCountersJustBeforeStatus) {
+  StatusBench b;
+  fw::CanFrameRing& ring = b.ring;
+  fw::CanBroadcaster& bc = b.bc;
+  loop::LoopSnapshot s;
+  s.encoder_counters = {1, 2, 3, 4, 5, 6, 7, 8};
+  for (std::uint64_t grow : {0u, 250u}) {
+    EncoderCounters& c = s.encoder_counters;
+    c.link_errors += grow;        // 5 -> 255: the last value that is exact
+    c.sequence_gaps += 2 * grow;  // 6 -> 506: saturates at 255
+    ++s.tick;
+    bc.on_tick(s);
+    CanFrame f;
+    ASSERT_TRUE(ring.pop(f));
+    ASSERT_EQ(f.id, id(Msg::kEncoderFaults));
+    EncoderCounters got;
+    ASSERT_TRUE(protocol::decode_encoder_faults(f, got));
+    EXPECT_EQ(got.invalid_transitions, 1u);
+    EXPECT_EQ(got.implausible_jumps, 2u);
+    EXPECT_EQ(got.stale_events, 3u);
+    EXPECT_EQ(got.read_errors, 4u);
+    EXPECT_EQ(got.link_errors, grow == 0 ? 5u : 255u);
+    EXPECT_EQ(got.sequence_gaps, grow == 0 ? 6u : 255u);
+    EXPECT_EQ(got.controller_resets, 7u);
+    EXPECT_EQ(got.reconnects, 8u);
+    ASSERT_TRUE(ring.pop(f));
+    EXPECT_EQ(f.id, id(Msg::kStatus));
   }
 }
 
@@ -394,8 +440,9 @@ TEST(CanBroadcast, CleanStopSendsFinalPoseThenStoppingStatus) {
   b.wire_frames();
   b.bc.send_final(b.loop->snapshot());
   const auto fs = b.wire_frames();
-  ASSERT_EQ(fs.size(), 6u);
+  ASSERT_EQ(fs.size(), 7u);
   EXPECT_EQ(fs.front().id, id(Msg::kPoseX));
+  EXPECT_EQ(fs[5].id, id(Msg::kEncoderFaults));
   EXPECT_EQ(fs.back().id, id(Msg::kStatus));
   protocol::StatusMsg st;
   ASSERT_TRUE(protocol::decode_status(fs.back(), st));

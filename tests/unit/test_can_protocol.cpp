@@ -36,8 +36,13 @@ TEST(CanIds, NodeBlocksAndSplit) {
   ASSERT_TRUE(split_id(0x400, f, node, m));
   EXPECT_EQ(node, 3);
   EXPECT_EQ(m, Msg::kTiming);
-  f.id = 0x436;  // offsets 6, 7, 11..15 are not ours
-  EXPECT_FALSE(split_id(0x400, f, node, m));
+  f.id = 0x436;
+  ASSERT_TRUE(split_id(0x400, f, node, m));
+  EXPECT_EQ(m, Msg::kEncoderFaults);
+  for (std::uint32_t off : {7u, 11u, 12u, 15u}) {  // offsets the message table does not list
+    f.id = 0x430 + off;
+    EXPECT_FALSE(split_id(0x400, f, node, m)) << off;
+  }
   f.id = 0x3FF;
   EXPECT_FALSE(split_id(0x400, f, node, m));
   f.id = 0x410;
@@ -250,6 +255,25 @@ TEST(CanTiming, RoundTripInMicroseconds) {
   EXPECT_NEAR(t.wakeup_max, 1.5e-3, 1e-15);
   EXPECT_NEAR(t.compute_max, 0.065535, 1e-15);  // saturated
   EXPECT_EQ(t.tx_dropped, 65535u);
+}
+
+// EncoderFaults, bytes by hand: one byte per counter in EncoderCounters' order (invalid
+// transitions, implausible jumps, stale events, read errors, link errors, sequence gaps,
+// controller resets, reconnects); 300 saturates at 0xFF, 2^40 too.
+TEST(CanEncoderFaults, OneByteEachInOrderSaturating) {
+  CanFrame f;
+  encode_encoder_faults(kId + 6, EncoderCounters{1, 2, 3, 4, 300, 0, 5, std::uint64_t{1} << 40}, f);
+  EXPECT_EQ(f.id, kId + 6);
+  ASSERT_EQ(f.len, 8);
+  const std::array<std::uint8_t, 8> want{0x01, 0x02, 0x03, 0x04, 0xFF, 0x00, 0x05, 0xFF};
+  for (std::size_t i = 0; i < 8; ++i) EXPECT_EQ(f.data[i], want[i]) << i;
+  EncoderCounters c;
+  ASSERT_TRUE(decode_encoder_faults(f, c));
+  EXPECT_EQ(c.read_errors, 4u);
+  EXPECT_EQ(c.link_errors, 255u);
+  EXPECT_EQ(c.reconnects, 255u);
+  f.len = 7;
+  EXPECT_FALSE(decode_encoder_faults(f, c));
 }
 
 TEST(CanSetPose, SetResetAndRejects) {

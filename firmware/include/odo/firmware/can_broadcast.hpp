@@ -102,8 +102,8 @@ class CanBroadcaster final : public loop::TickObserver {
                  CanFrameRing* log) noexcept;
 
   void on_tick(const loop::LoopSnapshot& snap) noexcept override;
-  // send_final: the final pose group, velocity, uncertainty, timing and a status frame with the
-  // stopping flag (clean stop); call on the loop thread after run() returned.
+  // send_final: the final pose group, velocity, uncertainty, timing, encoder faults and a
+  // status frame with the stopping flag (clean stop); call on the loop thread after run() returned.
   void send_final(const loop::LoopSnapshot& snap) noexcept;
 
   const CanBroadcastCounters& counters() const noexcept { return c_; }
@@ -125,6 +125,8 @@ class CanBroadcaster final : public loop::TickObserver {
   void send_uncertainty(const loop::LoopSnapshot& s) noexcept;
   void send_status(const loop::LoopSnapshot& s, bool stopping) noexcept;
   void send_timing(const loop::LoopSnapshot& s) noexcept;
+  // send_encoder_faults: the EncoderFaults frame (the backend's counters, saturating at 255).
+  void send_encoder_faults(const loop::LoopSnapshot& s) noexcept;
   void log_frame(const CanFrame& f) noexcept {
     if (o_.lossless_log)
       log_->push_wait(f, [] { std::this_thread::yield(); });

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "odo/hal/can_bus.hpp"
+#include "odo/hal/encoder.hpp"
 
 namespace odo::protocol {
 
@@ -16,15 +17,16 @@ constexpr int kMaxNodeId = 63;
 
 // Message offsets within a node's block of 16 ids.
 enum class Msg : std::uint8_t {
-  kPoseX = 0,        // x, seq
-  kPoseYTheta = 1,   // y, theta, seq
-  kVelocity = 2,     // v, w, seq
-  kUncertainty = 3,  // sigma_x, sigma_y, sigma_theta, rho_xy, seq
-  kStatus = 4,       // encoder flags, calibration state, stopping, set-pose ack, missed, uptime
-  kTiming = 5,       // wake-up latency p99/max, compute max, transmit drops
-  kSetPose = 8,      // command to the node: set (DLC 8) or reset to zero (DLC 0)
-  kFixPose = 9,      // absolute fix to the node, part 1: x, y, seq (self-calibration, issue 18)
-  kFixSigma = 10,    // part 2: theta, sigma_xy, sigma_theta (0 = theta unknown), age, seq
+  kPoseX = 0,          // x, seq
+  kPoseYTheta = 1,     // y, theta, seq
+  kVelocity = 2,       // v, w, seq
+  kUncertainty = 3,    // sigma_x, sigma_y, sigma_theta, rho_xy, seq
+  kStatus = 4,         // encoder flags, calibration state, stopping, set-pose ack, missed, uptime
+  kTiming = 5,         // wake-up latency p99/max, compute max, transmit drops
+  kEncoderFaults = 6,  // the encoder backend's eight fault counters (saturating at 255)
+  kSetPose = 8,        // command to the node: set (DLC 8) or reset to zero (DLC 0)
+  kFixPose = 9,        // absolute fix to the node, part 1: x, y, seq (self-calibration, issue 18)
+  kFixSigma = 10,      // part 2: theta, sigma_xy, sigma_theta (0 = theta unknown), age, seq
 };
 
 // Scalings (physical = raw * scale).
@@ -112,6 +114,8 @@ void encode_velocity(std::uint32_t id, const VelocityMsg& v, CanFrame& f) noexce
 void encode_uncertainty(std::uint32_t id, const UncertaintyMsg& u, CanFrame& f) noexcept;
 void encode_status(std::uint32_t id, const StatusMsg& s, CanFrame& f) noexcept;
 void encode_timing(std::uint32_t id, const TimingMsg& t, CanFrame& f) noexcept;
+// encode_encoder_faults: the backend's counters, each saturating at 255.
+void encode_encoder_faults(std::uint32_t id, const EncoderCounters& c, CanFrame& f) noexcept;
 // encode_set_pose: DLC 0 for a reset, else DLC 8 with x, y at 1 mm and theta at 1e-4 rad.
 void encode_set_pose(std::uint32_t id, const SetPoseCmd& c, CanFrame& f) noexcept;
 
@@ -122,6 +126,8 @@ bool decode_velocity(const CanFrame& f, VelocityMsg& v) noexcept;
 bool decode_uncertainty(const CanFrame& f, UncertaintyMsg& u) noexcept;
 bool decode_status(const CanFrame& f, StatusMsg& s) noexcept;
 bool decode_timing(const CanFrame& f, TimingMsg& t) noexcept;
+// decode_encoder_faults: the counters as sent (255 = at least 255).
+bool decode_encoder_faults(const CanFrame& f, EncoderCounters& c) noexcept;
 // encode_fix: the two frames of a fix (ids id_pose, id_sigma).
 void encode_fix(std::uint32_t id_pose, std::uint32_t id_sigma, const FixMsg& m, CanFrame& pose,
                 CanFrame& sigma) noexcept;

@@ -4,6 +4,7 @@
 // checks protocol/odometry.dbc against it, so the four cannot drift apart.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -12,6 +13,7 @@
 
 #include "odo/hal/bytes.hpp"
 #include "odo/hal/can_bus.hpp"
+#include "odo/hal/encoder.hpp"
 #include "odo/protocol/can_protocol.hpp"
 
 namespace odo::protocol {
@@ -59,6 +61,15 @@ inline constexpr Signal wakeup_p99{"wakeup_p99", 0, 16, kLatencyScale, false, 0,
 inline constexpr Signal wakeup_max{"wakeup_max", 16, 16, kLatencyScale, false, 0, 65535, "s"};
 inline constexpr Signal compute_max{"compute_max", 32, 16, kLatencyScale, false, 0, 65535, "s"};
 inline constexpr Signal tx_dropped{"tx_dropped", 48, 16, 1.0, false, 0, 65535, ""};
+// EncoderFaults: hal's EncoderCounters, one byte each, saturating at 255.
+inline constexpr Signal invalid_transitions{"invalid_transitions", 0, 8, 1.0, false, 0, 255, ""};
+inline constexpr Signal implausible_jumps{"implausible_jumps", 8, 8, 1.0, false, 0, 255, ""};
+inline constexpr Signal stale_events{"stale_events", 16, 8, 1.0, false, 0, 255, ""};
+inline constexpr Signal read_errors{"read_errors", 24, 8, 1.0, false, 0, 255, ""};
+inline constexpr Signal link_errors{"link_errors", 32, 8, 1.0, false, 0, 255, ""};
+inline constexpr Signal sequence_gaps{"sequence_gaps", 40, 8, 1.0, false, 0, 255, ""};
+inline constexpr Signal controller_resets{"controller_resets", 48, 8, 1.0, false, 0, 255, ""};
+inline constexpr Signal reconnects{"reconnects", 56, 8, 1.0, false, 0, 255, ""};
 inline constexpr Signal set_x{"set_x", 0, 24, kSetPosScale, true, kI24Min, kI24Max, "m"};
 inline constexpr Signal set_y{"set_y", 24, 24, kSetPosScale, true, kI24Min, kI24Max, "m"};
 inline constexpr Signal set_theta{"set_theta",   48,           16,   kThetaScale, true,
@@ -82,6 +93,26 @@ inline constexpr const Signal* kStatus[] = {
     &encoder_flags, &calibration_state, &stopping,         &gyro_state,
     &gyro_events,   &set_pose_ack,      &missed_deadlines, &uptime};
 inline constexpr const Signal* kTiming[] = {&wakeup_p99, &wakeup_max, &compute_max, &tx_dropped};
+// kEncoderFaultFields: each EncoderFaults signal and the EncoderCounters field it carries; the
+// message's signal list, its encoder and its decoder all come from here.
+struct CounterSignal {
+  const Signal* signal;
+  std::uint64_t EncoderCounters::*field;
+};
+inline constexpr CounterSignal kEncoderFaultFields[] = {
+    {&invalid_transitions, &EncoderCounters::invalid_transitions},
+    {&implausible_jumps, &EncoderCounters::implausible_jumps},
+    {&stale_events, &EncoderCounters::stale_events},
+    {&read_errors, &EncoderCounters::read_errors},
+    {&link_errors, &EncoderCounters::link_errors},
+    {&sequence_gaps, &EncoderCounters::sequence_gaps},
+    {&controller_resets, &EncoderCounters::controller_resets},
+    {&reconnects, &EncoderCounters::reconnects}};
+inline constexpr auto kEncoderFaults = [] {
+  std::array<const Signal*, std::size(kEncoderFaultFields)> a{};
+  for (std::size_t i = 0; i < a.size(); ++i) a[i] = kEncoderFaultFields[i].signal;
+  return a;
+}();
 inline constexpr const Signal* kSetPose[] = {&set_x, &set_y, &set_theta};
 inline constexpr const Signal* kFixPose[] = {&fix_x, &fix_y, &fix_seq};
 inline constexpr const Signal* kFixSigma[] = {&fix_theta, &fix_sigma_xy, &fix_sigma_theta, &fix_age,
@@ -103,6 +134,7 @@ inline constexpr MessageSpec kMessages[] = {
     {Msg::kUncertainty, "Uncertainty", false, sig::kUncertainty},
     {Msg::kStatus, "Status", false, sig::kStatus},
     {Msg::kTiming, "Timing", false, sig::kTiming},
+    {Msg::kEncoderFaults, "EncoderFaults", false, sig::kEncoderFaults},
     {Msg::kSetPose, "SetPose", true, sig::kSetPose},
     {Msg::kFixPose, "FixPose", true, sig::kFixPose},
     {Msg::kFixSigma, "FixSigma", true, sig::kFixSigma},
