@@ -98,9 +98,9 @@ TEST(UmbmarkSim, PaperNoiseSpreadsTheReturnPositions) {
   o.seed = 1;
   const auto r = simulate(o);
   const calib::UmbmarkResult& u = r.passes[0].result;
-  ASSERT_TRUE(u.sigma.has_value());
-  EXPECT_GT(*u.sigma, 0.0125);
-  EXPECT_LT(*u.sigma, 0.050);
+  ASSERT_TRUE(u.spread.sigma.has_value());
+  EXPECT_GT(*u.spread.sigma, 0.0125);
+  EXPECT_LT(*u.spread.sigma, 0.050);
   EXPECT_GE(r.improvement, 5.0);
 }
 

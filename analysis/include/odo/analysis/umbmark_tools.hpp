@@ -82,6 +82,7 @@ struct UmbmarkRunSet {
   std::vector<calib::UmbmarkRun> runs;  // return errors (with etheta)
   calib::CentreOfGravity cw, ccw;
   double e_max_syst = 0.0;  // [m]
+  calib::SetSpread spread;  // sigma, SEM and the 3 x SEM verdict of these runs
 };
 
 struct UmbmarkSimPass {
