@@ -25,6 +25,23 @@ json opt(const std::optional<double>& v) {
   return v ? json(*v) : json(nullptr);
 }
 
+// print_spread: sigma, SEM and the 3 x SEM verdict of the input runs, beside their E_max,syst
+// (Borenstein & Feng Sec. 6.3: the rule compares a set's E_max,syst with that set's SEM).
+void print_spread(std::ostream& out, double e_max, const calib::SetSpread& sp) {
+  out << std::setprecision(2);
+  if (!sp.sigma) {
+    out << "spread sigma         unknown (fewer than 3 runs)\n"
+        << "pass on these runs   worthwhile (no spread to judge by)\n";
+    return;
+  }
+  out << "spread sigma         " << *sp.sigma * 1e3 << " mm, SEM " << sp.sem * 1e3
+      << " mm, 3 x SEM " << 3 * sp.sem * 1e3 << " mm\n"
+      << "pass on these runs   "
+      << (sp.worthwhile ? "worthwhile (E_max,syst " : "not worthwhile (E_max,syst ") << e_max * 1e3
+      << (sp.worthwhile ? " mm > 3 x SEM " : " mm <= 3 x SEM ") << 3 * sp.sem * 1e3
+      << (sp.worthwhile ? " mm)\n" : " mm: within the noise)\n");
+}
+
 }  // namespace
 
 nlohmann::json compute_json(const calib::UmbmarkResult& r) {
@@ -52,9 +69,9 @@ nlohmann::json compute_json(const calib::UmbmarkResult& r) {
          {"c_r_pass", r.pass.c_r},
          {"c_l", r.composed.c_l},
          {"c_r", r.composed.c_r},
-         {"sigma", opt(r.sigma)},
-         {"sem", r.sem},
-         {"second_pass_recommended", r.second_pass}};
+         {"sigma", opt(r.spread.sigma)},
+         {"sem", r.spread.sem},
+         {"pass_worthwhile", r.spread.worthwhile}};
   if (r.eps_theta_nonsys) j["eps_theta_nonsys"] = *r.eps_theta_nonsys;
   return j;
 }
@@ -66,8 +83,9 @@ void print_compute(std::ostream& out, const calib::UmbmarkResult& r, double whee
       << r.cw.r * 1e3 << " mm\n"
       << "centre of gravity ccw x " << r.ccw.x * 1e3 << " mm, y " << r.ccw.y * 1e3 << " mm, r_cg "
       << r.ccw.r * 1e3 << " mm\n"
-      << "E_max,syst           " << r.e_max_syst * 1e3 << " mm\n"
-      << std::setprecision(4) << "alpha (Type A)       " << r.ab.alpha * kDegPerRad
+      << "E_max,syst           " << r.e_max_syst * 1e3 << " mm\n";
+  print_spread(out, r.e_max_syst, r.spread);
+  out << std::setprecision(4) << "alpha (Type A)       " << r.ab.alpha * kDegPerRad
       << " deg per corner (x: " << r.ab.alpha_x * kDegPerRad << ", y: " << r.ab.alpha_y * kDegPerRad
       << ")\n"
       << "beta (Type B)        " << r.ab.beta * kDegPerRad
@@ -85,16 +103,8 @@ void print_compute(std::ostream& out, const calib::UmbmarkResult& r, double whee
       << r.composed.wheelbase * 1e3 << " mm\n"
       << std::setprecision(6) << "use from now on      c_l " << r.composed.c_l << ", c_r "
       << r.composed.c_r << ", wheelbase " << r.composed.wheelbase << " m\n";
-  if (r.sigma) {
-    out << std::setprecision(2) << "spread sigma         " << *r.sigma * 1e3 << " mm, SEM "
-        << r.sem * 1e3 << " mm, 3 x SEM " << 3 * r.sem * 1e3 << " mm\n";
-  } else {
-    out << "spread sigma         unknown (fewer than 3 runs)\n";
-  }
-  out << "second pass          "
-      << (r.second_pass ? "recommended (E_max,syst > 3 x SEM)"
-                        : "not worthwhile (E_max,syst <= 3 x SEM)")
-      << "\n";
+  out << "next                 drive the squares again with these factors and compute on those\n"
+      << "                     runs: their E_max,syst against their 3 x SEM decides another pass\n";
   if (r.eps_theta_nonsys) {
     out << std::setprecision(3) << "eps_theta,nonsys     " << *r.eps_theta_nonsys * kDegPerRad
         << " deg (extended UMBmark)\n";
@@ -318,16 +328,19 @@ bool simulate_outputs(const SimulateOpts& o, const analysis::UmbmarkSimResult& r
 void print_simulate_json(const analysis::UmbmarkSimResult& r) {
   json passes = json::array();
   for (const analysis::UmbmarkSimPass& p : r.passes) {
+    // Each set's figures carry its name; the verdict is the after set's (another pass?).
     json jp{{"e_max_syst_before", p.before.e_max_syst},
-            {"e_max_syst_after", p.after.e_max_syst},
+            {"sigma_before", opt(p.before.spread.sigma)},
+            {"sem_before", p.before.spread.sem},
             {"c_l", p.result.composed.c_l},
             {"c_r", p.result.composed.c_r},
             {"b", p.result.composed.wheelbase},
             {"alpha", p.result.ab.alpha},
             {"beta", p.result.ab.beta},
-            {"sigma", opt(p.result.sigma)},
-            {"sem", p.result.sem},
-            {"second_pass_recommended", p.result.second_pass}};
+            {"e_max_syst_after", p.after.e_max_syst},
+            {"sigma_after", opt(p.after.spread.sigma)},
+            {"sem_after", p.after.spread.sem},
+            {"another_pass_recommended", p.after.spread.worthwhile}};
     if (p.result.eps_theta_nonsys) jp["eps_theta_nonsys"] = *p.result.eps_theta_nonsys;
     passes.push_back(jp);
   }
@@ -336,22 +349,41 @@ void print_simulate_json(const analysis::UmbmarkSimResult& r) {
   std::cout << out.dump() << "\n";
 }
 
+// spread_cells: a set's E_max,syst, sigma and 3 x SEM [mm] as three table cells ("-": no sigma).
+void spread_cells(std::ostream& out, const analysis::UmbmarkRunSet& set) {
+  out << std::setprecision(2) << std::setw(12) << set.e_max_syst * 1e3;
+  if (set.spread.sigma) {
+    out << std::setw(8) << *set.spread.sigma * 1e3 << std::setw(8) << 3 * set.spread.sem * 1e3;
+  } else {
+    out << std::setw(8) << "-" << std::setw(8) << "-";
+  }
+}
+
 void print_simulate_text(const analysis::UmbmarkSimResult& r, const std::string& gyro_class) {
-  std::cout << "pass  E_max,syst before  after [mm]   c_l        c_r        b [mm]    "
-               "sigma [mm]  3xSEM [mm]  2nd pass?\n";
+  // Each set's statistics sit beside its own E_max,syst; "another pass?" is the after set's
+  // 3 x SEM verdict (Borenstein & Feng Sec. 6.3), which is also the next pass's input.
+  std::cout << std::right << std::setw(32) << "before (input set) [mm]" << std::setw(32)
+            << "factors found from it" << std::setw(30) << "after (verification) [mm]"
+            << "\n"
+            << "pass" << std::setw(12) << "E_max,syst" << std::setw(8) << "sigma" << std::setw(8)
+            << "3xSEM" << std::setw(11) << "c_l" << std::setw(11) << "c_r" << std::setw(10)
+            << "b [mm]" << std::setw(14) << "E_max,syst" << std::setw(8) << "sigma" << std::setw(8)
+            << "3xSEM"
+            << "  another pass?\n";
   int i = 1;
   for (const analysis::UmbmarkSimPass& p : r.passes) {
     const calib::UmbmarkResult& u = p.result;
-    std::cout << std::fixed << std::setw(4) << i++ << std::setprecision(2) << std::setw(19)
-              << p.before.e_max_syst * 1e3 << std::setw(11) << p.after.e_max_syst * 1e3
-              << std::setprecision(6) << std::setw(11) << u.composed.c_l << std::setw(11)
+    std::cout << std::fixed << std::setw(4) << i++;
+    spread_cells(std::cout, p.before);
+    std::cout << "  " << std::setprecision(6) << std::setw(9) << u.composed.c_l << std::setw(11)
               << u.composed.c_r << std::setprecision(3) << std::setw(10)
-              << u.composed.wheelbase * 1e3 << std::setprecision(2) << std::setw(12)
-              << (u.sigma ? *u.sigma * 1e3 : 0.0) << std::setw(12) << 3 * u.sem * 1e3 << "  "
-              << (u.second_pass ? "yes" : "no") << "\n";
+              << u.composed.wheelbase * 1e3 << "  ";
+    spread_cells(std::cout, p.after);
+    std::cout << "  " << (p.after.spread.worthwhile ? "yes" : "no") << "\n";
   }
   std::cout << std::setprecision(1) << "improvement (first before / last after): " << r.improvement
-            << "-fold\n";
+            << "-fold\nanother pass?: the after set's E_max,syst > its own 3 x SEM "
+               "(Borenstein & Feng, Sec. 6.3)\n";
   if (const auto& e = r.passes.front().result.eps_theta_nonsys) {
     std::cout << std::setprecision(3) << "eps_theta,nonsys (extended UMBmark): " << *e * kDegPerRad
               << " deg\n";

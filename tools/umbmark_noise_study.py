@@ -23,12 +23,12 @@ def main():
         p1, p2 = json.loads(out)["passes"]
         rows.append({
             "seed": seed,
-            "sigma": p1["sigma"],
+            "sigma": p1["sigma_before"],
             "before": p1["e_max_syst_before"],
             "after1": p1["e_max_syst_after"],
             "improve1": p1["e_max_syst_before"] / p1["e_max_syst_after"],
             # pass 2's input is pass 1's verification set: its rule decides about pass 2.
-            "second_asked": p2["second_pass_recommended"],
+            "second_asked": p1["another_pass_recommended"],
             "after2": p2["e_max_syst_after"],
         })
     print("seed  sigma[mm]  Emax before  after 1  improvement  3xSEM asks 2nd?  after 2 [mm]")

@@ -14,7 +14,7 @@ namespace {
 // Chi-square quantile for 95% with 2 degrees of freedom: -2 ln(0.05).
 const double kChi2_95 = -2.0 * std::log(0.05);
 constexpr double kPanel = 300.0;  // panel size [px]
-constexpr double kMargin = 50.0;  // room for labels [px]
+constexpr double kTop = 75.0;     // room for the title lines above the panels [px]
 constexpr std::size_t kMaxDots = 3000;
 
 // Human units at the edge: millimetres and milliradians, labelled.
@@ -40,38 +40,44 @@ std::vector<std::array<double, 2>> ellipse_points(const Cov3& c, int i, int j, d
   return pts;
 }
 
-// Panel: where the (i, j) panel number p sits, its half-ranges around the mean, and the
-// mapping of error values to SVG coordinates.
+// Panel: which pair (i, j) panel number p shows, and its frame in display units (kScale).
 struct Panel {
   int p = 0, i = 0, j = 0;
-  double ox = 0, oy = 0, hx = 0, hy = 0, mi = 0, mj = 0;
-  double sx(double v) const { return ox + kPanel * (0.5 + 0.5 * (v - mi) / hx); }
-  double sy(double v) const { return oy + kPanel * (0.5 - 0.5 * (v - mj) / hy); }
+  PlotFrame f;
+  double sx(double v) const { return f.px(v * kScale[i]); }
+  double sy(double v) const { return f.py(v * kScale[j]); }
 };
 
-// half_range: the larger ellipse plus a margin, so outlying dots may fall off the panel.
-void half_range(Panel& q, const std::vector<std::array<double, 2>>& pred,
-                const std::vector<std::array<double, 2>>& samp) {
+// frame_ranges: the larger ellipse plus a margin around the mean (outlying dots may fall off
+// the panel), in display units; equal scales when both axes are positions (ex, ey).
+void frame_ranges(Panel& q, const std::vector<std::array<double, 2>>& pred,
+                  const std::vector<std::array<double, 2>>& samp, double mi, double mj) {
   double hx = 0.0, hy = 0.0;
   for (const auto* e : {&pred, &samp}) {
     for (const auto& pt : *e) {
-      hx = std::max(hx, std::fabs(pt[0] - q.mi));
-      hy = std::max(hy, std::fabs(pt[1] - q.mj));
+      hx = std::max(hx, std::fabs(pt[0] - mi));
+      hy = std::max(hy, std::fabs(pt[1] - mj));
     }
   }
-  q.hx = std::max(hx * 1.4, 1e-12);
-  q.hy = std::max(hy * 1.4, 1e-12);
+  hx = std::max(hx * 1.4, 1e-12) * kScale[q.i];
+  hy = std::max(hy * 1.4, 1e-12) * kScale[q.j];
+  q.f.x0 = mi * kScale[q.i] - hx;
+  q.f.x1 = mi * kScale[q.i] + hx;
+  q.f.y0 = mj * kScale[q.j] - hy;
+  q.f.y1 = mj * kScale[q.j] + hy;
+  if (q.i < 2 && q.j < 2) equal_scale(q.f);
 }
 
-// write_plot: the panel's frame, the run dots and both ellipses (clipped to the panel).
+// write_plot: the panel's axes, the run dots and both ellipses (clipped to the panel).
 void write_plot(std::ostream& s, const Panel& q, const std::vector<PoseError>& errors,
                 const std::vector<std::array<double, 2>>& pred,
                 const std::vector<std::array<double, 2>>& samp) {
-  s << "<g>\n<rect x=\"" << q.ox << "\" y=\"" << q.oy << "\" width=\"" << kPanel << "\" height=\""
-    << kPanel << "\" fill=\"none\" stroke=\"black\"/>\n";
-  s << "<clipPath id=\"c" << q.p << "\"><rect x=\"" << q.ox << "\" y=\"" << q.oy << "\" width=\""
-    << kPanel << "\" height=\"" << kPanel << "\"/></clipPath>\n<g clip-path=\"url(#c" << q.p
-    << ")\">\n";
+  s << "<g class=\"panel\">\n";
+  axes_svg(s, q.f, tick_step(q.f.x1 - q.f.x0), tick_step(q.f.y1 - q.f.y0), kLabel[q.i], kLabel[q.j],
+           11.0);
+  s << "<clipPath id=\"c" << q.p << "\"><rect x=\"" << q.f.left << "\" y=\"" << q.f.top
+    << "\" width=\"" << kPanel << "\" height=\"" << kPanel
+    << "\"/></clipPath>\n<g clip-path=\"url(#c" << q.p << ")\">\n";
   const std::size_t n = std::min(errors.size(), kMaxDots);
   for (std::size_t k = 0; k < n; ++k) {
     s << "<circle cx=\"" << q.sx(errors[k][q.i]) << "\" cy=\"" << q.sy(errors[k][q.j])
@@ -84,26 +90,7 @@ void write_plot(std::ostream& s, const Panel& q, const std::vector<PoseError>& e
   };
   poly(samp, "stroke=\"black\" stroke-width=\"1.5\"");
   poly(pred, "stroke=\"#c0392b\" stroke-width=\"1.5\" stroke-dasharray=\"6,4\"");
-  s << "</g>\n";
-}
-
-// write_axes: axis labels and the extreme values of each axis, in mm / mrad.
-void write_axes(std::ostream& s, const Panel& q) {
-  const double ox = q.ox, oy = q.oy;
-  s << std::setprecision(3);
-  s << "<text x=\"" << ox + kPanel / 2 << "\" y=\"" << oy + kPanel + 30
-    << "\" text-anchor=\"middle\">" << kLabel[q.i] << "</text>\n"
-    << "<text x=\"" << ox << "\" y=\"" << oy + kPanel + 14 << "\">" << (q.mi - q.hx) * kScale[q.i]
-    << "</text>\n"
-    << "<text x=\"" << ox + kPanel << "\" y=\"" << oy + kPanel + 14 << "\" text-anchor=\"end\">"
-    << (q.mi + q.hx) * kScale[q.i] << "</text>\n"
-    << "<text transform=\"translate(" << ox - 8 << "," << oy + kPanel / 2
-    << ") rotate(-90)\" text-anchor=\"middle\">" << kLabel[q.j] << "</text>\n"
-    << "<text x=\"" << ox + 3 << "\" y=\"" << oy + 12 << "\">" << (q.mj + q.hy) * kScale[q.j]
-    << "</text>\n"
-    << "<text x=\"" << ox + 3 << "\" y=\"" << oy + kPanel - 4 << "\">"
-    << (q.mj - q.hy) * kScale[q.j] << "</text>\n";
-  s << std::setprecision(6);
+  s << "</g>\n</g>\n";
 }
 
 }  // namespace
@@ -111,35 +98,36 @@ void write_axes(std::ostream& s, const Panel& q) {
 std::string error_ellipse_svg(const std::vector<PoseError>& errors, const Cov3& predicted,
                               const Cov3& sample, const PoseError& mean, const std::string& title) {
   const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
-  // Wide enough for the three panels and for the title, whatever its length.
-  const double width =
-      std::max(3 * (kPanel + kMargin) + kMargin, kMargin + text_width(title, 13) + 10);
-  const double height = kPanel + 2.5 * kMargin;
-  std::ostringstream s;
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
-    << "\" font-family=\"sans-serif\" font-size=\"11\">\n"
-    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << kMargin << "\" y=\"18\" font-size=\"13\">" << xml_escape(title)
-    << "</text>\n"
-    << "<text x=\"" << kMargin << "\" y=\"34\">dots: runs; solid: 95% ellipse of the sample; "
-    << "dashed: 95% ellipse predicted by the closed form (both around the sample mean)</text>\n";
+  const std::string sub =
+      "dots: runs; solid: 95% ellipse of the sample; dashed: 95% ellipse predicted by the closed "
+      "form (both around the sample mean); ex-ey on equal scales";
+  std::ostringstream body;
+  body << std::setprecision(6);
+  double left = 20.0;  // the next panel's room for its y tick labels starts here
   for (int p = 0; p < 3; ++p) {
     Panel q;
     q.p = p;
     q.i = pairs[p][0];
     q.j = pairs[p][1];
-    q.mi = mean[q.i];
-    q.mj = mean[q.j];
-    q.ox = kMargin + p * (kPanel + kMargin);
-    q.oy = 1.5 * kMargin;
-    const auto pred = ellipse_points(predicted, q.i, q.j, q.mi, q.mj);
-    const auto samp = ellipse_points(sample, q.i, q.j, q.mi, q.mj);
-    half_range(q, pred, samp);
-    write_plot(s, q, errors, pred, samp);
-    write_axes(s, q);
-    s << "</g>\n";
+    const auto pred = ellipse_points(predicted, q.i, q.j, mean[q.i], mean[q.j]);
+    const auto samp = ellipse_points(sample, q.i, q.j, mean[q.i], mean[q.j]);
+    q.f = PlotFrame{0.0, kTop, kPanel, kPanel};
+    frame_ranges(q, pred, samp, mean[q.i], mean[q.j]);
+    q.f.left = left + y_tick_room(q.f, tick_step(q.f.y1 - q.f.y0), 11.0);
+    write_plot(body, q, errors, pred, samp);
+    left = q.f.left + kPanel + 10.0;
   }
-  s << "</svg>\n";
+  // Wide enough for the three panels and for the title lines, whatever their length.
+  const double width =
+      std::max({left + 10.0, 20.0 + text_width(title, 13) + 10, 20.0 + text_width(sub, 11.0) + 10});
+  const double height = kTop + kPanel + 50.0;
+  std::ostringstream s;
+  s << std::setprecision(6) << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width
+    << "\" height=\"" << height << "\" font-family=\"sans-serif\" font-size=\"11\">\n"
+    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+    << "<text x=\"20\" y=\"18\" font-size=\"13\">" << xml_escape(title) << "</text>\n"
+    << "<text x=\"20\" y=\"34\">" << xml_escape(sub) << "</text>\n"
+    << body.str() << "</svg>\n";
   return s.str();
 }
 

@@ -19,7 +19,7 @@ struct Param {
   const char* name;
   const char* label;
   const char* colour;
-  int shape;  // 0 circle, 1 square, 2 triangle
+  int shape;  // marker_svg: 0 circle, 1 square, 2 triangle
   double dx;  // [px]
 };
 constexpr Param kParams[3] = {{"c_l", "c_L", "#1f5fbf", 0, -6.0},
@@ -34,52 +34,29 @@ std::array<double, 2> rel_error(const SelfCalFitPoint& p, const calib::Factors& 
   return {100.0 * (est[i] - tr[i]) / tr[i], 100.0 * p.sigma[static_cast<std::size_t>(i)] / tr[i]};
 }
 
-// marker: shape s at (x, y), filled with the colour or open; `cls` names the series.
+// marker: the parameter's shape at (x, y), filled with its colour or open; `cls` names the series.
 void marker(std::ostream& s, double x, double y, const Param& p, bool filled,
             const char* cls = nullptr) {
   const std::string fill = filled ? p.colour : "white";
-  const std::string attrs = std::string(cls ? std::string(" class=\"") + cls + "\"" : "") +
-                            " fill=\"" + fill + "\" stroke=\"" + p.colour +
-                            "\" stroke-width=\"1.5\"";
-  if (p.shape == 0) {
-    s << "<circle cx=\"" << x << "\" cy=\"" << y << "\" r=\"4\"" << attrs << "/>\n";
-  } else if (p.shape == 1) {
-    s << "<rect x=\"" << x - 3.5 << "\" y=\"" << y - 3.5 << "\" width=\"7\" height=\"7\"" << attrs
-      << "/>\n";
-  } else {
-    s << "<path d=\"M" << x << "," << y - 4.5 << " L" << x + 4.5 << "," << y + 3.5 << " L"
-      << x - 4.5 << "," << y + 3.5 << " Z\"" << attrs << "/>\n";
-  }
+  marker_svg(s, p.shape, x, y,
+             std::string(cls ? std::string("class=\"") + cls + "\" " : "") + "fill=\"" + fill +
+                 "\" stroke=\"" + p.colour + "\" stroke-width=\"1.5\"");
 }
 
 // Axes: x in excursions [0, xmax], y in percent [-h, h], mapped to the plot area.
 struct Axes {
   double xmax, h;
-  double px(double v) const { return kLeft + kW * v / xmax; }
-  double py(double v) const { return kTop + kH * (0.5 - 0.5 * v / h); }
+  PlotFrame frame() const { return {kLeft, kTop, kW, kH, 0.0, xmax, -h, h}; }
+  double px(double v) const { return frame().px(v); }
+  double py(double v) const { return frame().py(v); }
 };
 
-// axes_svg: frame, grid, ticks with labels, the zero line and both axis titles.
+// axes_svg: frame, grid, ticks with labels, the zero line and both axis titles. 10 intervals at
+// most: at least 4 ticks on either axis; whole excursions on x.
 void axes_svg(std::ostream& s, const Axes& a) {
-  // 10 intervals at most: at least 4 ticks on either axis.
-  const double xs = std::max(1.0, tick_step(a.xmax, 10.0)), ys = tick_step(2.0 * a.h, 10.0);
-  for (double t = 0.0; t <= a.xmax + 1e-9; t += xs) {
-    s << "<line x1=\"" << a.px(t) << "\" y1=\"" << kTop << "\" x2=\"" << a.px(t) << "\" y2=\""
-      << kTop + kH + 5 << "\" stroke=\"#dddddd\"/>\n<text x=\"" << a.px(t) << "\" y=\""
-      << kTop + kH + 17 << "\" text-anchor=\"middle\">" << t << "</text>\n";
-  }
-  for (double t = std::ceil(-a.h / ys) * ys; t <= a.h + 1e-12; t += ys) {
-    const double v = std::fabs(t) < 1e-9 * ys ? 0.0 : t;  // no "-0"
-    s << "<line x1=\"" << kLeft - 5 << "\" y1=\"" << a.py(v) << "\" x2=\"" << kLeft + kW
-      << "\" y2=\"" << a.py(v) << "\" stroke=\"" << (v == 0.0 ? "#888888" : "#dddddd")
-      << "\"/>\n<text x=\"" << kLeft - 8 << "\" y=\"" << a.py(v) + 4 << "\" text-anchor=\"end\">"
-      << v << "</text>\n";
-  }
-  s << "<rect x=\"" << kLeft << "\" y=\"" << kTop << "\" width=\"" << kW << "\" height=\"" << kH
-    << "\" fill=\"none\" stroke=\"black\"/>\n<text x=\"" << kLeft + kW / 2 << "\" y=\""
-    << kTop + kH + 36 << "\" text-anchor=\"middle\">excursions driven when the fit ran</text>\n"
-    << "<text transform=\"translate(16," << kTop + kH / 2
-    << ") rotate(-90)\" text-anchor=\"middle\">(estimate - truth) / truth [%]</text>\n";
+  analysis::axes_svg(s, a.frame(), std::max(1.0, tick_step(a.xmax, 10.0)),
+                     tick_step(2.0 * a.h, 10.0), "excursions driven when the fit ran",
+                     "(estimate - truth) / truth [%]", kFont);
 }
 
 // axes_for: x up to the last fit's excursion count; y symmetric around 0, holding every

@@ -78,142 +78,122 @@ std::string format_umbmark_runs(const std::vector<calib::UmbmarkRun>& runs) {
 
 namespace {
 
+// Series: one set of runs drawn in a panel with its own marker.
 struct Series {
   const std::vector<calib::UmbmarkRun>* runs;
   calib::CentreOfGravity cw, ccw;
-  std::string label;
-  int shape;  // 0: open circle (before), 1..: filled circle, square, triangle, diamond
+  std::string label;  // legend text before the colon, the runs' tooltip, the class "run NAME"
+  std::string name;   // class of its markers: before, bumps, after-1 ..
+  int shape;          // marker_svg shape
+  bool filled;
+  bool bumps;  // the extended-UMBmark runs (no centres of gravity: Eq. 3.2 leaves them out)
 };
 
-constexpr double kSize = 520.0, kMargin = 60.0, kFont = 11.0;
+constexpr double kPanel = 400.0, kTop = 84.0, kLeft = 70.0, kFont = 11.0;
+constexpr int kBumpShape = 10;  // four-pointed star, open: no pass uses it
 constexpr const char* kCwColour = "#1f5fbf";
 constexpr const char* kCcwColour = "#c0392b";
 
-// marker: one run (with a tooltip `title`) or one legend sample (title empty) at (x, y) [px].
-void marker(std::ostringstream& s, double x, double y, int shape, const char* col,
-            const std::string& title = {}) {
-  auto close = [&](const char* tag) {
-    return title.empty() ? std::string("/>\n")
-                         : "><title>" + title + "</title></" + std::string(tag) + ">\n";
-  };
-  const std::string paint =
-      (shape == 0 ? std::string("fill=\"none\"") : std::string("fill=\"") + col + "\"") +
-      " stroke=\"" + col + "\"";
-  // Passes beyond the fourth reuse the filled shapes.
-  switch (shape == 0 ? 0 : 1 + (shape - 1) % 4) {
-    case 2:
-      s << "<rect x=\"" << x - 3.5 << "\" y=\"" << y - 3.5 << "\" width=\"7\" height=\"7\" "
-        << paint << close("rect");
-      break;
-    case 3:
-      s << "<path d=\"M" << x << "," << y - 4.5 << " L" << x + 4 << "," << y + 3 << " L" << x - 4
-        << "," << y + 3 << " Z\" " << paint << close("path");
-      break;
-    case 4:
-      s << "<path d=\"M" << x << "," << y - 4.5 << " L" << x + 4.5 << "," << y << " L" << x << ","
-        << y + 4.5 << " L" << x - 4.5 << "," << y << " Z\" " << paint << close("path");
-      break;
-    default:
-      s << "<circle cx=\"" << x << "\" cy=\"" << y << "\" r=\"3.5\" " << paint << close("circle");
-  }
+std::string paint(const Series& se, const char* col) {
+  return std::string("fill=\"") + (se.filled ? col : "none") + "\" stroke=\"" + col +
+         "\" class=\"run " + se.name + "\"";
 }
 
-// axes: frame, grid and labelled ticks of the symmetric view [-h, h] mm on both axes.
-void axes(std::ostringstream& s, double h) {
-  auto px = [&](double v) { return kMargin + kSize * (0.5 + 0.5 * v / h); };
-  auto py = [&](double v) { return kMargin + kSize * (0.5 - 0.5 * v / h); };
-  const double step = tick_step(2.0 * h);
-  const double first = std::ceil(-h / step) * step;
-  s << std::setprecision(6);
-  for (double v = first; v <= h + 1e-9 * step; v += step) {
-    const double t = std::fabs(v) < 1e-9 * step ? 0.0 : v;  // no "-0"
-    const char* grid = t == 0.0 ? "#999" : "#e4e4e4";
-    s << "<line x1=\"" << px(t) << "\" y1=\"" << kMargin << "\" x2=\"" << px(t) << "\" y2=\""
-      << kMargin + kSize << "\" stroke=\"" << grid << "\"/>\n<line x1=\"" << kMargin << "\" y1=\""
-      << py(t) << "\" x2=\"" << kMargin + kSize << "\" y2=\"" << py(t) << "\" stroke=\"" << grid
-      << "\"/>\n<line x1=\"" << px(t) << "\" y1=\"" << kMargin + kSize << "\" x2=\"" << px(t)
-      << "\" y2=\"" << kMargin + kSize + 5 << "\" stroke=\"black\"/>\n<line x1=\"" << kMargin - 5
-      << "\" y1=\"" << py(t) << "\" x2=\"" << kMargin << "\" y2=\"" << py(t)
-      << "\" stroke=\"black\"/>\n"
-      << "<text x=\"" << px(t) << "\" y=\"" << kMargin + kSize + 17 << "\" text-anchor=\"middle\">"
-      << t * 1e3 << "</text>\n<text x=\"" << kMargin - 8 << "\" y=\"" << py(t) + 4
-      << "\" text-anchor=\"end\">" << t * 1e3 << "</text>\n";
-  }
-  s << "<rect x=\"" << kMargin << "\" y=\"" << kMargin << "\" width=\"" << kSize << "\" height=\""
-    << kSize << "\" fill=\"none\" stroke=\"black\"/>\n<text x=\"" << kMargin + kSize / 2
-    << "\" y=\"" << kMargin + kSize + 36 << "\" text-anchor=\"middle\">ex [mm]</text>\n"
-    << "<text transform=\"translate(14," << kMargin + kSize / 2
-    << ") rotate(-90)\" text-anchor=\"middle\">ey [mm]</text>\n";
+// half_range: a symmetric view [-h, h] mm holding every run of the series, 15 % spare.
+double half_range(const std::vector<Series>& series) {
+  double h = 1e-3;
+  for (const Series& s : series)
+    for (const auto& run : *s.runs) h = std::max({h, std::fabs(run.ex), std::fabs(run.ey)});
+  return 1.15e3 * h;
 }
 
-// series_svg: every run of one set and its two centres of gravity (crosses).
-void series_svg(std::ostringstream& s, const Series& se, double h) {
-  auto px = [&](double v) { return kMargin + kSize * (0.5 + 0.5 * v / h); };
-  auto py = [&](double v) { return kMargin + kSize * (0.5 - 0.5 * v / h); };
-  for (const auto& run : *se.runs) {
-    if (run.bumps) continue;
-    marker(s, px(run.ex), py(run.ey), se.shape,
-           run.direction == calib::Direction::kCw ? kCwColour : kCcwColour, se.label);
-  }
-  for (const calib::CentreOfGravity* g : {&se.cw, &se.ccw}) {
-    const char* col = g == &se.cw ? kCwColour : kCcwColour;
-    const double x = px(g->x), y = py(g->y);
-    s << "<path d=\"M" << x - 7 << "," << y << " L" << x + 7 << "," << y << " M" << x << ","
-      << y - 7 << " L" << x << "," << y + 7 << "\" stroke=\"" << col << "\" stroke-width=\"2\"/>\n";
-  }
-}
-
-// legend_lines: one line a set ("before: r_cg cw 354 mm, ccw 352 mm").
-std::vector<std::string> legend_lines(const std::vector<Series>& series) {
-  std::vector<std::string> out;
+// panel_svg: the axes of one panel (equal scales: ex and ey are positions), every run of its
+// series and the centres of gravity (crosses) of the plain runs.
+void panel_svg(std::ostringstream& s, PlotFrame f, const std::string& title,
+               const std::vector<Series>& series) {
+  equal_scale(f);
+  const double step = tick_step(f.x1 - f.x0);
+  s << "<g class=\"panel\">\n<text x=\"" << f.left << "\" y=\"" << f.top - 8 << "\">"
+    << xml_escape(title) << "</text>\n";
+  axes_svg(s, f, step, step, "ex [mm]", "ey [mm]", kFont);
   for (const Series& se : series) {
-    std::ostringstream t;
+    for (const auto& run : *se.runs) {
+      if (run.bumps != se.bumps) continue;
+      const char* col = run.direction == calib::Direction::kCw ? kCwColour : kCcwColour;
+      marker_svg(s, se.shape, f.px(run.ex * 1e3), f.py(run.ey * 1e3), paint(se, col), se.label);
+    }
+    if (se.bumps) continue;
+    for (const calib::CentreOfGravity* g : {&se.cw, &se.ccw}) {
+      const char* col = g == &se.cw ? kCwColour : kCcwColour;
+      const double x = f.px(g->x * 1e3), y = f.py(g->y * 1e3);
+      s << "<path class=\"cg\" d=\"M" << x - 7 << "," << y << " L" << x + 7 << "," << y << " M" << x
+        << "," << y - 7 << " L" << x << "," << y + 7 << "\" stroke=\"" << col
+        << "\" stroke-width=\"2\"/>\n";
+    }
+  }
+  s << "</g>\n";
+}
+
+// legend_line: "before: r_cg cw 354 mm, ccw 352 mm" (bump runs: how many).
+std::string legend_line(const Series& se) {
+  std::ostringstream t;
+  if (se.bumps) {
+    t << se.label << ": " << se.runs->size() << " (10 bumps each; not in the centres of gravity)";
+  } else {
     t << std::setprecision(4) << se.label << ": r_cg cw " << se.cw.r * 1e3 << " mm, ccw "
       << se.ccw.r * 1e3 << " mm";
-    out.push_back(t.str());
   }
-  return out;
+  return t.str();
 }
 
 }  // namespace
 
 std::string umbmark_svg(const UmbmarkSimResult& r, const std::string& title) {
-  std::vector<Series> series;
   const auto& p0 = r.passes.front().before;
-  series.push_back({&p0.runs, p0.cw, p0.ccw, "before", 0});
+  std::vector<Series> before{{&p0.runs, p0.cw, p0.ccw, "before", "before", 0, false, false}};
+  if (!r.bump_runs.empty())
+    before.push_back({&r.bump_runs, {}, {}, "bump runs", "bumps", kBumpShape, false, true});
+  std::vector<Series> after;
   for (std::size_t i = 0; i < r.passes.size(); ++i) {
     const auto& a = r.passes[i].after;
-    series.push_back(
-        {&a.runs, a.cw, a.ccw, "after pass " + std::to_string(i + 1), static_cast<int>(i) + 1});
+    const std::string k = std::to_string(i + 1);
+    after.push_back({&a.runs, a.cw, a.ccw, "after pass " + k, "after-" + k,
+                     static_cast<int>(i) % kMarkerShapes, true, false});
   }
-  // Symmetric square view around the origin, in mm, big enough for every run.
-  double h = 1e-3;
-  for (const Series& s : series)
-    for (const auto& run : *s.runs) h = std::max({h, std::fabs(run.ex), std::fabs(run.ey)});
-  h *= 1.15;
+  // Two panels, each on its own scale: the after-clusters are ten times tighter than the
+  // before-clusters and would be a dot in their frame.
+  const double hb = half_range(before), ha = half_range(after);
+  const PlotFrame fb{kLeft, kTop, kPanel, kPanel, -hb, hb, -hb, hb};
+  PlotFrame fa{0.0, kTop, kPanel, kPanel, -ha, ha, -ha, ha};
+  fa.left = kLeft + kPanel + 20 + y_tick_room(fa, tick_step(2 * ha), kFont);
   const std::string sub1 = "return errors ex, ey [mm] (truth - odometry, start frame)";
   const std::string sub2 =
-      "blue cw, red ccw; open: before, filled: after each pass; crosses: centres of gravity";
-  const std::vector<std::string> legend = legend_lines(series);
-  // The canvas holds the plot, the legend to its right and the title lines, whatever their length.
-  const double legend_x = kMargin + kSize + 30;
+      "blue cw, red ccw; one marker a set; crosses: centres of gravity; each panel its own scale";
+  std::vector<const Series*> all;
+  for (const auto* v : {&before, &after})
+    for (const Series& se : *v) all.push_back(&se);
+  // The canvas holds both panels, the legend to their right and the title lines.
+  const double legend_x = fa.left + kPanel + 30;
   double width = legend_x;
-  for (const std::string& l : legend) width = std::max(width, legend_x + 16 + text_width(l, kFont));
-  width =
-      std::max({width, kMargin + text_width(title, 13), kMargin + text_width(sub2, kFont)}) + 10;
+  for (const Series* se : all)
+    width = std::max(width, legend_x + 16 + text_width(legend_line(*se), kFont));
+  width = std::max({width, kLeft + text_width(title, 13), kLeft + text_width(sub2, kFont)}) + 10;
   std::ostringstream s;
   s << std::setprecision(6) << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width
-    << "\" height=\"" << kSize + 2 * kMargin << "\" font-family=\"sans-serif\" font-size=\""
-    << kFont << "\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"" << kMargin
-    << "\" y=\"18\" font-size=\"13\">" << xml_escape(title) << "</text>\n<text x=\"" << kMargin
-    << "\" y=\"34\">" << sub1 << "</text>\n<text x=\"" << kMargin << "\" y=\"48\">" << sub2
+    << "\" height=\"" << kTop + kPanel + 50 << "\" font-family=\"sans-serif\" font-size=\"" << kFont
+    << "\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"" << kLeft
+    << "\" y=\"18\" font-size=\"13\">" << xml_escape(title) << "</text>\n<text x=\"" << kLeft
+    << "\" y=\"34\">" << sub1 << "</text>\n<text x=\"" << kLeft << "\" y=\"48\">" << sub2
     << "</text>\n";
-  axes(s, h);
-  for (std::size_t i = 0; i < series.size(); ++i) {
-    series_svg(s, series[i], h);
-    const double y = kMargin + 10 + 18 * static_cast<double>(i);
-    marker(s, legend_x + 4, y - 4, series[i].shape, kCwColour);
-    s << "<text x=\"" << legend_x + 16 << "\" y=\"" << y << "\">" << xml_escape(legend[i])
+  panel_svg(s, fb, "before: the first pass's input (uncalibrated)", before);
+  panel_svg(s, fa, "after each pass: the verification sets", after);
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const double y = kTop + 10 + 18 * static_cast<double>(i);
+    const Series& se = *all[i];
+    std::string legend_paint = paint(se, kCwColour);
+    legend_paint = legend_paint.substr(0, legend_paint.find(" class="));
+    marker_svg(s, se.shape, legend_x + 4, y - 4, legend_paint);
+    s << "<text x=\"" << legend_x + 16 << "\" y=\"" << y << "\">" << xml_escape(legend_line(se))
       << "</text>\n";
   }
   s << "</svg>\n";

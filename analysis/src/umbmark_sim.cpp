@@ -100,6 +100,7 @@ struct Driver {
     s.cw = calib::centre_of_gravity(s.runs, Direction::kCw);
     s.ccw = calib::centre_of_gravity(s.runs, Direction::kCcw);
     s.e_max_syst = calib::e_max_syst(s.cw, s.ccw);
+    s.spread = calib::set_spread(s.runs, s.cw, s.ccw);
     return s;
   }
 };

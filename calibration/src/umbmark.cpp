@@ -104,6 +104,16 @@ bool second_pass_recommended(double e_max, double sem) {
   return e_max > 3.0 * sem;
 }
 
+SetSpread set_spread(std::span<const UmbmarkRun> runs, const CentreOfGravity& cw,
+                     const CentreOfGravity& ccw) {
+  SetSpread s;
+  s.sigma = return_spread(runs, cw, ccw);
+  // The c.g. with fewer runs is the less certain one: SEM with the smaller n.
+  if (s.sigma) s.sem = *s.sigma / std::sqrt(std::min(cw.n, ccw.n));
+  s.worthwhile = second_pass_recommended(e_max_syst(cw, ccw), s.sem);
+  return s;
+}
+
 Result<std::optional<double>> eps_theta_nonsys(std::span<const UmbmarkRun> runs) {
   std::optional<double> total;
   for (Direction d : {Direction::kCw, Direction::kCcw}) {
@@ -185,10 +195,7 @@ Result<UmbmarkResult> umbmark_compute(const UmbmarkInput& in) {
     if (!(v >= L::kFactorMin && v <= L::kFactorMax))
       return factor_range(std::string("resulting ") + f, v);
   }
-  out.sigma = return_spread(in.runs, out.cw, out.ccw);
-  // The c.g. with fewer runs is the less certain one: SEM with the smaller n.
-  if (out.sigma) out.sem = *out.sigma / std::sqrt(std::min(out.cw.n, out.ccw.n));
-  out.second_pass = second_pass_recommended(out.e_max_syst, out.sem);
+  out.spread = set_spread(in.runs, out.cw, out.ccw);
   auto eps = eps_theta_nonsys(in.runs);
   if (!eps) return std::move(eps).error();
   out.eps_theta_nonsys = *eps;

@@ -4,6 +4,10 @@
 # canvas. The rendering part is skipped (exit 77, after the other checks) without rsvg-convert.
 # The self-calibration's convergence plot (issue 18): one marker per fit and parameter, filled
 # for the applied ones, as many as --json counts; a bad --plot path refused before any work.
+# Issue 35 item 5 (check_svg_axes.py on every plot): each panel has labelled ticks and a grid on
+# both axes, equal scales where both axes are positions (ex-ey), every text inside the canvas;
+# the UMBmark plot has the after-clusters in their own panel, the bump runs drawn and a marker
+# of its own for every one of 10 passes.
 set -u
 . "$(dirname "$0")/lib.sh"  # run, check, $tmp
 
@@ -11,6 +15,9 @@ run "$ODOMCTL" umbmark simulate --runs 3 --passes 3 --noise paper --plot "$tmp/u
 check "simulate --passes 3 --plot exit 0" $?
 run "$ODOMCTL" umbmark simulate --runs 2 --passes 1 --side 0.5 --plot "$tmp/u1.svg" >/dev/null 2>&1
 check "simulate --side 0.5 --plot exit 0" $?
+run "$ODOMCTL" umbmark simulate --runs 2 --passes 10 --bumps --noise paper --plot "$tmp/u10.svg" \
+  >/dev/null 2>&1
+check "simulate --passes 10 --bumps --plot exit 0" $?
 run "$ODOMCTL" errormodel validate --runs 50 --plot "$tmp/e.svg" >/dev/null 2>&1
 check "errormodel validate --plot exit 0" $?
 run "$ODOMCTL" selfcal simulate --excursions 10 --min-fixes 3 --fit-every 1 --score-runs 5 \
@@ -63,9 +70,23 @@ assert 'fill="none" stroke=' in s and "<rect x=" in s and " Z\" fill=" in s, "ma
 PY
 check "umbmark plot: ticks on both axes, every pass in the legend and with its own marker" $?
 
+axes="$(dirname "$0")/check_svg_axes.py"
+python3 "$axes" "$tmp/u10.svg" --umbmark 10 bumps
+check "u10.svg: two panels, before and bump runs left, 10 passes right, 12 distinct markers, axes" $?
+python3 "$axes" "$tmp/u3.svg" --umbmark 3 && python3 "$axes" "$tmp/u1.svg"
+check "u3.svg, u1.svg: ticks, grid, equal scales, text inside" $?
+python3 "$axes" "$tmp/e.svg" && python3 - "$tmp/e.svg" <<'PY'
+import sys
+s = open(sys.argv[1]).read()
+assert s.count('<g class="panel">') == 3 and 'class="axis-x" ' in s, "three panels"
+PY
+check "e.svg (errormodel validate --plot): three panels with ticks and grid, ex-ey equal scales" $?
+python3 "$axes" "$tmp/s.svg"
+check "s.svg (selfcal simulate --plot): ticks and grid on both axes, text inside" $?
+
 # Without a renderer: every unrotated text's extent, estimated at 0.55 em a character (DejaVu
 # Sans averages about 0.55 em; a renderer check follows below), lies inside the canvas.
-for f in u3 u1 e s; do
+for f in u3 u1 u10 e s; do
   python3 - "$tmp/$f.svg" <<'PY'
 import re, sys
 s = open(sys.argv[1]).read()
@@ -137,7 +158,7 @@ out = [(x, y) for y in range(H) for x in range(W)
 assert not out, "%d pixels outside the canvas, e.g. %s" % (len(out), out[:5])
 PY
 }
-for f in u3 u1 e s; do
+for f in u3 u1 u10 e s; do
   inside "$tmp/$f.svg"
   check "$f.svg: nothing drawn outside the canvas" $?
 done

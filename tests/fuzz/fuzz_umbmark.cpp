@@ -34,10 +34,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     require(named, "compute error does not name the field:", m);
     return 0;
   }
-  for (double v :
-       {r->cw.x, r->cw.y, r->ccw.x, r->ccw.y, r->e_max_syst, r->ab.alpha, r->ab.beta, r->e_d,
-        r->e_b, r->composed.c_l, r->composed.c_r, r->composed.wheelbase, r->sem,
-        r->sigma.value_or(0.0), r->eps_theta_nonsys.value_or(0.0), r->radius.value_or(0.0)}) {
+  for (double v : {r->cw.x, r->cw.y, r->ccw.x, r->ccw.y, r->e_max_syst, r->ab.alpha, r->ab.beta,
+                   r->e_d, r->e_b, r->composed.c_l, r->composed.c_r, r->composed.wheelbase,
+                   r->spread.sem, r->spread.sigma.value_or(0.0), r->eps_theta_nonsys.value_or(0.0),
+                   r->radius.value_or(0.0)}) {
     require(std::isfinite(v), "accepted input gave a non-finite result");
   }
   require(r->e_d > 0.0 && r->e_b > 0.0 && r->composed.wheelbase > 0.0, "non-positive factor");

@@ -98,9 +98,9 @@ TEST(UmbmarkSim, PaperNoiseSpreadsTheReturnPositions) {
   o.seed = 1;
   const auto r = simulate(o);
   const calib::UmbmarkResult& u = r.passes[0].result;
-  ASSERT_TRUE(u.sigma.has_value());
-  EXPECT_GT(*u.sigma, 0.0125);
-  EXPECT_LT(*u.sigma, 0.050);
+  ASSERT_TRUE(u.spread.sigma.has_value());
+  EXPECT_GT(*u.spread.sigma, 0.0125);
+  EXPECT_LT(*u.spread.sigma, 0.050);
   EXPECT_GE(r.improvement, 5.0);
 }
 
@@ -161,25 +161,47 @@ TEST(UmbmarkFloor, BumpsOnlyOnTheFirstLegUnderTheChosenWheel) {
   EXPECT_EQ(r, 0.01);
 }
 
+// occurrences: how often `what` occurs in `text` (overlaps counted).
+std::size_t occurrences(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t p = text.find(what); p != std::string::npos; p = text.find(what, p + 1)) ++n;
+  return n;
+}
+
 TEST(UmbmarkSvg, PlotHasEveryRunAndCentreOfGravity) {
   analysis::UmbmarkSimOptions o;
   o.runs = 2;
   o.passes = 2;
   const auto r = simulate(o);
   const std::string svg = analysis::umbmark_svg(r, "t & t");
-  const auto count = [&svg](const std::string& what) {
-    std::size_t n = 0;
-    for (std::size_t p = svg.find(what); p != std::string::npos; p = svg.find(what, p + 1)) ++n;
-    return n;
-  };
+  const auto count = [&svg](const std::string& what) { return occurrences(svg, what); };
   // One marker per run, each with its set as tooltip (each pass has its own marker shape, so
   // the runs are counted by their tooltips): before + 2 verification sets, 2 + 2 runs each.
   EXPECT_EQ(count("<title>"), 3U * 4U);
   EXPECT_EQ(count("<title>before</title>"), 4U);
   EXPECT_EQ(count("<title>after pass 1</title>"), 4U);
   EXPECT_EQ(count("<title>after pass 2</title>"), 4U);
-  EXPECT_EQ(count("<path"), 3U * 2U);  // a cw and a ccw c.g. cross per set
+  // A cw and a ccw c.g. cross per set (markers are paths too: the crosses have their class).
+  EXPECT_EQ(count("<path class=\"cg\""), 3U * 2U);
   EXPECT_NE(svg.find("t &amp; t"), std::string::npos);
+  // Two panels (before; after each pass), each with its own axes.
+  EXPECT_EQ(count("<g class=\"panel\">"), 2U);
+  EXPECT_EQ(count("class=\"axis-x\""), 2U);
+}
+
+TEST(UmbmarkSvg, BumpRunsAreDrawnWithoutCentreOfGravity) {
+  analysis::UmbmarkSimOptions o;
+  o.runs = 2;
+  o.bumps = true;
+  const auto r = simulate(o);
+  const std::string svg = analysis::umbmark_svg(r, "t");
+  const auto count = [&svg](const std::string& what) { return occurrences(svg, what); };
+  // 2 cw + 2 ccw bump runs, each a marker with its tooltip; c.g. crosses only for the two
+  // sets of plain runs (Eq. 3.2 leaves the bump runs out); one legend line for them.
+  ASSERT_EQ(r.bump_runs.size(), 4U);
+  EXPECT_EQ(count("<title>bump runs</title>"), 4U);
+  EXPECT_EQ(count("<path class=\"cg\""), 2U * 2U);
+  EXPECT_EQ(count(">bump runs: 4 "), 1U);
 }
 
 }  // namespace

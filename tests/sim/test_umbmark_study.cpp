@@ -29,9 +29,12 @@ TEST(UmbmarkStudy, PaperNoiseTwentySeeds) {
     const auto& p1 = r->passes[0];
     const auto& p2 = r->passes[1];
     improve.push_back(p1.before.e_max_syst / p1.after.e_max_syst);
-    sigma.push_back(p1.result.sigma.value_or(0.0));
-    // Pass 2's input is pass 1's verification set: its 3 x SEM verdict decides about pass 2.
-    (p2.result.second_pass ? gain_asked : gain_not_asked)
+    sigma.push_back(p1.before.spread.sigma.value_or(0.0));
+    // Pass 2's input is pass 1's verification set: its 3 x SEM verdict decides about pass 2,
+    // and it is the verdict pass 1 reports beside its "after" figures.
+    EXPECT_EQ(p1.after.spread.worthwhile, p2.result.spread.worthwhile);
+    EXPECT_EQ(p1.before.spread.sem, p1.result.spread.sem);
+    (p1.after.spread.worthwhile ? gain_asked : gain_not_asked)
         .push_back(p2.before.e_max_syst / p2.after.e_max_syst);
   }
   // Issue 3: the median one-pass improvement is at least 10-fold.

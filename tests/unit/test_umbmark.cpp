@@ -158,6 +158,37 @@ TEST(Umbmark, SpreadAndThreeSemRule) {
   EXPECT_FALSE(second_pass_recommended(0.021, sem));
 }
 
+TEST(Umbmark, SetSpreadJudgesTheSetItIsComputedOn) {
+  // The runs above: c.g. cw (1, 0) mm, ccw (0, 12) mm -> E_max,syst 12 mm; sigma sqrt(5) mm,
+  // n = 2 a direction: SEM = sqrt(5)/sqrt(2) = 1.5811388 mm, 3 SEM = 4.74 mm < 12 mm.
+  const std::vector<UmbmarkRun> runs{cw(0, 0), cw(0.002, 0), ccw(0, 0.010), ccw(0, 0.014)};
+  const auto g_cw = centre_of_gravity(runs, Direction::kCw);
+  const auto g_ccw = centre_of_gravity(runs, Direction::kCcw);
+  const SetSpread s = set_spread(runs, g_cw, g_ccw);
+  ASSERT_TRUE(s.sigma.has_value());
+  EXPECT_NEAR(*s.sigma, 2.2360680e-3, 1e-9);
+  EXPECT_NEAR(s.sem, 1.5811388e-3, 1e-9);
+  EXPECT_TRUE(s.worthwhile);
+  // A set whose c.g. sit within the noise: cw (0, 0), (2, 0) mm -> (1, 0); ccw (0, -1), (0, 1)
+  // mm -> (0, 0): E_max,syst 1 mm; squared distances 1 + 1 + 1 + 1 = 4 mm^2 over 2: sigma =
+  // sqrt(2) mm, SEM = sqrt(2)/sqrt(2) = 1 mm, 3 SEM = 3 mm > 1 mm: no pass on these runs.
+  const std::vector<UmbmarkRun> quiet{cw(0, 0), cw(0.002, 0), ccw(0, -0.001), ccw(0, 0.001)};
+  const SetSpread q = set_spread(quiet, centre_of_gravity(quiet, Direction::kCw),
+                                 centre_of_gravity(quiet, Direction::kCcw));
+  EXPECT_NEAR(*q.sigma, 1.4142136e-3, 1e-9);
+  EXPECT_NEAR(q.sem, 1e-3, 1e-12);
+  EXPECT_FALSE(q.worthwhile);
+  // umbmark_compute reports the spread of its own input runs.
+  UmbmarkInput in;
+  in.runs = quiet;
+  in.side = 4.0;
+  in.current = {1.0, 1.0, 0.34};
+  auto r = umbmark_compute(in);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_NEAR(r->spread.sem, 1e-3, 1e-12);
+  EXPECT_FALSE(r->spread.worthwhile);
+}
+
 TEST(Umbmark, ExtendedUmbmarkRemovesTheSystematicBias) {
   // cw plain etheta 0.01, 0.02 -> mu_cw = 0.015 (Eq. 3.6); cw bump runs 0.025, 0.005 ->
   // |0.010|, |-0.010| -> mean 0.010. ccw plain -0.004, -0.006 -> mu_ccw = -0.005; ccw bump runs
@@ -197,8 +228,8 @@ TEST(Umbmark, ComputeEndToEnd) {
   EXPECT_NEAR(r->composed.wheelbase, 0.342178375, 1e-9);
   // One run a direction: warned about, and no spread (second pass on the safe side).
   EXPECT_EQ(r->warnings.size(), 2U);
-  EXPECT_FALSE(r->sigma.has_value());
-  EXPECT_TRUE(r->second_pass);
+  EXPECT_FALSE(r->spread.sigma.has_value());
+  EXPECT_TRUE(r->spread.worthwhile);
   // With factors already in use the result composes: c_L = 1.002 * 0.999915 = 1.001914830.
   in.current = {1.002, 0.998, 0.34};
   auto r2 = umbmark_compute(in);

@@ -110,7 +110,8 @@ void write_run_errors(std::ostream& out, const std::vector<PoseError>& e);
 Result<FitResult> fit_error_model(const std::vector<PoseError>& errors, double d, double b);
 
 // error_ellipse_svg: three panels (ex-ey, ex-etheta, ey-etheta) with the runs as dots and the 95%
-// ellipses of the sample (solid) and predicted (dashed) covariances around the sample mean.
+// ellipses of the sample (solid) and predicted (dashed) covariances around the sample mean; ticks
+// and a grid on both axes of each panel, ex-ey (both positions) on equal scales.
 std::string error_ellipse_svg(const std::vector<PoseError>& errors, const Cov3& predicted,
                               const Cov3& sample, const PoseError& mean, const std::string& title);
 

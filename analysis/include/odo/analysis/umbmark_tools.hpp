@@ -82,6 +82,7 @@ struct UmbmarkRunSet {
   std::vector<calib::UmbmarkRun> runs;  // return errors (with etheta)
   calib::CentreOfGravity cw, ccw;
   double e_max_syst = 0.0;  // [m]
+  calib::SetSpread spread;  // sigma, SEM and the 3 x SEM verdict of these runs
 };
 
 struct UmbmarkSimPass {
@@ -121,8 +122,9 @@ Status check_umbmark_sim_options(const UmbmarkSimOptions& o);
 Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
                                                 const std::function<void(int, int)>& progress = {});
 
-// umbmark_svg: the ex-ey plane [mm] with every run of the first "before" set and of each
-// verification set, cw and ccw, and their centres of gravity.
+// umbmark_svg: two ex-ey panels [mm], each on its own equal-scale frame with ticks and a grid:
+// the first "before" set with its bump runs, and every pass's verification set (a marker shape
+// of its own for each of up to 10 passes); cw and ccw, and the centres of gravity.
 std::string umbmark_svg(const UmbmarkSimResult& r, const std::string& title);
 
 }  // namespace odo::analysis

@@ -116,9 +116,25 @@ Factors compose(const Factors& current, const PassFactors& pass);
 std::optional<double> return_spread(std::span<const UmbmarkRun> runs, const CentreOfGravity& cw,
                                     const CentreOfGravity& ccw);
 
-// second_pass_recommended: the report's rule of thumb: a second pass is worthwhile when
-// E_max,syst [m] > 3 * SEM [m] (SEM = sigma / sqrt(n)).
+// second_pass_recommended: the report's rule of thumb (Sec. 6.3): a second pass is worthwhile
+// when E_max,syst [m] of the compensated robot's runs > 3 * SEM [m] of the same runs
+// (SEM = sigma / sqrt(n)).
 bool second_pass_recommended(double e_max_syst, double sem);
+
+// SetSpread: the 3 x SEM rule applied to one set of runs, all three figures of that set.
+struct SetSpread {
+  std::optional<double> sigma;  // [m], see return_spread()
+  double sem = 0.0;             // sigma / sqrt(min(n_cw, n_ccw)) [m] (0 without sigma)
+  // E_max,syst > 3 SEM of this set: a (further) pass computed from these runs is worthwhile.
+  // On a verification set this is the report's "second compensation" question. Without sigma
+  // (fewer than 3 runs) true: the safe side.
+  bool worthwhile = true;
+};
+
+// set_spread: sigma [m], SEM [m] and the 3 x SEM verdict of the plain runs of one set whose
+// centres of gravity are cw, ccw.
+SetSpread set_spread(std::span<const UmbmarkRun> runs, const CentreOfGravity& cw,
+                     const CentreOfGravity& ccw);
 
 // eps_theta_nonsys: extended UMBmark (Eq. 3.5/3.6 as reconstructed, see README): the mean of
 // |etheta_i - mu_dir| over the bump runs of each direction, summed over the directions that have
@@ -143,9 +159,7 @@ struct UmbmarkResult {
   double e_b = 1.0;              // Eq. 6.29 (or C&K Eq. 9)
   PassFactors pass;              // this pass alone: c_L, c_R (Eq. 6.33/6.34) and E_b
   Factors composed;              // what to use from now on: c_l, c_r, b_new [m] (Eq. 6.28)
-  std::optional<double> sigma;   // [m], see return_spread()
-  double sem = 0.0;              // sigma / sqrt(min(n_cw, n_ccw)) [m] (0 without sigma)
-  bool second_pass = true;       // E_max,syst > 3 SEM
+  SetSpread spread;              // of the input runs: whether a pass on them is worthwhile
   std::optional<double> eps_theta_nonsys;  // [rad]
   std::vector<std::string> warnings;       // e.g. fewer than 5 runs a direction
 };
