@@ -90,6 +90,13 @@ void run_decode(const DecodeOpts& o, int& exit_code) {
   while (std::getline(in, line)) {
     ++n;
     if (line.empty() || line == "\r") continue;
+    // A last line without its newline is a line still being written (a log tailed while
+    // candump or odometryd --can-log writes it): not a frame yet, and not an error.
+    if (in.eof()) {
+      std::cerr << "odomctl decode: " << o.file << ":" << n
+                << ": the last line has no newline yet (still being written?): left out\n";
+      break;
+    }
     auto p = protocol::parse_candump_line(line);
     if (!p) {
       std::cerr << "odomctl decode: " << o.file << ":" << n << ": " << p.error().message << "\n";

@@ -2,11 +2,16 @@
 // from the daemon's CAN broadcast (read from the bus, or from a candump -L log being written),
 // the person types only what the tape gives; the return errors are computed here and saved
 // after every run.
+#include <signal.h>
+#include <sys/stat.h>
+
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <ctime>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -14,6 +19,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -74,40 +80,163 @@ class PosePairer {
   int x_seq_ = -1;
 };
 
+// interrupted: set by SIGINT (Ctrl-C); the session then ends as at the end of its input.
+volatile std::sig_atomic_t interrupted = 0;
+
+extern "C" void on_interrupt(int) {
+  interrupted = 1;
+}
+
+// catch_interrupt: Ctrl-C interrupts the read of an answer (no SA_RESTART) instead of killing
+// the process, so that the session says what Ctrl-D says (runs saved, the same command resumes).
+void catch_interrupt() {
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;
+  sigaction(SIGINT, &sa, nullptr);
+}
+
+// PoseReading: a pose read at an Enter, and the odometry's path length since the read before
+// [m] when the feed saw every pose in between (a log does; the bus queue does not).
+struct PoseReading {
+  Pose2 pose;
+  std::optional<double> path;
+};
+
 // PoseFeed: where the daemon's current pose is read from.
 class PoseFeed {
  public:
   virtual ~PoseFeed() = default;
   // latest: the daemon's newest pose [m, m, rad], or why there is none.
-  virtual Result<Pose2> latest() = 0;
+  virtual Result<PoseReading> latest() = 0;
 };
 
-// LogPoseFeed: the newest complete pose in a candump -L log that is being written.
+double wall_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+std::string seconds_text(double s) {
+  std::ostringstream t;
+  t << std::fixed << std::setprecision(1) << s << " s";
+  return t.str();
+}
+
+// LogPoseFeed: the daemon's pose from a candump -L log that is being written. Each read goes on
+// from where the last one ended (a log started again from empty is read from its start); a
+// partial last line is left for the next read. A pose counts only when its own time stamp is
+// at most kMaxAge before the Enter; the newest Status frame tells a stopped daemon.
 class LogPoseFeed final : public PoseFeed {
  public:
-  LogPoseFeed(std::string path, std::uint32_t base_id, int node)
-      : path_(std::move(path)), base_id_(base_id), node_(node) {}
+  static constexpr double kMaxAge = 0.5;  // [s] a pose older than the Enter by more: stale
+  static constexpr double kWait = 3.0;    // [s] for a fresh pose: pose_hz >= 0.5 is enough
 
-  Result<Pose2> latest() override {
-    std::ifstream in(path_, std::ios::binary);
-    if (!in) return make_error(Errc::kIo, path_ + ": cannot open (is candump -L running?)");
-    PosePairer pairer(base_id_, node_);
-    std::optional<Pose2> pose;
-    for (std::string line; std::getline(in, line);) {
-      auto l = protocol::parse_candump_line(line);
-      if (!l) continue;
-      if (auto p = pairer.take(l->frame)) pose = p;
+  LogPoseFeed(std::string path, std::uint32_t base_id, int node)
+      : path_(std::move(path)), base_id_(base_id), node_(node), pairer_(base_id, node) {}
+
+  Result<PoseReading> latest() override {
+    const double asked = wall_now();
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(kWait);
+    for (;;) {
+      if (auto st = read_on(); !st) return std::move(st).error();
+      if (stopping_) return stopped(asked);
+      if (pose_ && pose_stamp_ >= asked - kMaxAge) {
+        PoseReading r{*pose_, path_complete_ ? std::optional(path_since_) : std::nullopt};
+        path_since_ = 0.0;
+        path_complete_ = true;
+        return r;
+      }
+      if (interrupted || std::chrono::steady_clock::now() >= deadline) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
-    if (!pose)
-      return make_error(Errc::kIo,
-                        path_ + ": no pose frames of node " + std::to_string(node_) + " yet");
-    return *pose;
+    return stale(asked);
   }
 
  private:
+  // read_on: the lines added since the last read; a replaced or emptied log is read anew.
+  Status read_on() {
+    struct stat st {};
+    if (::stat(path_.c_str(), &st) != 0)
+      return make_error(Errc::kIo, path_ + ": cannot open (is odometryd --can-log " + path_ +
+                                       " or candump -L running?)");
+    if (st.st_ino != inode_ || static_cast<std::uint64_t>(st.st_size) < offset_) restart(st.st_ino);
+    std::ifstream in(path_, std::ios::binary);
+    if (!in) return make_error(Errc::kIo, path_ + ": cannot open");
+    in.seekg(static_cast<std::streamoff>(offset_));
+    for (std::string line; std::getline(in, line);) {
+      if (in.eof()) break;  // a partial last line: read again, whole, next time
+      offset_ += line.size() + 1;
+      take_line(line);
+    }
+    return Ok{};
+  }
+
+  // restart: the log read from its start; a log replaced or emptied after the first read (the
+  // daemon started again, a capture rotated) hides the path in between: unknown, not 0.
+  void restart(ino_t inode) {
+    if (inode_ != 0) path_complete_ = false;
+    inode_ = inode;
+    offset_ = 0;
+    pairer_ = PosePairer(base_id_, node_);
+    pose_.reset();
+    stopping_ = false;
+    status_stamp_ = -1.0;
+    path_since_ = 0.0;
+  }
+
+  // take_line: one whole line; lines that are not the node's pose or status are skipped.
+  void take_line(std::string_view line) {
+    auto l = protocol::parse_candump_line(line);
+    if (!l) return;
+    const double stamp = static_cast<double>(l->sec) + 1e-6 * l->usec;
+    int n = 0;
+    protocol::Msg m{};
+    protocol::StatusMsg status;
+    if (protocol::split_id(base_id_, l->frame, n, m) && n == node_ && m == protocol::Msg::kStatus &&
+        protocol::decode_status(l->frame, status)) {
+      stopping_ = status.stopping;
+      status_stamp_ = stamp;
+      return;
+    }
+    if (auto p = pairer_.take(l->frame)) {
+      if (pose_) path_since_ += std::hypot(p->x - pose_->x, p->y - pose_->y);
+      pose_ = p;
+      pose_stamp_ = stamp;
+    }
+  }
+
+  Error stopped(double asked) const {
+    return make_error(Errc::kIo, path_ + ": odometryd has stopped (its last Status frame, " +
+                                     seconds_text(asked - status_stamp_) +
+                                     " old, says stopping): start it again with --can-log " +
+                                     path_);
+  }
+
+  Error stale(double asked) const {
+    std::string m = path_ + ": ";
+    if (!pose_)
+      m += "no pose frames of node " + std::to_string(node_) + " within " + seconds_text(kWait);
+    else
+      m += "the newest pose is " + seconds_text(asked - pose_stamp_) + " old (at most " +
+           seconds_text(kMaxAge) + " is taken)";
+    if (status_stamp_ >= 0.0)
+      m += ", the newest Status frame " + seconds_text(asked - status_stamp_) + " old";
+    return make_error(Errc::kIo, m + ": is odometryd running with --can-log " + path_ +
+                                     " (or candump -L writing it)? Start it");
+  }
+
   std::string path_;
   std::uint32_t base_id_;
   int node_;
+  PosePairer pairer_;
+  ino_t inode_ = 0;
+  std::uint64_t offset_ = 0;  // bytes of whole lines read
+  std::optional<Pose2> pose_;
+  double pose_stamp_ = 0.0;     // [s] wall clock of the log
+  double status_stamp_ = -1.0;  // [s], < 0: no Status frame yet
+  bool stopping_ = false;
+  double path_since_ = 0.0;    // [m] odometry path since the last reading
+  bool path_complete_ = true;  // every pose since the last reading was read
 };
 
 // BusPoseFeed: the next complete pose the daemon broadcasts on a SocketCAN interface.
@@ -125,7 +254,7 @@ class BusPoseFeed final : public PoseFeed {
     return std::unique_ptr<PoseFeed>(new BusPoseFeed(iface, std::move(bus).value(), base_id, node));
   }
 
-  Result<Pose2> latest() override {
+  Result<PoseReading> latest() override {
     // What waits in the socket was queued while the person measured: old, and once the queue
     // is full the kernel drops the newest frames. Empty it, then take the next complete pair.
     CanFrame f{};
@@ -135,12 +264,12 @@ class BusPoseFeed final : public PoseFeed {
     // repeats (8 bits), so an old PoseX could complete a new PoseYTheta into a pose that never was.
     PosePairer pairer(base_id_, node_);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(kWait);
-    while (std::chrono::steady_clock::now() < deadline) {
+    while (std::chrono::steady_clock::now() < deadline && !interrupted) {
       if (!bus_->receive(f)) {
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
         continue;
       }
-      if (auto p = pairer.take(f)) return *p;
+      if (auto p = pairer.take(f)) return PoseReading{*p, std::nullopt};
     }
     std::ostringstream m;
     m << iface_ << ": no pose frames of node " << node_ << " within " << kWait
@@ -160,16 +289,19 @@ class BusPoseFeed final : public PoseFeed {
 
 // Prompter: asks on stdout and reads one line from the terminal or from --answers (then echoed,
 // so that a transcript reads like a session). A bad answer is asked again on a terminal and
-// is an error naming file:line in an answers file.
+// is an error naming file:line in an answers file (bad() then tells the caller: exit 2).
 class Prompter {
  public:
+  // Plausibility: why a value [unit as typed] cannot be meant, empty when it can.
+  using Plausibility = std::function<std::string(double)>;
+
   Prompter(std::istream& in, std::string source) : in_(in), source_(std::move(source)) {}
 
-  // line: the answer to `prompt`, nullopt when the input has ended.
+  // line: the answer to `prompt`, nullopt when the input has ended (Ctrl-D, Ctrl-C).
   std::optional<std::string> line(const std::string& prompt) {
     std::cout << prompt << std::flush;
     std::string a;
-    if (!std::getline(in_, a)) {
+    if (interrupted || !std::getline(in_, a) || interrupted) {
       std::cout << "\n";
       return std::nullopt;
     }
@@ -178,10 +310,10 @@ class Prompter {
     return a;
   }
 
-  // number: a value in [lo, hi] (unit as typed) times `scale`; empty is nullopt when `optional`.
-  // false when the input ended or a scripted answer was bad.
+  // number: a value in [lo, hi] (unit as typed) that `plausible` accepts, times `scale`; empty
+  // is nullopt when `optional`. false when the input ended or a scripted answer was bad.
   bool number(const std::string& prompt, double lo, double hi, double scale, bool optional,
-              std::optional<double>& out) {
+              std::optional<double>& out, const Plausibility& plausible = {}) {
     for (;;) {
       auto a = line(prompt);
       if (!a) return false;
@@ -191,38 +323,57 @@ class Prompter {
       }
       char* end = nullptr;
       const double v = std::strtod(a->c_str(), &end);
-      if (!a->empty() && end && *end == '\0' && std::isfinite(v) && v >= lo && v <= hi) {
+      std::string why;
+      if (a->empty() || !end || *end != '\0' || !std::isfinite(v) || v < lo || v > hi) {
+        std::ostringstream m;
+        m << "'" << *a << "' is not a number in [" << lo << ", " << hi << "]";
+        why = m.str();
+      } else if (plausible) {
+        why = plausible(v);
+      }
+      if (why.empty()) {
         out = v * scale;
         return true;
       }
-      std::ostringstream m;
-      m << "'" << *a << "' is not a number in [" << lo << ", " << hi << "]";
-      if (!source_.empty()) {
-        std::cerr << "odomctl " << kCmd << ": " << source_ << ":" << line_ << ": " << m.str()
-                  << "\n";
-        return false;
-      }
-      std::cout << "  " << m.str() << "; again.\n";
+      if (!refused(why)) return false;
     }
+  }
+
+  // refused: says why the last answer is not taken; true when it is asked again (a terminal),
+  // false when the session ends (a script: the error names the answer's file:line).
+  bool refused(const std::string& why) {
+    if (!source_.empty()) {
+      std::cerr << "odomctl " << kCmd << ": " << source_ << ":" << line_ << ": " << why << "\n";
+      bad_ = true;
+      return false;
+    }
+    std::cout << "  " << why << "; again.\n";
+    return true;
   }
 
   // scripted: the answers come from --answers, not from a person.
   bool scripted() const { return !source_.empty(); }
+  // bad: a scripted answer was refused (bad input, exit 2).
+  bool bad() const { return bad_; }
 
  private:
   std::istream& in_;
   std::string source_;  // the answers file, empty on a terminal
   int line_ = 0;
+  bool bad_ = false;
 };
 
 // print_diagram: the signs of Eq. 3.1 as the tape gives them, for the chosen side wall.
 void print_diagram(calib::SideWall wall) {
   const bool left = wall == calib::SideWall::kLeft;
   std::cout << "Signs (seen from above; start frame: x along the first leg, y to the left):\n"
-            << (left ? "      left wall\n  ++=================\n  ||    ^ y\n  ||    |\n" : "")
+            // The back wall is the vertical one (||): its label at its open end, away from
+            // the side wall's label (below it with a left wall, above it with a right wall).
+            << (left ? "      left wall\n  ++=================\n  ||    ^ y\n  ||    |\n"
+                     : "  back wall\n")
             << "  ||    o---> x     o: the robot's reference point on the start mark\n"
-            << (left ? "" : "  ||    |\n  ||    v -y\n  ++=================\n      right wall\n")
-            << "  back wall\n"
+            << (left ? "  back wall\n"
+                     : "  ||    |\n  ||    v -y\n  ++=================\n      right wall\n")
             << "  x_abs = back(end) - back(start)      ex = x_abs - x_odometry\n"
             << (left ? "  y_abs = left(start) - left(end)" : "  y_abs = right(end) - right(start)")
             << "      ey = y_abs - y_odometry\n"
@@ -241,9 +392,14 @@ void print_pose(const char* when, const Pose2& p) {
             << " deg\n";
 }
 
-// read_pose: asks for Enter, then reads the daemon's pose; on a terminal a missing pose is
-// asked for again, in a script it ends the session (the runs so far stay saved).
-bool read_pose(Prompter& in, PoseFeed& feed, const std::string& prompt, Pose2& out) {
+// Plausibility bounds of what a person types or the odometry reports (issue 35).
+constexpr double kMinTapeMm = 10.0;          // [mm] a reference point closer to a wall: metres?
+constexpr double kMaxReturnFraction = 0.25;  // return error over the side: a mistyped reading
+constexpr double kMinPathFraction = 0.5;     // odometry path over the square's 4 L: not driven
+
+// read_pose: asks for Enter, then reads the daemon's pose; on a terminal a missing or stale pose
+// is asked for again, in a script it ends the session (the runs so far stay saved).
+bool read_pose(Prompter& in, PoseFeed& feed, const std::string& prompt, PoseReading& out) {
   for (;;) {
     if (!in.line(prompt)) return false;
     auto p = feed.latest();
@@ -251,6 +407,7 @@ bool read_pose(Prompter& in, PoseFeed& feed, const std::string& prompt, Pose2& o
       out = *p;
       return true;
     }
+    if (interrupted) return false;
     // A script cannot wait for the daemon: the next answer is not an Enter for this pose.
     if (in.scripted()) {
       std::cerr << "odomctl " << kCmd << ": " << p.error().message << "\n";
@@ -260,18 +417,73 @@ bool read_pose(Prompter& in, PoseFeed& feed, const std::string& prompt, Pose2& o
   }
 }
 
+// read_end_pose: the pose after the square; odometry that did not move along the square between
+// the two Enters (the log's poses in between: less than half of 4 L) is refused: on a terminal
+// the Enter is asked for again, in a script the session ends.
+bool read_end_pose(Prompter& in, PoseFeed& feed, const RecordOpts& o, const char* dir,
+                   PoseReading& out) {
+  const std::string prompt =
+      std::string("  drive the ") + dir + " square now; press Enter when it has stopped: ";
+  for (;;) {
+    if (!read_pose(in, feed, prompt, out)) return false;
+    if (!out.path || *out.path >= kMinPathFraction * 4.0 * o.side) return true;
+    std::ostringstream m;
+    m << "the odometry moved " << std::fixed << std::setprecision(3) << *out.path
+      << " m since the start pose, a square of " << o.side << " m is " << 4.0 * o.side
+      << " m: drive the square (is --side right?), then press Enter";
+    if (in.scripted()) {
+      std::cerr << "odomctl " << kCmd << ": " << m.str() << "\n";
+      return false;
+    }
+    std::cout << "  " << m.str() << ".\n";
+  }
+}
+
 // tape: the two distances [mm on the prompt, m returned] at `when` (start or end).
 bool tape(Prompter& in, const RecordOpts& o, const char* when, calib::TapeReading& t) {
   const std::string side = o.wall == calib::SideWall::kLeft ? "left" : "right";
+  const Prompter::Plausibility millimetres = [](double v) {
+    std::ostringstream m;
+    if (v < kMinTapeMm)
+      m << v << " mm from a wall (under " << kMinTapeMm << " mm): metres typed? type millimetres ("
+        << v << " m = " << v * 1e3 << " mm)";
+    return m.str();
+  };
   std::optional<double> back, s;
   if (!in.number(std::string("  tape at ") + when + ": reference point to the back wall [mm]: ",
-                 0.0, 1e5, 1e-3, false, back) ||
+                 0.0, 1e5, 1e-3, false, back, millimetres) ||
       !in.number(
           std::string("  tape at ") + when + ": reference point to the " + side + " wall [mm]: ",
-          0.0, 1e5, 1e-3, false, s))
+          0.0, 1e5, 1e-3, false, s, millimetres))
     return false;
   t = {*back, *s};
   return true;
+}
+
+// end_readings: the end tape and heading, and the return error they give; a return error over
+// kMaxReturnFraction of the side is asked again (a terminal) or refused (a script).
+bool end_readings(Prompter& in, const RecordOpts& o, Direction d, bool bumps,
+                  const calib::TapeReading& t0, const Pose2& p0, const Pose2& p1, UmbmarkRun& run) {
+  const bool need_heading = bumps || o.bumps;
+  for (;;) {
+    calib::TapeReading t1;
+    std::optional<double> heading;
+    if (!tape(in, o, "end", t1) ||
+        !in.number(need_heading ? "  heading change [deg, counter-clockwise +]: "
+                                : "  heading change [deg, counter-clockwise +; empty: not "
+                                  "measured]: ",
+                   -180.0, 180.0, kRadPerDeg, !need_heading, heading))
+      return false;
+    run = calib::tape_return_error(d, bumps, o.wall, t0, t1, heading, p0, p1);
+    const double r = std::hypot(run.ex, run.ey);
+    if (r <= kMaxReturnFraction * o.side) return true;
+    std::ostringstream m;
+    m << "the return error (ex " << mm(run.ex) << ", ey " << mm(run.ey) << ") is " << std::noshowpos
+      << std::fixed << std::setprecision(0) << 100.0 * r / o.side << " % of the " << o.side
+      << " m side (at most " << 100.0 * kMaxReturnFraction
+      << " % is taken): check the end readings (millimetres, which wall), then type them";
+    if (!in.refused(m.str())) return false;
+  }
 }
 
 // record_run: one run of the plan, from the start mark to the computed return error.
@@ -285,26 +497,15 @@ bool record_run(Prompter& in, PoseFeed& feed, const RecordOpts& o, Direction d, 
                                                "track on the first leg")
                       : "")
             << ".\n";
-  calib::TapeReading t0, t1;
-  Pose2 p0, p1;
-  std::optional<double> heading;
+  calib::TapeReading t0;
+  PoseReading p0, p1;
   if (!tape(in, o, "start", t0) ||
       !read_pose(in, feed, "  press Enter to read the odometry's start pose: ", p0))
     return false;
-  print_pose("start", p0);
-  if (!read_pose(
-          in, feed,
-          std::string("  drive the ") + dir + " square now; press Enter when it has " + "stopped: ",
-          p1))
-    return false;
-  print_pose("end", p1);
-  if (!tape(in, o, "end", t1) ||
-      !in.number(bumps || o.bumps ? "  heading change [deg, counter-clockwise +]: "
-                                  : "  heading change [deg, counter-clockwise +; empty: not "
-                                    "measured]: ",
-                 -180.0, 180.0, kRadPerDeg, !(bumps || o.bumps), heading))
-    return false;
-  run = calib::tape_return_error(d, bumps, o.wall, t0, t1, heading, p0, p1);
+  print_pose("start", p0.pose);
+  if (!read_end_pose(in, feed, o, dir, p1)) return false;
+  print_pose("end", p1.pose);
+  if (!end_readings(in, o, d, bumps, t0, p0.pose, p1.pose, run)) return false;
   std::cout << "  return error (absolute - odometry): ex " << mm(run.ex) << ", ey " << mm(run.ey);
   if (run.etheta) std::cout << ", etheta " << std::showpos << *run.etheta * kDegPerRad << " deg";
   std::cout << std::noshowpos << "\n";
@@ -360,6 +561,52 @@ bool load_runs(const RecordOpts& o, std::vector<UmbmarkRun>& runs) {
   return true;
 }
 
+// factor_sigmas: the standard deviations of the composed c_l, c_r, b_new [m] from the spread
+// of the runs: each direction's centre of gravity is uncertain by its SEM (sigma / sqrt(n)) in
+// x and y, independently; each of these four is moved by its SEM (every plain run of the
+// direction shifted) and the changes of the factors are added in quadrature (first order).
+// nullopt without a spread (fewer than 3 runs) or when a moved set does not compute.
+std::optional<calib::Factors> factor_sigmas(const calib::UmbmarkInput& ui,
+                                            const calib::UmbmarkResult& r) {
+  if (!r.sigma) return std::nullopt;
+  calib::Factors s{0.0, 0.0, 0.0};
+  for (const auto& [d, n] :
+       {std::pair{Direction::kCw, r.cw.n}, std::pair{Direction::kCcw, r.ccw.n}})
+    for (const bool in_x : {true, false}) {
+      const double sem = *r.sigma / std::sqrt(static_cast<double>(n));
+      calib::UmbmarkInput moved = ui;
+      for (UmbmarkRun& run : moved.runs)
+        if (run.direction == d && !run.bumps) (in_x ? run.ex : run.ey) += sem;
+      auto m = calib::umbmark_compute(moved);
+      if (!m) return std::nullopt;
+      s.c_l += std::pow(m->composed.c_l - r.composed.c_l, 2);
+      s.c_r += std::pow(m->composed.c_r - r.composed.c_r, 2);
+      s.wheelbase += std::pow(m->composed.wheelbase - r.composed.wheelbase, 2);
+    }
+  return calib::Factors{std::sqrt(s.c_l), std::sqrt(s.c_r), std::sqrt(s.wheelbase)};
+}
+
+// print_import: what an import would change: the factors the robot used during the runs
+// against the new ones, with the new ones' sigmas.
+void print_import(const RecordOpts& o, const calib::UmbmarkInput& ui,
+                  const calib::UmbmarkResult& r) {
+  const std::optional<calib::Factors> sd = factor_sigmas(ui, r);
+  auto row = [&](const char* name, double old_v, double new_v, std::optional<double> sigma,
+                 double unit, const char* unit_name, int digits) {
+    std::cout << "  " << std::left << std::setw(10) << name << std::right << std::fixed
+              << std::setprecision(digits) << old_v * unit << unit_name << " -> " << new_v * unit
+              << unit_name;
+    if (sigma) std::cout << "  (sigma " << *sigma * unit << unit_name << ")";
+    std::cout << "\n";
+  };
+  std::cout << "the import would store (used during the runs -> new):\n";
+  row("c_l", o.cl, r.composed.c_l, sd ? std::optional(sd->c_l) : std::nullopt, 1.0, "", 6);
+  row("c_r", o.cr, r.composed.c_r, sd ? std::optional(sd->c_r) : std::nullopt, 1.0, "", 6);
+  row("wheelbase", o.wheelbase, r.composed.wheelbase,
+      sd ? std::optional(sd->wheelbase) : std::nullopt, 1e3, " mm", 1);
+  if (!sd) std::cout << "  (sigmas unknown: fewer than 3 runs a direction)\n";
+}
+
 // finish: the computation over all runs, --out, and the offer to import into --store.
 bool finish(Prompter& in, const RecordOpts& o, const std::vector<UmbmarkRun>& runs) {
   calib::UmbmarkInput ui;
@@ -382,6 +629,7 @@ bool finish(Prompter& in, const RecordOpts& o, const std::vector<UmbmarkRun>& ru
               << " --store /var/lib/odometryd/calibration.bin\n";
     return true;
   }
+  print_import(o, ui, *r);
   auto yes = in.line("import into " + o.store + " now? [y/N] ");
   if (!yes || (*yes != "y" && *yes != "Y")) {
     std::cout << "not imported.\n";
@@ -470,6 +718,7 @@ void run_record(RecordOpts o, int& exit_code) {
   std::cout << "UMBmark record: " << p.size() << " runs of a " << o.side << " m square, "
             << runs.size() << " already in " << o.csv << "\n";
   print_diagram(o.wall);
+  catch_interrupt();
   exit_code = kExitFailed;
   for (std::size_t i = runs.size(); i < p.size(); ++i) {
     std::cout << "\nRun " << i + 1 << " of " << p.size() << ": "
@@ -478,8 +727,10 @@ void run_record(RecordOpts o, int& exit_code) {
               << (p[i].second ? ", with bumps" : "") << "\n";
     UmbmarkRun run;
     if (!record_run(in, *feed, o, p[i].first, p[i].second, run)) {
+      // Ctrl-D, Ctrl-C and a session that cannot go on all end here, with the same words.
       std::cerr << "odomctl " << kCmd << ": stopped; " << runs.size() << " runs saved in " << o.csv
                 << ": the same command resumes\n";
+      if (in.bad()) exit_code = kExitBadInput;
       return;
     }
     runs.push_back(run);

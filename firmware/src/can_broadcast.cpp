@@ -58,12 +58,19 @@ void CanLogWriter::start(std::int64_t epoch_ns) {
 void CanLogWriter::drain() noexcept {
   CanFrame f;
   char line[96];
+  bool any = false;
   while (ring_.pop(f)) {
     const std::size_t n =
         protocol::format_candump_line(line, sizeof line, epoch_ns_ + f.stamp, iface_.c_str(), f);
-    if (n > 0 && std::fwrite(line, 1, n, file_) == n)
+    if (n > 0 && std::fwrite(line, 1, n, file_) == n) {
       written_.fetch_add(1, std::memory_order_relaxed);
+      any = true;
+    }
   }
+  // A reader tails the log (odomctl decode, umbmark record --can-log): what was drained is in
+  // the file now, whole lines, not when the 64 KiB buffer fills (issue 35: 8 s, then steps).
+  // One write call per drain (every 20 ms) rather than one a frame.
+  if (any) std::fflush(file_);
 }
 
 void CanLogWriter::stop() {

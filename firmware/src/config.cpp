@@ -65,6 +65,7 @@ void read_sim(TableReader t, SimSection& s) {
   s.speed = t.number("speed", s.speed, 0.01, 5.0, "m/s");
   s.turn_rate = t.number("turn_rate", s.turn_rate, 0.05, 10.0, "rad/s");
   s.pause = t.number("pause", s.pause, 0.0, 60.0, "s");
+  s.start_delay = t.number("start_delay", s.start_delay, 0.0, 600.0, "s");
   s.counter_bits =
       static_cast<int>(t.integer("counter_bits", s.counter_bits, kCounterBitsMin, kCounterBitsMax));
   t.finish();

@@ -26,7 +26,9 @@ sim::Scenario make_scenario(const SimSection& s, const Kinematics& k) {
                              : s.scenario == SimScenario::kSquareCcw ? sim::SquareSet::kCcw
                              : s.scenario == SimScenario::kSquareCw  ? sim::SquareSet::kCw
                                                                      : sim::SquareSet::kNone;
-  return sim::squares_scenario(k, o, set);
+  sim::Scenario sc = sim::squares_scenario(k, o, set);
+  if (s.start_delay > 0.0) sc.insert(sc.begin(), {s.start_delay, 0.0, 0.0});
+  return sc;
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 # jget FILE KEY   prints the value at the dotted KEY of the JSON object in FILE
 # poll SECONDS CMD...  runs CMD every 0.1 s until it succeeds (at most SECONDS); non-zero on timeout
 # wait_text FILE TEXT  waits until FILE holds TEXT (at most 30 s); non-zero on timeout
+# start_live_log LOG DRIVE  a daemon's log being written at LOG (live_log.py), $relay its pid
 set -u
 run() { ${CROSS_EMULATOR:-} "$@"; }
 fail=0; pass=0
@@ -25,3 +26,16 @@ poll() {
   return 1
 }
 wait_text() { poll 30 grep -qs -- "$2" "$1"; }
+# start_live_log LOG DRIVE: a candump log being written at LOG by tests/cli/live_log.py from the
+# frames of a virtual-time cw square (ODOMETRYD); a line appended to DRIVE drives the square.
+# Sets relay (its pid: the caller kills it); returns once LOG holds a pose.
+start_live_log() {
+  printf '[loop]\nstatus_period = 0\n[calibration]\nstore = ""\n[sim]\nscenario = "square-cw"\n' \
+    >"$tmp/live_sq.toml"
+  run "$ODOMETRYD" --config "$tmp/live_sq.toml" --virtual-time --can-log "$tmp/live_sq.log" \
+    >/dev/null 2>&1
+  : >"$2"
+  python3 "$(dirname "${BASH_SOURCE[0]}")/live_log.py" "$tmp/live_sq.log" "$1" "$2" &
+  relay=$!
+  poll 5 grep -qs " 411#" "$1"
+}

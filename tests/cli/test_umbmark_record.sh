@@ -42,149 +42,252 @@ run "$ODOMCTL" umbmark simulate --runs 2 --json >/dev/null 2>"$tmp/err"
 check "simulate off a terminal: header and summary only: $(tr '\n' '|' <"$tmp/err")" $?
 
 # --- the simulated reference: CSV of the first pass and its factors (no noise: the daemon's
-# simulated robot has no floor roughness model) ---
-run "$ODOMCTL" umbmark simulate --runs 5 --seed 3 --csv "$tmp/sim.csv" --store "$tmp/sim.bin" \
+# simulated robot has no floor roughness model); 0.5 m squares, as the live daemon drives them ---
+run "$ODOMCTL" umbmark simulate --runs 2 --side 0.5 --seed 3 --csv "$tmp/sim.csv" --store "$tmp/sim.bin" \
   --json >"$tmp/sim.json" 2>/dev/null
 check "simulate --csv --store exit 0" $?
 
-# --- the scripted session: odometryd drives each square in virtual time and broadcasts its
-# pose (CAN log); the answers come through a FIFO, written as the session asks for them; the
+# --- the live session (issue 35): for each run odometryd starts in REAL time on the simulated
+# robot, writing --can-log; the robot stands still for start_delay (the session reads the start
+# pose from the growing log), drives a 0.5 m square, and stands still again while the session
+# reads the end pose. The answers come through a FIFO, written as the session asks for them; the
 # "tape" is the simulator's truth: the reference point starts 500 mm from the back wall and 300
 # mm from the left wall ---
-printf '[loop]\nstatus_period = 0\n[calibration]\nstore = ""\n[sim]\nscenario = "idle"\n' >"$tmp/idle.toml"
 for d in cw ccw; do
-  printf '[loop]\nstatus_period = 0\n[calibration]\nstore = ""\n[sim]\nscenario = "square-%s"\n' \
-    "$d" >"$tmp/$d.toml"
+  printf '[loop]\nstatus_period = 0\n[calibration]\nstore = ""\n[realtime]\npriority = 0\nlock_memory = false\n[sim]\nscenario = "square-%s"\nside = 0.5\nspeed = 1.0\nturn_rate = 5.0\npause = 0.1\nstart_delay = 1.5\n' \
+    "$d" >"$tmp/rt_$d.toml"
 done
 mkfifo "$tmp/answers"
 run "$ODOMCTL" umbmark record --csv "$tmp/rec.csv" --can-log "$tmp/pose.log" --wheelbase 0.34 \
-  --answers "$tmp/answers" --out "$tmp/rec.json" --store "$tmp/rec.bin" >"$tmp/session" 2>&1 &
+  --side 0.5 --runs 2 --answers "$tmp/answers" --out "$tmp/rec.json" --store "$tmp/rec.bin" \
+  >"$tmp/session" 2>&1 &
 rec_pid=$!
 exec 3>"$tmp/answers"
-# wait_for N TEXT: until the session's transcript holds TEXT N times (the session has read
-# the pose before the log is replaced by the next daemon run).
-seen() { [ "$(grep -c -- "$2" "$tmp/session")" -ge "$1" ]; }
+# wait_for N TEXT [FILE]: until the session's transcript holds TEXT N times.
+seen() { [ "$(grep -c -- "$2" "${3:-$tmp/session}")" -ge "$1" ]; }
 wait_for() {
-  poll 60 seen "$1" "$2" && return 0
+  poll 60 seen "$@" && return 0
   echo "timeout waiting for '$2' x$1"; return 1
 }
+has_pose() { grep -qs " 411#" "$tmp/pose.log"; }
 n=0
-for d in cw cw cw cw cw ccw ccw ccw ccw ccw; do
+for d in cw cw ccw ccw; do
   n=$((n + 1))
-  run "$ODOMETRYD" --config "$tmp/idle.toml" --virtual-time --duration 0.2 --can-log "$tmp/pose.log" >/dev/null 2>&1
+  rm -f "$tmp/pose.log"  # the log of the run before says stopping until the daemon starts anew
+  run "$ODOMETRYD" --config "$tmp/rt_$d.toml" --duration 8 --json --can-log "$tmp/pose.log" \
+    >"$tmp/d$n.json" 2>"$tmp/d$n.err" &
+  dpid=$!
+  t0=$(date +%s.%N)
+  poll 5 has_pose || echo "no pose in the live log within 5 s"
   printf '500\n300\n\n' >&3
   wait_for $n "odometry at start" || break
-  run "$ODOMETRYD" --config "$tmp/$d.toml" --virtual-time --json --can-log "$tmp/pose.log" \
-    >"$tmp/d.json" 2>/dev/null
+  # Enter once the square is driven: start_delay + the scenario, as the daemon says, + 0.3 s.
+  wait_text "$tmp/d$n.err" "scenario '" || break
+  dur=$(sed -n "s/.*scenario 'square-[a-z]*' (\([0-9.]*\) s).*/\1/p" "$tmp/d$n.err")
+  sleep "$(python3 -c "import sys,time; print(max(0.0, float(sys.argv[1]) + float(sys.argv[2]) + 0.3 - time.time()))" "$t0" "$dur")"
+  printf '\n' >&3
+  wait_for $n "odometry at end" || break
+  wait $dpid
   # Tape at the end from the truth [mm]: back 500 + x, left 300 - y; heading [deg] wrapped.
-  python3 - "$tmp/d.json" >&3 <<'PY'
+  python3 - "$tmp/d$n.json" >&3 <<'PY'
 import json, math, sys
 t = json.load(open(sys.argv[1]))["truth"]
 th = math.atan2(math.sin(t["theta"]), math.cos(t["theta"]))
-print("")  # Enter: the robot has stopped
 print("%.4f\n%.4f\n%.6f" % (500 + 1e3 * t["x"], 300 - 1e3 * t["y"], math.degrees(th)))
 PY
   wait_for $n "saved in" || break
 done
-echo y >&3
+wait_for 1 "import into" && echo y >&3
 exec 3>&-
 wait $rec_pid
-check "record session exit 0: $(tail -3 "$tmp/session" | tr '\n' '|')" $?
+check "live record session exit 0: $(tail -3 "$tmp/session" | tr '\n' '|')" $?
 grep -q "odometry at end" "$tmp/session" && grep -q "return error (absolute - odometry)" "$tmp/session" &&
   grep -q "centre of gravity" "$tmp/session" && grep -q "spread sigma" "$tmp/session" &&
   grep -q "back wall" "$tmp/session"
 check "record transcript: poses, return error, running c.g. and spread, diagram" $?
-
-# The same CSV: every value within the CAN pose resolution (x, y 0.1 mm, theta 1e-4 rad: the
-# daemon's pose is rounded to it on the bus) plus the CSV's own rounding (0.05 mm, 0.5e-5 rad).
+# Every start pose read from the live log is the robot at rest on its mark (the issue's stale
+# log gave y -0.3488 m there).
+[ "$(grep -c "odometry at start: x 0.0000 m, y 0.0000 m, theta 0.000 deg" "$tmp/session")" = 4 ]
+check "live session: the 4 start poses are the daemon's (0, 0, 0): $(grep "at start" "$tmp/session" | tr '\n' '|')" $?
+# The CSV rows = the simulator's truth: run i's ex, ey, etheta = truth - odometry at the
+# daemon's end (its --json), within the CAN pose resolution (x, y 0.1 mm, theta 1e-4 rad) plus
+# the CSV's rounding (0.05 mm, 0.5e-5 rad).
+python3 - "$tmp/rec.csv" "$tmp"/d1.json "$tmp"/d2.json "$tmp"/d3.json "$tmp"/d4.json <<'PY'
+import json, math, sys
+rows = open(sys.argv[1]).read().splitlines()
+assert len(rows) == 5, rows
+for row, path, d in zip(rows[1:], sys.argv[2:], ["cw", "cw", "ccw", "ccw"]):
+    j = json.load(open(path))
+    t = j["truth"]
+    f = row.split(",")
+    w = lambda a: math.atan2(math.sin(a), math.cos(a))
+    assert f[0] == d and f[4] == "0", row
+    assert abs(float(f[1]) - (t["x"] - j["x"])) <= 1.5e-4, (row, t, j["x"])
+    assert abs(float(f[2]) - (t["y"] - j["y"])) <= 1.5e-4, (row, t, j["y"])
+    assert abs(float(f[3]) - w(w(t["theta"]) - j["theta"])) <= 1.6e-4, (row, t, j["theta"])
+PY
+check "live record CSV = the simulator's truth - odometry, run by run" $?
+# And the same as `umbmark simulate --csv` of 0.5 m squares (same seed, no noise).
 python3 - "$tmp/sim.csv" "$tmp/rec.csv" <<'PY'
 import sys
 a = open(sys.argv[1]).read().splitlines()
 b = open(sys.argv[2]).read().splitlines()
-assert a[0] == b[0] and len(a) == len(b) == 11, (a, b)
+assert a[0] == b[0] and len(a) == len(b) == 5, (a, b)
 for la, lb in zip(a[1:], b[1:]):
     fa, fb = la.split(","), lb.split(",")
     assert fa[0] == fb[0] and fa[4] == fb[4], (la, lb)
     assert abs(float(fa[1]) - float(fb[1])) <= 1.5e-4 and abs(float(fa[2]) - float(fb[2])) <= 1.5e-4, (la, lb)
     assert abs(float(fa[3]) - float(fb[3])) <= 1.6e-4, (la, lb)
 PY
-check "record CSV = simulate --csv (same seed) within the CAN resolution" $?
-# The same calibration: a 0.15 mm change of a c.g. over 4 L = 16 m moves alpha, beta by
-# < 1e-5 rad; b_new by 0.34 * 1e-5 / (pi/2) = 2.2e-6 m, c_l, c_r by b/(2L) * 1e-5 = 4.3e-7.
-python3 - "$tmp/sim.json" "$tmp/rec.json" <<'PY'
-import json, sys
-s = json.load(open(sys.argv[1]))["passes"][0]
-r = json.load(open(sys.argv[2]))
-assert abs(s["b"] - r["b_new"]) < 3e-6, (s, r)
-assert abs(s["c_l"] - r["c_l"]) < 1e-6 and abs(s["c_r"] - r["c_r"]) < 1e-6, (s, r)
-PY
-check "record calibration = simulate's pass 1" $?
+check "live record CSV = simulate --csv (same seed) within the CAN resolution" $?
+# The import shows the factors used during the runs against the new ones with their sigmas,
+# then stores what it showed.
+grep -q "the import would store (used during the runs -> new):" "$tmp/session" &&
+  grep -Eq "^  c_l +1.000000 -> [0-9.]+  \(sigma [0-9.]+\)$" "$tmp/session" &&
+  grep -Eq "^  wheelbase +340.0 mm -> [0-9.]+ mm  \(sigma [0-9.]+ mm\)$" "$tmp/session"
+check "record: the import shows old -> new and sigmas: $(grep -A3 "import would" "$tmp/session" | tr '\n' '|')" $?
 run "$ODOMCTL" calib show --store "$tmp/rec.bin" --json >"$tmp/rs.json" 2>/dev/null
-run "$ODOMCTL" calib show --store "$tmp/sim.bin" --json >"$tmp/ss.json" 2>/dev/null
-python3 - "$tmp/ss.json" "$tmp/rs.json" <<'PY'
-import json, sys
-s, r = (json.load(open(p)) for p in sys.argv[1:3])
-assert s["status"] == r["status"] == "ok", (s, r)
-for k in ("c_l", "c_r", "wheelbase"):
-    assert abs(s[k] - r[k]) < 3e-6, (k, s, r)
+python3 - "$tmp/rs.json" "$tmp/session" "$tmp/rec.json" <<'PY'
+import json, re, sys
+s = json.load(open(sys.argv[1]))
+shown = re.search(r"^  c_l +[0-9.]+ -> ([0-9.]+)", open(sys.argv[2]).read(), re.M).group(1)
+r = json.load(open(sys.argv[3]))
+assert s["status"] == "ok" and abs(s["c_l"] - float(shown)) <= 5e-7, (s, shown)
+assert abs(s["c_l"] - r["c_l"]) < 1e-9 and abs(s["wheelbase"] - r["b_new"]) < 1e-9, (s, r)
 PY
-check "record's import into the store = simulate --store" $?
+check "record's import into the store = what it showed and --out" $?
+
+# --- the recorder's logic on a log being written: live_log.py writes the log of a running
+# daemon (fresh stamps) from a virtual-time square's frames; each "drive" line in its control
+# file drives the square between the two Enters (odometry moves along it, 0 net) ---
+start_live_log "$tmp/still.log" "$tmp/drive"
+trap 'kill $relay 2>/dev/null; rm -rf "$tmp"' EXIT
+# scripted NAME ARGS... RUNS...: `umbmark record ARGS` with its answers through the FIFO
+# $tmp/NAME (the error messages name it), transcript $tmp/NAME.out, stderr $tmp/NAME.err; each
+# RUN is "BACK0 SIDE0 BACK1 SIDE1 HEADING" [mm, deg; HEADING - is an empty answer], the square
+# driven between the Enters. Sets rc to the session's exit code.
+scripted() {
+  local name=$1 args=() r k=0
+  shift
+  while [ $# -gt 0 ] && [ "${1%% *}" = "$1" ]; do  # options have no blank, runs do
+    args+=("$1"); shift
+  done
+  rm -f "$tmp/$name"; mkfifo "$tmp/$name"
+  run "$ODOMCTL" umbmark record --can-log "$tmp/still.log" --wheelbase 0.34 "${args[@]}" \
+    --answers "$tmp/$name" >"$tmp/$name.out" 2>"$tmp/$name.err" &
+  local pid=$!
+  exec 4>"$tmp/$name"
+  for r in "$@"; do
+    k=$((k + 1))
+    set -- $r
+    printf '%s\n%s\n\n' "$1" "$2" >&4
+    poll 10 seen $k "odometry at start" "$tmp/$name.out" || break
+    echo drive >>"$tmp/drive"
+    sleep 0.2
+    printf '\n' >&4
+    poll 10 seen $k "odometry at end" "$tmp/$name.out" || break
+    printf '%s\n%s\n%s\n' "$3" "$4" "$([ "$5" = - ] || echo "$5")" >&4
+    poll 10 seen $k "saved in" "$tmp/$name.out" || poll 2 grep -q "stopped;" "$tmp/$name.err" || break
+  done
+  exec 4>&-
+  wait $pid
+  rc=$?
+}
 
 # --- interrupted and resumed: the answers end after two runs; the rerun asks for run 3 ---
-run "$ODOMETRYD" --config "$tmp/idle.toml" --virtual-time --duration 0.2 --can-log "$tmp/still.log" >/dev/null 2>&1
-printf '500\n300\n\n\n501\n299\n\n500\n300\n\n\n499.5\n300\n\n' >"$tmp/two.txt"
-run "$ODOMCTL" umbmark record --csv "$tmp/r2.csv" --can-log "$tmp/still.log" --wheelbase 0.34 \
-  --answers "$tmp/two.txt" >"$tmp/s2" 2>"$tmp/e2"
-rc=$?
-[ $rc = 1 ] && [ "$(wc -l <"$tmp/r2.csv")" = 3 ] && grep -q "2 runs saved in .*r2.csv: the same command resumes" "$tmp/e2" &&
+scripted two.txt --csv "$tmp/r2.csv" "500 300 501 299 -" "500 300 499.5 300 -"
+[ $rc = 1 ] && [ "$(wc -l <"$tmp/r2.csv")" = 3 ] && grep -q "2 runs saved in .*r2.csv: the same command resumes" "$tmp/two.txt.err" &&
   grep -q "^cw,0.0010,0.0010,,0$" "$tmp/r2.csv" && grep -q "^cw,-0.0005,0.0000,,0$" "$tmp/r2.csv"
-check "record interrupted: exit 1, 2 runs kept: $(tr '\n' '|' <"$tmp/e2")" $?
-printf '500\n300\n\n\n500\n300\n\n' >"$tmp/one.txt"
-run "$ODOMCTL" umbmark record --csv "$tmp/r2.csv" --can-log "$tmp/still.log" --wheelbase 0.34 \
-  --answers "$tmp/one.txt" >"$tmp/s3" 2>/dev/null
-grep -q "2 already in" "$tmp/s3" && grep -q "^Run 3 of 10" "$tmp/s3" && ! grep -q "^Run 1 of" "$tmp/s3" &&
+check "record interrupted: exit 1, 2 runs kept: rc $rc $(tr '\n' '|' <"$tmp/two.txt.err")" $?
+scripted one.txt --csv "$tmp/r2.csv" "500 300 500 300 -"
+grep -q "2 already in" "$tmp/one.txt.out" && grep -q "^Run 3 of 10" "$tmp/one.txt.out" && ! grep -q "^Run 1 of" "$tmp/one.txt.out" &&
   [ "$(wc -l <"$tmp/r2.csv")" = 4 ]
 check "record resumes at run 3" $?
-# A bad scripted answer names the file and line; the CSV keeps what it had.
+# A bad scripted answer names the file and line and exits 2 (bad input); the CSV keeps what it had.
 printf '500\nabc\n' >"$tmp/bad.txt"
 run "$ODOMCTL" umbmark record --csv "$tmp/r2.csv" --can-log "$tmp/still.log" --wheelbase 0.34 \
   --answers "$tmp/bad.txt" >/dev/null 2>"$tmp/e4"
-grep -q "bad.txt:2: 'abc' is not a number in \[0, 100000\]" "$tmp/e4" && [ "$(wc -l <"$tmp/r2.csv")" = 4 ]
-check "record: bad answer names file:line: $(head -1 "$tmp/e4")" $?
+rc=$?
+[ $rc = 2 ] && grep -q "bad.txt:2: 'abc' is not a number in \[0, 100000\]" "$tmp/e4" && [ "$(wc -l <"$tmp/r2.csv")" = 4 ]
+check "record: bad answer names file:line, exit 2: rc $rc $(head -1 "$tmp/e4")" $?
+# Metres typed where millimetres are asked: refused with the reason (exit 2, file:line).
+printf '500\n0.3\n' >"$tmp/metres.txt"
+run "$ODOMCTL" umbmark record --csv "$tmp/r2.csv" --can-log "$tmp/still.log" --wheelbase 0.34 \
+  --answers "$tmp/metres.txt" >/dev/null 2>"$tmp/e5"
+rc=$?
+[ $rc = 2 ] && grep -q "metres.txt:2: 0.3 mm from a wall (under 10 mm): metres typed? type millimetres (0.3 m = 300 mm)" "$tmp/e5" &&
+  [ "$(wc -l <"$tmp/r2.csv")" = 4 ]
+check "record: 0.3 where mm are asked is refused: rc $rc $(head -1 "$tmp/e5")" $?
 run "$ODOMCTL" umbmark record --csv "$tmp/no/dir/r.csv" --can-log "$tmp/still.log" --wheelbase 0.34 \
-  --answers "$tmp/one.txt" >"$tmp/out" 2>"$tmp/err"
+  --answers "$tmp/bad.txt" >"$tmp/out" 2>"$tmp/err"
 [ $? = 2 ] && [ "$(wc -l <"$tmp/err")" = 1 ] && [ ! -s "$tmp/out" ]
 check "record --csv unwritable: exit 2 before the first question: $(cat "$tmp/err")" $?
-# --bumps: the extended-UMBmark runs follow the plain ones and need the heading. With the robot
-# standing still, etheta is the typed heading: plain cw 1.0, ccw -0.5 deg; bumps cw 3.0, ccw -2.0
-# deg, so eps_theta,nonsys = |3.0 - 1.0| + |-2.0 - (-0.5)| = 3.5 deg = 0.0610865 rad.
-printf '500\n300\n\n\n500\n300\n%s\n' 1.0 -0.5 3.0 -2.0 >"$tmp/bumps.txt"
-run "$ODOMCTL" umbmark record --csv "$tmp/rb.csv" --can-log "$tmp/still.log" --wheelbase 0.34 \
-  --runs 1 --bumps --answers "$tmp/bumps.txt" --out "$tmp/rb.json" >"$tmp/sb" 2>"$tmp/eb"
-rc=$?
-[ $rc = 0 ] && grep -q "^Run 3 of 4: cw (clockwise, turning right), with bumps" "$tmp/sb" &&
+# A return error of 1100 mm on a 4 m square (27.5 % of the side, over 25 %): a mistyped reading,
+# refused naming the answer's line (the heading, the last of the end readings: line 7).
+scripted far.txt --csv "$tmp/rf.csv" "500 300 1600 300 -"
+[ $rc = 2 ] && grep -q "far.txt:7: the return error (ex +1100.0 mm, ey +0.0 mm) is 28 % of the 4 m side (at most 25 % is taken)" "$tmp/far.txt.err" &&
+  [ ! -e "$tmp/rf.csv" ]
+check "record: a return error of 28 % of the side is refused: rc $rc $(head -1 "$tmp/far.txt.err")" $?
+# --bumps: the extended-UMBmark runs follow the plain ones and need the heading. With the
+# odometry back where it started, etheta is the typed heading: plain cw 1.0, ccw -0.5 deg; bumps
+# cw 3.0, ccw -2.0 deg, so eps_theta,nonsys = |3.0 - 1.0| + |-2.0 - (-0.5)| = 3.5 deg = 0.0610865 rad.
+scripted bumps.txt --csv "$tmp/rb.csv" --runs 1 --bumps --out "$tmp/rb.json" \
+  "500 300 500 300 1.0" "500 300 500 300 -0.5" "500 300 500 300 3.0" "500 300 500 300 -2.0"
+[ $rc = 0 ] && grep -q "^Run 3 of 4: cw (clockwise, turning right), with bumps" "$tmp/bumps.txt.out" &&
   [ "$(cut -d, -f5 "$tmp/rb.csv" | tr '\n' ' ')" = "bumps 0 0 1 1 " ] &&
   python3 -c "import json,sys; e=json.load(open(sys.argv[1]))['eps_theta_nonsys']; sys.exit(abs(e-0.0610865)>1e-6)" "$tmp/rb.json"
-check "record --bumps: 2 + 2 runs, eps_theta,nonsys 3.5 deg: rc $rc $(grep eps_theta "$tmp/sb")" $?
-# A bump run without the heading: the scripted answer is refused with file:line, the plain runs
-# stay saved.
-printf '500\n300\n\n\n500\n300\n%s\n' 1.0 -0.5 >"$tmp/nohead.txt"
-printf '500\n300\n\n\n500\n300\n\n' >>"$tmp/nohead.txt"
-run "$ODOMCTL" umbmark record --csv "$tmp/rn.csv" --can-log "$tmp/still.log" --wheelbase 0.34 \
-  --runs 1 --bumps --answers "$tmp/nohead.txt" >/dev/null 2>"$tmp/en"
-rc=$?
-[ $rc = 1 ] && grep -q "nohead.txt:21: '' is not a number in \[-180, 180\]" "$tmp/en" &&
+check "record --bumps: 2 + 2 runs, eps_theta,nonsys 3.5 deg: rc $rc $(grep eps_theta "$tmp/bumps.txt.out")" $?
+# A bump run without the heading: the scripted answer is refused with file:line (exit 2), the
+# plain runs stay saved.
+scripted nohead.txt --csv "$tmp/rn.csv" --runs 1 --bumps \
+  "500 300 500 300 1.0" "500 300 500 300 -0.5" "500 300 500 300 -"
+[ $rc = 2 ] && grep -q "nohead.txt:21: '' is not a number in \[-180, 180\]" "$tmp/nohead.txt.err" &&
   [ "$(wc -l <"$tmp/rn.csv")" = 3 ]
-check "record --bumps: a bump run needs the heading (file:line): $(head -1 "$tmp/en")" $?
+check "record --bumps: a bump run needs the heading (file:line): rc $rc $(head -1 "$tmp/nohead.txt.err")" $?
 
+# --- refusals (issue 35): no odometry motion between the two Enters, a stale log, a stopped
+# daemon; each says what to do ---
+rm -f "$tmp/still2"; mkfifo "$tmp/still2"
+run "$ODOMCTL" umbmark record --csv "$tmp/rs.csv" --can-log "$tmp/still.log" --wheelbase 0.34 \
+  --answers "$tmp/still2" >"$tmp/still2.out" 2>"$tmp/still2.err" &
+pid=$!
+exec 4>"$tmp/still2"
+printf '500\n300\n\n' >&4
+poll 10 seen 1 "odometry at start" "$tmp/still2.out"
+printf '\n' >&4  # Enter again without driving
+exec 4>&-
+wait $pid
+rc=$?
+[ $rc = 1 ] && grep -q "the odometry moved 0.000 m since the start pose, a square of 4 m is 16 m: drive the square (is --side right?), then press Enter" "$tmp/still2.err" &&
+  [ ! -e "$tmp/rs.csv" ]
+check "record: no odometry motion between the Enters is refused: rc $rc $(head -1 "$tmp/still2.err")" $?
+printf '500\n300\n\n\n500\n300\n\n' >"$tmp/one_still.txt"
+# Stale: the relay stops writing (a daemon killed without its last Status frame), 2 s later the
+# newest pose is older than 0.5 s.
+kill $relay; wait $relay 2>/dev/null
+sleep 2
+# refused NAME LOG PATTERN: a scripted session on LOG stops at the first pose (exit 1) with
+# PATTERN on stderr and writes no CSV.
+refused() {
+  run "$ODOMCTL" umbmark record --csv "$tmp/rs.csv" --can-log "$2" --wheelbase 0.34 \
+    --answers "$tmp/one_still.txt" >/dev/null 2>"$tmp/e_$1"
+  rc=$?
+  [ $rc = 1 ] && grep -Eq "$3" "$tmp/e_$1" && [ ! -e "$tmp/rs.csv" ]
+  check "record: $1 is refused: rc $rc $(head -1 "$tmp/e_$1")" $?
+}
+refused "a stale log" "$tmp/still.log" "still.log: the newest pose is [0-9.]+ s old \(at most 0.5 s is taken\), the newest Status frame [0-9.]+ s old: is odometryd running with --can-log .*still.log \(or candump -L writing it\)\? Start it$"
+# Stopped: the live session's log ends with the daemon's Status frame that says stopping.
+refused "a stopped daemon's log" "$tmp/pose.log" "pose.log: odometryd has stopped \(its last Status frame, [0-9.]+ s old, says stopping\): start it again with --can-log .*pose.log$"
+
+printf '[loop]\nstatus_period = 0\n[calibration]\nstore = ""\n[sim]\nscenario = "idle"\n' >"$tmp/idle.toml"
 # Where the poses come from: one source is needed; --config takes the daemon's [can] interface,
 # and a daemon config that broadcasts on no interface is said before the first question.
-run "$ODOMCTL" umbmark record --csv "$tmp/r3.csv" --wheelbase 0.34 --answers "$tmp/one.txt" \
+run "$ODOMCTL" umbmark record --csv "$tmp/r3.csv" --wheelbase 0.34 --answers "$tmp/one_still.txt" \
   >"$tmp/out" 2>"$tmp/err"
 [ $? = 2 ] && [ "$(wc -l <"$tmp/err")" = 1 ] && grep -q "one of --can IFACE" "$tmp/err" && [ ! -s "$tmp/out" ]
 check "record without a pose source: exit 2, one line: $(cat "$tmp/err")" $?
 run "$ODOMCTL" umbmark record --csv "$tmp/r3.csv" --config "$tmp/idle.toml" --wheelbase 0.34 \
-  --answers "$tmp/one.txt" >"$tmp/out" 2>"$tmp/err"
+  --answers "$tmp/one_still.txt" >"$tmp/out" 2>"$tmp/err"
 [ $? = 2 ] && [ "$(wc -l <"$tmp/err")" = 1 ] && grep -q 'idle.toml: \[can\] bus is not "socketcan"' "$tmp/err" &&
   [ ! -e "$tmp/r3.csv" ]
 check "record --config of a daemon on the simulated bus: exit 2: $(cat "$tmp/err")" $?

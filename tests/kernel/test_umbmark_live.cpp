@@ -129,14 +129,16 @@ class Broadcaster {
   std::thread thread_;
 };
 
-// write_log: a candump -L log holding one pose pair, replaced whole (rename).
+// write_log: a candump -L log holding one pose pair stamped now (the session refuses a pose
+// older than its Enter), replaced whole (rename).
 void write_log(const std::string& path, const protocol::PoseMsg& p) {
   const auto [fx, fy] = pose_frames(p);
   char a[128], b[128];
-  const std::size_t na =
-      protocol::format_candump_line(a, sizeof a, 1'700'000'000'000'000'000, "vcanu0", fx);
-  const std::size_t nb =
-      protocol::format_candump_line(b, sizeof b, 1'700'000'000'005'000'000, "vcanu0", fy);
+  const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                               std::chrono::system_clock::now().time_since_epoch())
+                               .count();
+  const std::size_t na = protocol::format_candump_line(a, sizeof a, now, "vcanu0", fx);
+  const std::size_t nb = protocol::format_candump_line(b, sizeof b, now + 5'000'000, "vcanu0", fy);
   {
     std::ofstream f(path + ".tmp", std::ios::binary);
     f.write(a, static_cast<std::streamsize>(na));

@@ -24,6 +24,7 @@ wheelbase = 0.25
 [sim]
 scenario = "square-cw"
 counter_bits = 16
+start_delay = 1.5
 )",
                         "x.toml");
   ASSERT_TRUE(c.ok()) << c.error().message;
@@ -34,6 +35,7 @@ counter_bits = 16
   EXPECT_DOUBLE_EQ(c->robot.wheelbase_nominal, 0.25);
   EXPECT_EQ(c->sim.scenario, SimScenario::kSquareCw);
   EXPECT_EQ(c->sim.counter_bits, 16);
+  EXPECT_DOUBLE_EQ(c->sim.start_delay, 1.5);
 }
 
 struct BadConfig {
@@ -62,6 +64,8 @@ INSTANTIATE_TEST_SUITE_P(
                   "encoder.backend = \"usb\" is not one of: sim, hctl1100, gpio, can"},
         BadConfig{"[sim]\ncounter_bits = 8\n",
                   "sim.counter_bits = 8 is outside the allowed range [16, 64]"},
+        BadConfig{"[sim]\nstart_delay = -1\n",
+                  "bad.toml:2: sim.start_delay = -1 is outside the allowed range [0, 600] s"},
         BadConfig{"[loop\n", "bad.toml:1: TOML syntax error"},
         BadConfig{"loop = 3\n", "bad.toml:1: loop must be a table"},
         BadConfig{"[robott]\n", "robott is not a known setting"}));

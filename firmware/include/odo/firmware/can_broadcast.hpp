@@ -35,7 +35,8 @@ using CanFrameRing = loop::SpscRing<CanFrame>;
 inline constexpr std::size_t kCanLogRingFrames = 4096;  // 24 s of the default broadcast
 
 // CanLogWriter: drains a CanFrameRing into a candump -L file from its own thread (every 20 ms),
-// so the loop never does file I/O. Frame stamps are loop time [ns]; the wall-clock time of loop
+// so the loop never does file I/O, and flushes after each drain: the file is at most ~20 ms
+// behind the loop, in whole lines. Frame stamps are loop time [ns]; the wall-clock time of loop
 // time zero is added.
 class CanLogWriter {
  public:

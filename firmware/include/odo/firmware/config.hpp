@@ -144,11 +144,12 @@ struct LoopSection {
 struct SimSection {
   SimRobotKind robot = SimRobotKind::kLabmate;  // nominal: true geometry = believed
   SimScenario scenario = SimScenario::kSquareCcw;
-  double side = 4.0;       // [m]
-  double speed = 0.2;      // [m/s]
-  double turn_rate = 0.5;  // [rad/s]
-  double pause = 0.5;      // [s]
-  int counter_bits = 32;   // simulated counter width, 16..64
+  double side = 4.0;         // [m]
+  double speed = 0.2;        // [m/s]
+  double turn_rate = 0.5;    // [rad/s]
+  double pause = 0.5;        // [s]
+  double start_delay = 0.0;  // [s] standstill before the scenario (time to read a start pose)
+  int counter_bits = 32;     // simulated counter width, 16..64
 };
 
 // [hctl1100]: two HCTL-1100 counter chips on one 8-bit multiplexed bus (AD0..AD7, ALE, /OE,
