@@ -314,7 +314,8 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
   std::unique_ptr<CanLink> link(new CanLink());
   if (s.bus == CanBusKind::kNone) {
     if (!can_log.empty())
-      return make_error(Errc::kInvalidArgument, "--can-log needs a CAN bus: [can] bus is \"none\"");
+      return make_error(Errc::kInvalidArgument,
+                        "can.bus = \"none\": --can-log needs a CAN bus (\"sim\" or \"socketcan\")");
     return std::unique_ptr<CanLink>();
   }
   std::string iface;
@@ -332,7 +333,8 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
   }
   if (!can_log.empty()) {
     auto w = CanLogWriter::open(can_log, iface);
-    if (!w) return std::move(w).error();
+    // The option's fault, not the config's: the daemon reports it without the config's name.
+    if (!w) return make_error(w.error().code, "--can-log " + w.error().message);
     link->log_ = std::move(w).value();
   }
   const CanBroadcastOptions o = broadcast_options(s, loop_hz, virtual_time);
