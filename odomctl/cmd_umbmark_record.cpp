@@ -514,8 +514,8 @@ void add_record(CLI::App& umbmark, int& exit_code) {
                 "the side wall at the start mark: left | right (default left)")
       ->transform(fw::choice_check(calib::kSideWalls, true));
   c->add_option("--config", o->config,
-                "the daemon's config: its [can] interface, node_id and base_id are the defaults "
-                "of --can, --node and --base-id");
+                "the daemon's config: --can, --node and --base-id are taken from its [can] "
+                "interface, node_id and base_id unless given");
   CLI::Option* node =
       c->add_option("--node", o->node, "node id of the daemon on the bus (default 1)");
   CLI::Option* base =
