@@ -87,6 +87,13 @@ refuse() {  # refuse NAME EXPECTED CMD...: exit 2, stderr has EXPECTED and no CL
 }
 refuse "--side-wall middle" "--side-wall: 'middle' must be left or right" \
   "$ODOMCTL" umbmark record --csv "$tmp/r.csv" --wheelbase 0.34 --side-wall middle
+# ... and accept the spellings: --side-wall right reaches the session (its sign diagram).
+for wall in left right; do
+  run "$ODOMCTL" umbmark record --csv "$tmp/w_$wall.csv" --wheelbase 0.34 --side-wall "$wall" \
+    --can-log "$tmp/none.log" --answers /dev/null >"$tmp/wall" 2>&1
+  grep -q "^ *$wall wall\$" "$tmp/wall"
+  check "--side-wall $wall accepted: the diagram shows the $wall wall" $?
+done
 refuse "--backend foo" "--backend: 'foo' must be auto or file or nvmem or mtd" \
   "$ODOMCTL" calib show --backend foo
 refuse "--duration -1" "odometryd: --duration: -1 is outside [0, 1e+09]" "$ODOMETRYD" --duration -1
