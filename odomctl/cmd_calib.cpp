@@ -27,7 +27,7 @@ void add_store_options(CLI::App* c, StoreOpts& o, bool json) {
   c->add_option("--store", o.path, "store: a file, an nvmem file or /dev/mtdN")
       ->capture_default_str();
   c->add_option("--backend", o.backend, "auto | file | nvmem | mtd (auto: from the path)")
-      ->check(CLI::IsMember(fw::choice_names<NvBackend>()))
+      ->check(fw::choice_check(fw::choices<NvBackend>(), false))
       ->capture_default_str();
   if (json) c->add_flag("--json", o.json, "print one JSON object");
 }
@@ -35,7 +35,7 @@ void add_store_options(CLI::App* c, StoreOpts& o, bool json) {
 // Opens the store and loads it; on failure prints why and sets exit_code.
 std::optional<fw::OpenStore> open_loaded(const char* cmd, const StoreOpts& o,
                                          calib::LoadResult& loaded, int& exit_code) {
-  // --backend is one of the spellings (CLI::IsMember above).
+  // --backend is one of the spellings (fw::choice_check above).
   const auto backend = fw::parse_choice<NvBackend>(o.backend).value_or(NvBackend::kAuto);
   auto s = fw::open_calibration_store(o.path, backend);
   if (!s) {
@@ -89,12 +89,31 @@ struct ImportOpts {
   std::string file;
 };
 
+// store_note: for a file store that does not exist, why (fw::store_absence): it is uncalibrated
+// because nothing was ever written there, or because its directory is missing (a typo?).
+std::optional<fw::StoreAbsence> store_note(const StoreOpts& o) {
+  return fw::store_absence(o.path,
+                           fw::parse_choice<NvBackend>(o.backend).value_or(NvBackend::kAuto));
+}
+
 // calib_show: `calib show`: the record and the store status (exit 1 when corrupt).
 void calib_show(const StoreOpts& o, int& exit_code) {
+  const auto absent = store_note(o);
   calib::LoadResult l;
   if (!open_loaded("show", o, l, exit_code)) return;
-  std::cout << (o.json ? analysis::show_json(l) + "\n" : analysis::show_text(l));
+  if (o.json && absent) {
+    auto j = nlohmann::json::parse(analysis::show_json(l));
+    j["note"] = absent->text;
+    std::cout << j.dump() << "\n";
+  } else {
+    std::cout << (o.json ? analysis::show_json(l) + "\n" : analysis::show_text(l));
+    if (absent) std::cout << "note: " << absent->text << "\n";
+  }
   exit_code = l.status == calib::StoreStatus::kCorrupt ? kExitFailed : kExitOk;
+  if (absent && absent->directory_missing) {
+    std::cerr << "odomctl calib show: " << absent->text << "\n";
+    exit_code = kExitFailed;
+  }
 }
 
 // calib_set: `calib set`: changes the given values, keeps the rest.
@@ -160,6 +179,11 @@ void calib_import(const ImportOpts& o, int& exit_code) {
 
 // calib_export: `calib export`: the stored record in the exchange format.
 void calib_export(const StoreOpts& o, int& exit_code) {
+  if (const auto absent = store_note(o)) {
+    std::cerr << "odomctl calib export: " << absent->text << "; nothing to export\n";
+    exit_code = kExitFailed;
+    return;
+  }
   calib::LoadResult l;
   if (!open_loaded("export", o, l, exit_code)) return;
   if (l.status != calib::StoreStatus::kOk) {
@@ -269,11 +293,17 @@ void add_calib(CLI::App& app, int& exit_code) {
   auto set = std::make_shared<SetOpts>();
   CLI::App* c_set = calib->add_subcommand("set", "change stored values (the rest are kept)");
   add_store_options(c_set, set->store, true);
-  c_set->add_option("--cl", set->cl, "left wheel correction factor c_L [0.9, 1.1]");
-  c_set->add_option("--cr", set->cr, "right wheel correction factor c_R [0.9, 1.1]");
-  c_set->add_option("--wheelbase", set->wheelbase, "effective wheelbase b [m], [0.01, 20]");
-  c_set->add_option("--wheel-diameter", set->wheel_diameter,
-                    "corrected wheel diameter Dn* [m], [0.005, 5]");
+  // The ranges are the record's (calib::RecordLimits), checked when the record is written.
+  using L = calib::RecordLimits;
+  fw::say_range(c_set->add_option("--cl", set->cl, "left wheel correction factor c_L"),
+                L::kFactorMin, L::kFactorMax);
+  fw::say_range(c_set->add_option("--cr", set->cr, "right wheel correction factor c_R"),
+                L::kFactorMin, L::kFactorMax);
+  fw::say_range(c_set->add_option("--wheelbase", set->wheelbase, "effective wheelbase b [m]"),
+                L::kWheelbaseMin, L::kWheelbaseMax);
+  fw::say_range(c_set->add_option("--wheel-diameter", set->wheel_diameter,
+                                  "corrected wheel diameter Dn* [m]"),
+                L::kDiameterMin, L::kDiameterMax);
   c_set->callback([set, &exit_code] { calib_set(*set, exit_code); });
 
   auto imp = std::make_shared<ImportOpts>();
@@ -286,7 +316,7 @@ void add_calib(CLI::App& app, int& exit_code) {
   auto exp = std::make_shared<StoreOpts>();
   CLI::App* c_exp =
       calib->add_subcommand("export", "print the stored calibration as JSON (for `import`)");
-  add_store_options(c_exp, *exp, true);
+  add_store_options(c_exp, *exp, false);  // its output is JSON: no --json to accept and ignore
   c_exp->callback([exp, &exit_code] { calib_export(*exp, exit_code); });
 
   auto reset = std::make_shared<StoreOpts>();

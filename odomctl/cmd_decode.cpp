@@ -122,8 +122,8 @@ void add_decode(CLI::App& app, int& exit_code) {
       "decode", "decode a candump -L log of the CAN pose protocol (README \"CAN protocol\")");
   c->add_option("file", o->file, "candump -L log (odometryd --can-log, candump -L)")->required();
   c->add_flag("--csv", o->csv, "CSV, one row per signal: time,iface,id,node,message,signal,value");
-  c->add_option("--base-id", o->base_id, "protocol base id (default 0x400 = 1024)")
-      ->check(CLI::Range(0, 1024));
+  fw::with_range(c->add_option("--base-id", o->base_id, "protocol base id"), 0, 1024)
+      ->capture_default_str();
   c->callback([o, &exit_code] { run_decode(*o, exit_code); });
 }
 

@@ -168,13 +168,13 @@ void add_validate(CLI::App& parent, int& exit_code) {
   auto o = std::make_shared<ValidateOpts>();
   CLI::App* c = parent.add_subcommand(
       "validate", "Monte Carlo on the simulated robot: predicted against sample covariance");
-  c->add_option("--runs", o->mc.runs, "number of runs (default 2000)");
-  c->add_option("--path", o->path,
-                "outback (10 m forward, 10 m back) or arc (270 deg, 2 m radius)");
-  c->add_option("--k-left", o->mc.k.k_left, "k_L [m^(1/2)] (default 0.00040)");
-  c->add_option("--k-right", o->mc.k.k_right, "k_R [m^(1/2)] (default 0.00058)");
-  c->add_option("--wheelbase", o->mc.wheelbase, "wheelbase b [m] (default 0.34)");
-  c->add_option("--seed", o->mc.seed, "random seed (default 1)");
+  c->add_option("--runs", o->mc.runs, "number of runs")->capture_default_str();
+  c->add_option("--path", o->path, "outback (10 m forward, 10 m back) or arc (270 deg, 2 m radius)")
+      ->capture_default_str();
+  c->add_option("--k-left", o->mc.k.k_left, "k_L [m^(1/2)]")->capture_default_str();
+  c->add_option("--k-right", o->mc.k.k_right, "k_R [m^(1/2)]")->capture_default_str();
+  c->add_option("--wheelbase", o->mc.wheelbase, "wheelbase b [m]")->capture_default_str();
+  c->add_option("--seed", o->mc.seed, "random seed")->capture_default_str();
   c->add_option("--plot", o->plot, "write an SVG of the 95% error ellipses");
   c->add_option("--csv", o->csv, "write every run's error in the CSV format of `fit`");
   c->add_flag("--json", o->json, "print one JSON object on stdout");
@@ -243,8 +243,8 @@ void add_fit(CLI::App& parent, int& exit_code) {
   CLI::App* c = parent.add_subcommand(
       "fit", "estimate k_L and k_R from the return errors of repeated out-and-back runs");
   c->add_option("FILE", o->file, "CSV with header ex,ey,etheta (optional column run)")->required();
-  c->add_option("--distance", o->distance, "distance driven each way [m] (default 10)");
-  c->add_option("--wheelbase", o->wheelbase, "wheelbase b [m] (default 0.34)");
+  c->add_option("--distance", o->distance, "distance driven each way [m]")->capture_default_str();
+  c->add_option("--wheelbase", o->wheelbase, "wheelbase b [m]")->capture_default_str();
   c->add_flag("--json", o->json, "print one JSON object on stdout");
   c->callback([o, &exit_code] { run_fit(*o, exit_code); });
 }

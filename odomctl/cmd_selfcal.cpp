@@ -204,6 +204,8 @@ fw::SelfCalSetup selfcal_setup(const SelfcalOpts& o, const Kinematics& believed)
   setup.cfg.fit_every = o.fit_every;
   setup.nominal = setup.in_use = believed.params();
   setup.ripe_delay = from_seconds(0.04);
+  setup.log_prefix = "odomctl selfcal simulate: ";
+  setup.stored_note = " (in the simulation's store only)";
   return setup;
 }
 
@@ -393,30 +395,29 @@ void add_selfcal(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<SelfcalOpts>();
   CLI::App* c = sc->add_subcommand(
       "simulate", "random excursions from a dock with fixes, through the daemon's estimator");
-  c->add_option("--excursions", o->excursions, "excursions, 1..1000")
-      ->check(CLI::Range(1, 1000))
+  fw::with_range(c->add_option("--excursions", o->excursions, "excursions"), 1, 1000)
       ->capture_default_str();
-  c->add_option("--sigma-xy", o->sigma_xy, "fix noise [m], 1e-4..1")
-      ->check(CLI::Range(1e-4, 1.0))
+  fw::with_range(c->add_option("--sigma-xy", o->sigma_xy, "fix noise [m]"), 1e-4, 1.0)
       ->capture_default_str();
-  c->add_option("--sigma-theta", o->sigma_theta, "fix heading noise [deg], 0.01..20")
-      ->check(CLI::Range(0.01, 20.0))
+  fw::with_range(c->add_option("--sigma-theta", o->sigma_theta, "fix heading noise [deg]"), 0.01,
+                 20.0)
       ->capture_default_str();
-  c->add_option("--outliers", o->outliers, "fraction of fixes moved 0.5-5 m, 0..0.5")
-      ->check(CLI::Range(0.0, 0.5))
+  fw::with_range(c->add_option("--outliers", o->outliers, "fraction of fixes moved 0.5-5 m"), 0.0,
+                 0.5)
       ->capture_default_str();
-  c->add_option("--late", o->late, "delay of every fix [s], 0..4")
-      ->check(CLI::Range(0.0, 4.0))
+  fw::with_range(c->add_option("--late", o->late, "delay of every fix [s]"), 0.0, 4.0)
       ->capture_default_str();
-  c->add_flag("--smooth-floor", o->smooth, "no floor roughness (default: the report's floor)");
-  c->add_option("--min-fixes", o->min_fixes, "fixes before the first fit (0: excursions + 1)")
-      ->check(CLI::Range(0, 1000));
-  c->add_option("--fit-every", o->fit_every, "a fit after every n new fixes, 1..1000")
-      ->check(CLI::Range(1, 1000))
+  c->add_flag("--smooth-floor", o->smooth, "no floor roughness (without it: the report's floor)");
+  fw::with_range(
+      c->add_option("--min-fixes", o->min_fixes, "fixes before the first fit, 0 = excursions + 1"),
+      0, 1000)
       ->capture_default_str();
-  c->add_option("--score-runs", o->score_runs,
-                "squares a direction of the systematic E_max,syst, 5..1000")
-      ->check(CLI::Range(5, 1000))
+  fw::with_range(c->add_option("--fit-every", o->fit_every, "a fit after every n new fixes"), 1,
+                 1000)
+      ->capture_default_str();
+  fw::with_range(c->add_option("--score-runs", o->score_runs,
+                               "squares a direction of the systematic E_max,syst"),
+                 5, 1000)
       ->capture_default_str();
   c->add_option("--seed", o->seed, "random seed")->capture_default_str();
   c->add_flag("--json", o->json, "print one JSON object");
@@ -444,8 +445,9 @@ void add_calib_fit_fixes(CLI::App& calib, int& exit_code) {
   c->add_option("--max-sigma-wheelbase", o->fit.max_sigma_wheelbase,
                 "acceptance bound on sigma(b) [m]")
       ->capture_default_str();
-  c->add_option("--min-improvement", o->fit.min_improvement,
-                "held-out score below (1 - this) x the values in use, 0..0.9")
+  fw::say_range(c->add_option("--min-improvement", o->fit.min_improvement,
+                              "held-out score below (1 - this) x the values in use"),
+                0.0, 0.9)
       ->capture_default_str();
   c->add_flag("--json", o->json, "print one JSON object");
   c->callback([o, &exit_code] { run_fit_fixes(*o, exit_code); });

@@ -93,7 +93,7 @@ void add_state(CLI::App& app, int& exit_code) {
   state->require_subcommand(1);
   auto o = std::make_shared<StateOpts>();
   CLI::App* show = state->add_subcommand("show", "print the newest valid state record");
-  show->add_option("--path", o->path, "state file ([resume] path)");
+  show->add_option("--path", o->path, "state file ([resume] path)")->capture_default_str();
   show->add_flag("--json", o->json, "one JSON object");
   show->callback([o, &exit_code] { run_state_show(*o, exit_code); });
 }

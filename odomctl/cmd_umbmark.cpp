@@ -168,8 +168,8 @@ void add_compute(CLI::App& parent, int& exit_code) {
   c->add_option("--side", o->side, "side L of the square [m]")->required();
   c->add_option("--wheelbase", o->wheelbase, "wheelbase the robot used during the runs [m]")
       ->required();
-  c->add_option("--current-cl", o->cl, "c_l the robot used during the runs (default 1)");
-  c->add_option("--current-cr", o->cr, "c_r the robot used during the runs (default 1)");
+  c->add_option("--current-cl", o->cl, "c_l the robot used during the runs")->capture_default_str();
+  c->add_option("--current-cr", o->cr, "c_r the robot used during the runs")->capture_default_str();
   c->add_flag("--json", o->json, "print one JSON object on stdout");
   c->callback([o, &exit_code] { run_compute(*o, exit_code); });
 }
@@ -433,20 +433,25 @@ void add_simulate(CLI::App& parent, int& exit_code) {
   auto o = std::make_shared<SimulateOpts>();
   CLI::App* c = parent.add_subcommand(
       "simulate", "automated UMBmark self-calibration of the simulated robot (virtual time)");
-  c->add_option("--robot", o->robot, "simulated robot (labmate: DESIGN.md reference)");
-  c->add_option("--runs", o->sim.runs, "squares a direction per set (default 5)");
-  c->add_option("--passes", o->sim.passes, "calibration passes (default 1)");
-  c->add_option("--side", o->sim.side, "side of the square [m] (default 4)");
-  c->add_option("--noise", o->noise, "none | paper (floor roughness, reference error)");
+  c->add_option("--robot", o->robot,
+                "simulated robot: labmate (the UMBmark report's LabMate) or nominal")
+      ->capture_default_str();
+  c->add_option("--runs", o->sim.runs, "squares a direction per set")->capture_default_str();
+  c->add_option("--passes", o->sim.passes, "calibration passes")->capture_default_str();
+  c->add_option("--side", o->sim.side, "side of the square [m]")->capture_default_str();
+  c->add_option("--noise", o->noise, "none | paper (floor roughness, reference error)")
+      ->capture_default_str();
   c->add_flag("--bumps", o->sim.bumps, "add extended-UMBmark runs (ten 10 mm bumps)");
-  c->add_option("--seed", o->sim.seed, "random seed (default 1)");
+  c->add_option("--seed", o->sim.seed, "random seed")->capture_default_str();
   c->add_option("--gyro", o->gyro,
-                "none | consumer | industrial: also compare odometry with the gyro fused");
+                "none | consumer | industrial: also compare odometry with the gyro fused")
+      ->capture_default_str();
   c->add_option("--store", o->store, "write the final factors to this calibration store");
   c->add_option("--plot", o->plot, "write an SVG of the return errors before and after");
   c->add_option("--csv", o->csv, "write the first pass's runs (the CSV `record` writes)");
   c->add_option("--eb-form", o->eb_form,
-                "wheelbase formula: umbmark (Eq. 6.29, default) or chong (C&K Eq. 9)");
+                "wheelbase formula: umbmark (Eq. 6.29) or chong (C&K Eq. 9)")
+      ->capture_default_str();
   c->add_flag("--json", o->json, "print one JSON object on stdout");
   c->callback([o, &exit_code] {
     const char* cmd = "umbmark simulate";

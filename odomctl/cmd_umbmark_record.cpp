@@ -761,12 +761,12 @@ void add_record(CLI::App& umbmark, int& exit_code) {
   c->add_option("--side", o->side, "side L of the square [m] (default 4)");
   c->add_option("--runs", o->runs, "squares a direction (default 5)");
   c->add_flag("--bumps", o->bumps, "then as many extended-UMBmark runs (heading required)");
-  c->add_option("--side-wall", o->wall, "the side wall at the start mark: left (default), right")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, calib::SideWall>{
-          {"left", calib::SideWall::kLeft}, {"right", calib::SideWall::kRight}}));
+  c->add_option("--side-wall", o->wall,
+                "the side wall at the start mark: left | right (default left)")
+      ->transform(fw::choice_check(calib::kSideWalls, true));
   c->add_option("--config", o->config,
-                "the daemon's config: its [can] interface, node_id and base_id are the defaults "
-                "of --can, --node and --base-id");
+                "the daemon's config: --can, --node and --base-id are taken from its [can] "
+                "interface, node_id and base_id unless given");
   CLI::Option* node =
       c->add_option("--node", o->node, "node id of the daemon on the bus (default 1)");
   CLI::Option* base =

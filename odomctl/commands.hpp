@@ -6,6 +6,7 @@
 #include <iostream>
 #include <string>
 
+#include "odo/firmware/cli_parse.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/gyrodometry.hpp"
 #include "odo/odometry/kinematics.hpp"

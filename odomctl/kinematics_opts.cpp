@@ -17,12 +17,14 @@ void add_kinematics_options(CLI::App& c, KinematicsOpts& k, const KinematicsHelp
       c.add_option("--wheel-diameter", k.wheel_diameter, "nominal wheel diameter Dn [m]"),
       c.add_option("--counts-per-rev", k.counts_per_rev,
                    "encoder counts per motor revolution after quadrature (Ce)"),
-      c.add_option("--gear-ratio", k.gear_ratio, "motor revolutions per wheel revolution (n)"),
+      c.add_option("--gear-ratio", k.gear_ratio, "motor revolutions per wheel revolution (n)")
+          ->capture_default_str(),
       c.add_option("--wheelbase", k.wheelbase, help.wheelbase),
       c.add_option("--cl", k.cl, help.cl),
       c.add_option("--cr", k.cr, help.cr)};
   for (CLI::Option* o : geometry) o->excludes(config);
-  c.add_option("--counter-bits", k.bits, "counter width in bits, 16..64 (default 64)");
+  fw::say_range(c.add_option("--counter-bits", k.bits, "counter width in bits"), 16, 64)
+      ->capture_default_str();
 }
 
 namespace {

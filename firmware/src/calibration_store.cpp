@@ -1,6 +1,8 @@
 #include "odo/firmware/calibration_store.hpp"
 
+#include <filesystem>
 #include <sstream>
+#include <system_error>
 
 #include "odo/drivers/nv_storage.hpp"
 
@@ -21,6 +23,29 @@ Result<OpenStore> open_calibration_store(const std::string& path, NvBackend back
   if (!s) return make_error(s.error().code, path + ": " + s.error().message);
   o.store.emplace(std::move(s).value());
   return o;
+}
+
+std::optional<StoreAbsence> store_absence(const std::string& path, NvBackend backend) {
+  const NvBackend k = backend == NvBackend::kAuto ? drivers::detect_nv_backend(path) : backend;
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (k != NvBackend::kFile || path.empty() || fs::exists(path, ec) || ec) return std::nullopt;
+  fs::path dir = fs::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  if (!fs::is_directory(dir, ec) && path == kDefaultCalibrationStore)  // not a typo: not installed
+    return StoreAbsence{"neither " + path +
+                            " nor its directory exists yet (the odometryd "
+                            "package creates " +
+                            dir.string() + ")",
+                        false};
+  if (!fs::is_directory(dir, ec))
+    return StoreAbsence{
+        "neither " + path + " nor its directory " + dir.string() + " exists (a typo in the path?)",
+        true};
+  return StoreAbsence{path +
+                          " does not exist yet; it is created when a calibration is first "
+                          "stored (odomctl calib set, calib import, umbmark record --store)",
+                      false};
 }
 
 AppliedCalibration apply_calibration(const KinematicParams& nominal,
@@ -79,10 +104,16 @@ AppliedCalibration read_and_apply(const KinematicParams& nominal, const std::str
     a.report = "calibration: no store configured; running on nominal values";
     return a;
   }
+  const auto absent = store_absence(path, backend);
   auto o = open_calibration_store(path, backend);
   if (!o) return apply_calibration(nominal, Result<LoadResult>(std::move(o).error()), path);
   const std::string where = path + " (" + o->backend + ")";
-  return apply_calibration(nominal, o->store->load(), where);
+  AppliedCalibration a = apply_calibration(nominal, o->store->load(), where);
+  // A store never written is uncalibrated; the person reading the log learns why.
+  if (absent && a.state == StoreStatus::kUncalibrated)
+    a.report =
+        "calibration " + where + ": uncalibrated (" + absent->text + "); running on nominal values";
+  return a;
 }
 
 }  // namespace odo::fw

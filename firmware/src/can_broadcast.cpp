@@ -328,17 +328,25 @@ CanLink::~CanLink() {
 
 Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loop_hz,
                                                  loop::OdometryLoop& loop,
-                                                 const std::string& can_log, bool virtual_time) {
+                                                 const std::string& can_log, bool virtual_time,
+                                                 std::string_view config_source) {
+  // The config's faults are reported under its file name; the log file's under the option.
+  auto config_error = [&](Error e) {
+    if (!config_source.empty()) e.message = std::string(config_source) + ": " + e.message;
+    return e;
+  };
   std::unique_ptr<CanLink> link(new CanLink());
   if (s.bus == CanBusKind::kNone) {
     if (!can_log.empty())
-      return make_error(Errc::kInvalidArgument, "--can-log needs a CAN bus: [can] bus is \"none\"");
+      return config_error(make_error(Errc::kInvalidArgument,
+                                     "can.bus = \"none\": --can-log needs a CAN bus (\"sim\" or "
+                                     "\"socketcan\")"));
     return std::unique_ptr<CanLink>();
   }
   std::string iface;
   if (s.bus == CanBusKind::kSocketCan) {
     auto bus = open_socket_bus(s);
-    if (!bus) return std::move(bus).error();
+    if (!bus) return config_error(std::move(bus).error());
     link->bus_ = std::move(bus).value();
     iface = s.interface;
   } else {
@@ -350,14 +358,14 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
   }
   if (!can_log.empty()) {
     auto w = CanLogWriter::open(can_log, iface);
-    if (!w) return std::move(w).error();
+    if (!w) return make_error(w.error().code, "--can-log " + w.error().message);
     link->log_ = std::move(w).value();
   }
   const CanBroadcastOptions o = broadcast_options(s, loop_hz, virtual_time);
   link->bc_ = std::make_unique<CanBroadcaster>(o, *link->bus_, &loop.commands(),
                                                link->log_ ? &link->log_->ring() : nullptr);
   if (!loop.add_observer(link->bc_.get()))
-    return make_error(Errc::kInvalidArgument, "can: too many loop observers");
+    return config_error(make_error(Errc::kInvalidArgument, "can: too many loop observers"));
   char idtxt[16];
   std::snprintf(idtxt, sizeof idtxt, "0x%03X",
                 protocol::frame_id(o.base_id, o.node_id, protocol::Msg::kPoseX));

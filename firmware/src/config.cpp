@@ -200,7 +200,7 @@ std::string read_interface(TableReader& t, std::string def) {
 }
 
 // ---- [can] (CAN pose broadcast) ----
-void read_can(TableReader t, CanSection& s, double loop_hz) {
+void read_can(TableReader t, CanSection& s, TableReader loop, double loop_hz) {
   s.bus = t.choice("bus", s.bus);
   s.interface = read_interface(t, s.interface);
   s.node_id = static_cast<int>(t.integer("node_id", s.node_id, 0, protocol::kMaxNodeId));
@@ -217,10 +217,17 @@ void read_can(TableReader t, CanSection& s, double loop_hz) {
     *rate = t.number(key, *rate, 0.0, 2000.0, "Hz");
     if (t.ok() && protocol::divisor_for(loop_hz, *rate) < 0) {
       std::ostringstream o;
-      o << "= " << *rate
-        << " Hz must be 0 or loop.rate_hz / n for a whole n >= 1 (loop.rate_hz = " << loop_hz
-        << ")";
-      t.reject(key, o.str());
+      if (t.written(key)) {
+        o << "= " << *rate
+          << " Hz must be 0 or loop.rate_hz / n for a whole n >= 1 (loop.rate_hz = " << loop_hz
+          << ")";
+        t.reject(key, o.str());
+      } else {  // the rate is can's default: the loop rate the user wrote is what does not fit
+        o << "= " << loop_hz << " Hz is not a whole multiple of can." << key << " = " << *rate
+          << " Hz (its default): use a loop rate that is (e.g. 100 or 200), or set can." << key
+          << " to loop.rate_hz / n, or 0 (off)";
+        loop.reject("rate_hz", o.str());
+      }
     }
   }
   s.set_pose = t.boolean("set_pose", s.set_pose);
@@ -410,7 +417,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_can_encoder(root.sub("can_encoder"), c.can_encoder);
   read_serial(root.sub("serial"), c.serial);
   read_error_model(root.sub("error_model"), c.error_model);
-  read_can(root.sub("can"), c.can, c.loop.rate_hz);
+  read_can(root.sub("can"), c.can, root.sub("loop"), c.loop.rate_hz);
   ros2::Config ros2_cfg;
   read_ros2(root.sub("ros2"), ros2_cfg, c.loop.rate_hz, c.realtime.priority);
   c.ros2 = std::make_shared<const ros2::Config>(std::move(ros2_cfg));

@@ -33,15 +33,18 @@ extern "C" void on_reload_signal(int) {
 int main(int argc, char** argv) {
   CLI::App app{"odometryd - wheel odometry firmware for differential-drive robots"};
   odo::fw::DaemonOptions o;
-  app.add_option("--config", o.config_path, "TOML config file (default: built-in simulated robot)")
+  app.add_option("--config", o.config_path,
+                 "TOML config file (default the built-in simulated robot)")
       ->check(CLI::ExistingFile);
-  app.add_option("--duration", o.duration, "seconds of loop time to run, then stop (0: forever)")
-      ->check(CLI::Range(0.0, 1e9));
+  odo::fw::with_range(
+      app.add_option("--duration", o.duration, "loop time to run, then stop [s], 0 = forever"), 0.0,
+      1e9)
+      ->capture_default_str();
   app.add_flag("--virtual-time", o.virtual_time,
                "run the same loop on a virtual clock as fast as possible (simulation only)");
   app.add_flag("--json", o.json, "print one JSON object with the final state at exit");
   app.add_option("--can-log", o.can_log,
-                 "write every CAN frame sent to FILE in candump -L format (also with the "
+                 "write every CAN frame sent to this file in candump -L format (also with the "
                  "simulated bus)");
   app.add_flag("--quiet", o.quiet, "no status lines");
   app.add_flag("--stats", o.stats,

@@ -147,7 +147,7 @@ void SelfCalEstimator::fit() {
   if (!r) {
     ++counters_.fit_errors;
     lk.unlock();
-    log_ << "odometryd: selfcal: fit failed: " << r.error().message << std::endl;
+    log_ << s_.log_prefix << "fit failed: " << r.error().message << std::endl;
     return;
   }
   for (int i : r->rejected) {
@@ -157,7 +157,7 @@ void SelfCalEstimator::fit() {
   }
   counters_.last = *r;
   lk.unlock();
-  log_ << "odometryd: selfcal: " << window_.size() << " fixes (" << r->fixes_rejected
+  log_ << s_.log_prefix << "" << window_.size() << " fixes (" << r->fixes_rejected
        << " rejected): c_l=" << r->estimate.c_l << " c_r=" << r->estimate.c_r
        << " b=" << r->estimate.wheelbase << " m, held-out chi2/dof " << r->score_candidate << " vs "
        << r->score_in_use << " in use: " << calib::verdict_name(r->verdict) << std::endl;
@@ -185,8 +185,8 @@ void SelfCalEstimator::apply(const calib::SelfCalResult& r) {
                                     r.sigma[2]};
   // Values the store or the kinematics refuse are not applied either: nothing half-done.
   if (auto v = calib::validate_record(rec); !v || !k) {
-    log_ << "odometryd: selfcal: candidate refused: "
-         << (!k ? k.error().message : v.error().message) << std::endl;
+    log_ << s_.log_prefix << "candidate refused: " << (!k ? k.error().message : v.error().message)
+         << std::endl;
     return;
   }
   calib::StoreStatus state = calib::StoreStatus::kUncalibrated;
@@ -195,8 +195,8 @@ void SelfCalEstimator::apply(const calib::SelfCalResult& r) {
     std::lock_guard lk(m_);
     if (!seq) {
       ++counters_.store_errors;
-      log_ << "odometryd: selfcal: store write failed, calibration not applied: "
-           << seq.error().message << std::endl;
+      log_ << s_.log_prefix
+           << "store write failed, calibration not applied: " << seq.error().message << std::endl;
       return;
     }
     ++counters_.written;
@@ -209,8 +209,8 @@ void SelfCalEstimator::apply(const calib::SelfCalResult& r) {
     s_.in_use = p;
     ++counters_.accepted;
   }
-  log_ << "odometryd: selfcal: applied c_l=" << p.c_l << " c_r=" << p.c_r << " b=" << p.wheelbase
-       << " m" << (store_ != nullptr ? " (stored)" : " (no store configured)") << std::endl;
+  log_ << s_.log_prefix << "applied c_l=" << p.c_l << " c_r=" << p.c_r << " b=" << p.wheelbase
+       << " m" << (store_ != nullptr ? s_.stored_note : " (no store configured)") << std::endl;
   // The next candidate must beat this one on fixes it has not seen: start a new window at the
   // newest fix.
   window_.erase(window_.begin(), window_.end() - 1);

@@ -127,7 +127,9 @@ Result<loop::BootId> current_boot_id(const std::string& state_path, const char* 
 Result<loop::StateRecord> read_state_file(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
-    if (errno == ENOENT) return make_error(Errc::kNotFound, path + ": no state record");
+    if (errno == ENOENT)
+      return make_error(Errc::kNotFound,
+                        "no state file yet at " + path + " (odometryd writes it while it runs)");
     return io_error("cannot open", path);
   }
   std::array<std::uint8_t, loop::kStateFileBytes> b{};

@@ -34,8 +34,14 @@ void print_timing_stats(std::ostream& out, const loop::LoopStats& st, TimeNs per
 }
 
 const char* format_timing_status(char* buf, std::size_t size, const loop::LoopStats& st) noexcept {
-  std::snprintf(buf, size, "lat p99/max=%.0f/%.0f us  cmp p99=%.1f us", us(st.wakeup_latency.p99),
-                us(st.wakeup_latency_max), us(st.compute_time.p99));
+  // The percentiles are summarised every kSummaryTicks ticks: until the first summary there are
+  // none, and "-" says so (a 0 would read as a measured 0 us).
+  char lat[24] = "-", cmp[24] = "-";
+  if (st.wakeup_latency.count > 0)
+    std::snprintf(lat, sizeof lat, "%.0f", us(st.wakeup_latency.p99));
+  if (st.compute_time.count > 0) std::snprintf(cmp, sizeof cmp, "%.1f", us(st.compute_time.p99));
+  std::snprintf(buf, size, "lat p99/max=%s/%.0f us  cmp p99=%s us", lat, us(st.wakeup_latency_max),
+                cmp);
   return buf;
 }
 

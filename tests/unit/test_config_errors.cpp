@@ -145,6 +145,14 @@ TEST(ConfigErrors, CanSection) {
                "(loop.rate_hz = 100)");
   expect_error("[loop]\nrate_hz = 200\n[can]\nstatus_hz = 300\n",
                "bad.toml:4: can.status_hz = 300 Hz must be 0 or loop.rate_hz / n");
+  // A rate left at its default (pose_hz 50) that the loop rate the user wrote cannot give: the
+  // key written (loop.rate_hz, line 2) is blamed, not the default the user never wrote (issue 35).
+  expect_error("[loop]\nrate_hz = 100.5\n",
+               "bad.toml:2: loop.rate_hz = 100.5 Hz is not a whole multiple of can.pose_hz = 50 Hz "
+               "(its default)");
+  expect_error("[loop]\nrate_hz = 125\n[can]\npose_hz = 25\n",
+               "bad.toml:2: loop.rate_hz = 125 Hz is not a whole multiple of can.velocity_hz = 50 "
+               "Hz (its default)");
   for (const char* ok : {"[can]\npose_hz = 0\n", "[can]\npose_hz = 100\n",
                          "[loop]\nrate_hz = 200\n[can]\npose_hz = 40\ntiming_hz = 0.5\n",
                          "[can]\nbus = \"none\"\n", "[can]\nbase_id = 0\nnode_id = 63\n"}) {

@@ -1,9 +1,25 @@
 #include <gtest/gtest.h>
 
 #include "odo/firmware/config.hpp"
+#include "odo/firmware/timing_report.hpp"
 
 namespace odo::fw {
 namespace {
+
+// The status line's timing part: "-" for a p99 not summarised yet (count 0: the first 256
+// ticks), the max from the first tick; then the summary's p99 in us (35 us = 35000 ns; compute
+// 11.3 us = 11300 ns, printed with one decimal).
+TEST(TimingStatus, PercentilesAreDashUntilTheFirstSummary) {
+  loop::LoopStats st;
+  st.wakeup_latency_max = 69'000;
+  char buf[96];
+  EXPECT_STREQ(format_timing_status(buf, sizeof buf, st), "lat p99/max=-/69 us  cmp p99=- us");
+  st.wakeup_latency.count = 256;
+  st.wakeup_latency.p99 = 35'000;
+  st.compute_time.count = 256;
+  st.compute_time.p99 = 11'300;
+  EXPECT_STREQ(format_timing_status(buf, sizeof buf, st), "lat p99/max=35/69 us  cmp p99=11.3 us");
+}
 
 TEST(RealtimeConfig, DefaultsAndValues) {
   const Config d = default_config();

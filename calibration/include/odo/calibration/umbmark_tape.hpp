@@ -6,12 +6,17 @@
 #include <optional>
 
 #include "odo/calibration/umbmark.hpp"
+#include "odo/hal/choice.hpp"
 #include "odo/odometry/pose.hpp"
 
 namespace odo::calib {
 
 // SideWall: which side of the start pose the side wall is on (the back wall is behind it).
 enum class SideWall { kLeft, kRight };
+
+// kSideWalls: how a person writes a SideWall (odomctl umbmark record --side-wall).
+inline constexpr Choice<SideWall> kSideWalls[] = {{SideWall::kLeft, "left"},
+                                                  {SideWall::kRight, "right"}};
 
 // TapeReading: distances [m] of the reference point to the back wall (along x of the start
 // frame) and to the side wall (along y), taken with the robot standing still.

@@ -30,6 +30,16 @@ struct OpenStore {
 // named nvmem is nvmem, anything else a regular file).
 Result<OpenStore> open_calibration_store(const std::string& path, NvBackend backend);
 
+// store_absence: why a file-backed store at `path` holds nothing yet, for a person: "PATH does
+// not exist yet; it is created when a calibration is first stored" or, when its directory is
+// missing too, "neither PATH nor its directory DIR exists (a typo in the path?)"; nullopt when
+// the path exists or the medium is not a file (nvmem, MTD: opening them says what is wrong).
+struct StoreAbsence {
+  std::string text;
+  bool directory_missing = false;
+};
+std::optional<StoreAbsence> store_absence(const std::string& path, NvBackend backend);
+
 // AppliedCalibration: what odometryd runs on after reading the store.
 struct AppliedCalibration {
   KinematicParams params;  // nominal values with the stored corrections applied

@@ -165,12 +165,14 @@ class CanBroadcaster final : public loop::TickObserver {
 class CanLink {
  public:
   ~CanLink();
-  // create: null (and ok) for bus = "none" with no log; errors name the interface.
-  // virtual_time: the log waits for its writer rather than dropping (no deadlines to keep).
+  // create: null (and ok) for bus = "none" with no log; errors name the interface, and begin
+  // with `config_source` ("file: ") when the config is at fault, with "--can-log FILE" when the
+  // log file is. virtual_time: the log waits for its writer rather than dropping.
   static Result<std::unique_ptr<CanLink>> create(const CanSection& s, double loop_hz,
                                                  loop::OdometryLoop& loop,
                                                  const std::string& can_log,
-                                                 bool virtual_time = false);
+                                                 bool virtual_time = false,
+                                                 std::string_view config_source = {});
   // start: the log thread (call just before the loop runs).
   void start(std::int64_t epoch_ns);
   // send_final: final frames with the stopping status (loop thread, after run()).

@@ -21,6 +21,7 @@
 #include <mutex>
 #include <optional>
 #include <ostream>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -55,6 +56,10 @@ struct SelfCalSetup {
   ErrorModelParams noise;         // wheel noise for the residual covariance
   TimeNs ripe_delay = 0;          // a fix is taken once the record reaches fix time + this [ns]
   std::size_t fix_capacity = 64;  // FixRing size
+  // Who speaks in the log lines, and what "stored" means there (odomctl selfcal simulate runs
+  // the estimator on a simulated store: it is not odometryd, and nothing reaches a real store).
+  std::string log_prefix = "odometryd: selfcal: ";
+  std::string stored_note = " (stored)";
 };
 
 // wall_clock_seconds: the record time of an online calibration [s since 1970, UTC].

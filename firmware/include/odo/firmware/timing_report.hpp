@@ -13,7 +13,8 @@ namespace odo::fw {
 // max in microseconds) and the missed deadlines, for a loop of period `period` [ns].
 void print_timing_stats(std::ostream& out, const loop::LoopStats& st, TimeNs period);
 
-// format_timing_status: "lat p99/max=12/80 us cmp p99=4 us" into buf (no allocation); returns buf.
+// format_timing_status: "lat p99/max=12/80 us  cmp p99=4.0 us" into buf (no allocation), "-" for a
+// p99 not summarised yet (the first kSummaryTicks ticks); returns buf.
 const char* format_timing_status(char* buf, std::size_t size, const loop::LoopStats& st) noexcept;
 
 }  // namespace odo::fw

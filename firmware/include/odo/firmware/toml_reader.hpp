@@ -50,6 +50,8 @@ class TableReader {
   // location: "file:line: path.key" of `key` (the table's line when the key is absent), for
   // errors found later, when the value is used (a serial device that is not there).
   std::string location(std::string_view key) const;
+  // written: the file gives `key` in this table (otherwise a getter returns its default).
+  bool written(std::string_view key) const { return table_ != nullptr && table_->contains(key); }
   // sub: a nested table (may be absent).
   TableReader sub(std::string_view key);
   // finish: reports the first key of this table that no getter asked for.
