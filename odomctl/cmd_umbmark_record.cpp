@@ -568,12 +568,12 @@ bool load_runs(const RecordOpts& o, std::vector<UmbmarkRun>& runs) {
 // nullopt without a spread (fewer than 3 runs) or when a moved set does not compute.
 std::optional<calib::Factors> factor_sigmas(const calib::UmbmarkInput& ui,
                                             const calib::UmbmarkResult& r) {
-  if (!r.sigma) return std::nullopt;
+  if (!r.spread.sigma) return std::nullopt;
   calib::Factors s{0.0, 0.0, 0.0};
   for (const auto& [d, n] :
        {std::pair{Direction::kCw, r.cw.n}, std::pair{Direction::kCcw, r.ccw.n}})
     for (const bool in_x : {true, false}) {
-      const double sem = *r.sigma / std::sqrt(static_cast<double>(n));
+      const double sem = *r.spread.sigma / std::sqrt(static_cast<double>(n));
       calib::UmbmarkInput moved = ui;
       for (UmbmarkRun& run : moved.runs)
         if (run.direction == d && !run.bumps) (in_x ? run.ex : run.ey) += sem;
