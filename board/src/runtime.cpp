@@ -1,7 +1,10 @@
 // What the C and C++ run-time libraries expect from a bare-metal system, and no more:
 // 64-bit atomics (the loop's std::atomic<std::uint64_t> counters; a Cortex-M4 has no 64-bit
-// exclusive access, and it has one core, so masking interrupts makes them atomic), and abort
-// (picolibc's raises a signal through kill/getpid, which a microcontroller has not).
+// exclusive access, and it has one core, so masking interrupts makes them atomic), abort
+// (picolibc's raises a signal through kill/getpid, which a microcontroller has not), and memcpy
+// (picolibc's, built for size, copies a byte at a time: 4 instructions a byte, 1.8k a tick for
+// the loop's snapshot copies; a word at a time when both ends are aligned is 4x fewer).
+#include <cstddef>
 #include <cstdint>
 
 #include "odo/board/fault.hpp"
@@ -61,6 +64,35 @@ bool __atomic_compare_exchange_8(volatile void* p, void* expected, std::uint64_t
   }
   *e = *q;
   return false;
+}
+
+// copy_bytes: memcpy's body. Not recognised as a memcpy (that would call itself).
+[[gnu::optimize("no-tree-loop-distribute-patterns")]] static void copy_bytes(
+    void* __restrict d, const void* __restrict s, std::size_t n) noexcept {
+  using Word [[gnu::may_alias]] = std::uint32_t;
+  auto* dc = static_cast<unsigned char*>(d);
+  const auto* sc = static_cast<const unsigned char*>(s);
+  if (((reinterpret_cast<std::uintptr_t>(dc) | reinterpret_cast<std::uintptr_t>(sc)) & 3U) == 0) {
+    for (; n >= 4; n -= 4, dc += 4, sc += 4)
+      *reinterpret_cast<Word*>(dc) = *reinterpret_cast<const Word*>(sc);
+  }
+  for (; n != 0; --n) *dc++ = *sc++;
+}
+
+// memcpy and its ARM EABI names (all of them here, so that picolibc's, which defines them
+// together, is not linked as well).
+void* memcpy(void* __restrict d, const void* __restrict s, std::size_t n) {
+  copy_bytes(d, s, n);
+  return d;
+}
+void __aeabi_memcpy(void* d, const void* s, std::size_t n) {
+  copy_bytes(d, s, n);
+}
+void __aeabi_memcpy4(void* d, const void* s, std::size_t n) {
+  copy_bytes(d, s, n);
+}
+void __aeabi_memcpy8(void* d, const void* s, std::size_t n) {
+  copy_bytes(d, s, n);
 }
 
 [[noreturn]] void abort() {
