@@ -3,11 +3,15 @@
 // exclusive access, and it has one core, so masking interrupts makes them atomic), abort
 // (picolibc's raises a signal through kill/getpid, which a microcontroller has not), and memcpy
 // (picolibc's, built for size, copies a byte at a time: 4 instructions a byte, 1.8k a tick for
-// the loop's snapshot copies; a word at a time when both ends are aligned is 4x fewer).
+// the loop's snapshot copies; a word at a time when both ends are aligned is 4x fewer), and
+// double division (libgcc's bit-at-a-time __aeabi_ddiv is wrapped, -Wl,--wrap: soft_divide.hpp
+// takes normal operands, libgcc's the rest).
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 
 #include "odo/board/fault.hpp"
+#include "odo/board/soft_divide.hpp"
 
 namespace {
 
@@ -93,6 +97,17 @@ void __aeabi_memcpy4(void* d, const void* s, std::size_t n) {
 }
 void __aeabi_memcpy8(void* d, const void* s, std::size_t n) {
   copy_bytes(d, s, n);
+}
+
+// The run-time ABI's helpers take and return doubles in core registers, also under the
+// hard-float ABI (pcs "aapcs").
+[[gnu::pcs("aapcs")]] double __real___aeabi_ddiv(double a, double b);
+[[gnu::pcs("aapcs")]] double __wrap___aeabi_ddiv(double a, double b) {
+  std::uint64_t q = 0;
+  if (odo::board::divide_normal(std::bit_cast<std::uint64_t>(a), std::bit_cast<std::uint64_t>(b),
+                                q))
+    return std::bit_cast<double>(q);
+  return __real___aeabi_ddiv(a, b);
 }
 
 [[noreturn]] void abort() {
