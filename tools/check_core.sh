@@ -2,9 +2,10 @@
 # check_core.sh - the house rules that a compiler or configure step does not check by itself
 # (README "Layout", issue 33). Exit 1 with the offending lines when a rule is broken.
 #   portable   the core rooms (hal, odometry, calibration, loop, protocol) include no Linux or
-#              POSIX header, start no thread, use no iostream, and compile with -fno-exceptions
-#              -fno-rtti (preset core-portable: those libraries only); the microcontroller
-#              build stands on this
+#              POSIX header, start no thread, use no C++ stream (iostream, sstream: their locale
+#              machinery is 88 KB of a microcontroller's flash; hal/format.hpp words numbers),
+#              and compile with -fno-exceptions -fno-rtti (preset core-portable: those
+#              libraries only); the microcontroller build stands on this
 #   functions  no function of the project's own code (tests excepted) is longer than 60 lines
 #              (clang-tidy's readability-function-size over build/default's compile database)
 # The layer table needs no check here: configure (odo_check_layers) fails on a wrong link.
@@ -19,9 +20,10 @@ rc=0
 check_portable() {
   local bad
   # Headers of an operating system, of threads and of stream I/O: none in the core.
-  bad=$(grep -rnE '#include <(unistd\.h|fcntl\.h|poll\.h|termios\.h|pthread\.h|sys/[a-z_/]+\.h|linux/[a-z_/]+\.h|iostream|fstream|thread|mutex|condition_variable|future|filesystem)>' \
+  bad=$(grep -rnE '#include <(unistd\.h|fcntl\.h|poll\.h|termios\.h|pthread\.h|sys/[a-z_/]+\.h|linux/[a-z_/]+\.h|iostream|fstream|sstream|ostream|istream|iomanip|locale|thread|mutex|condition_variable|future|filesystem)>' \
     "${core_rooms[@]}" || true)
-  bad+=$(grep -rnE 'std::(thread|jthread|async)\b|pthread_create' "${core_rooms[@]}" || true)
+  bad+=$(grep -rnE 'std::(thread|jthread|async)\b|pthread_create|std::(o|i)?stringstream|std::(cout|cerr|clog)\b' \
+    "${core_rooms[@]}" || true)
   if [[ -n $bad ]]; then
     echo "check_core: portable: the core rooms must not use these (Linux, POSIX, threads, streams):"
     echo "$bad"

@@ -1,7 +1,9 @@
 #include "odo/calibration/count_recorder.hpp"
 
 #include <cmath>
-#include <sstream>
+#include <string>
+
+#include "odo/hal/format.hpp"
 
 namespace odo::calib {
 namespace {
@@ -28,10 +30,9 @@ Result<RecorderLimits> recorder_limits(const Kinematics& k, double max_turn, dou
                 {"max_duration", max_duration, max_duration * 1e9}};
   for (const auto& c : checks) {
     if (!(std::isfinite(c.value) && c.value > 0.0 && c.counts >= 1.0 && c.counts < 1e9)) {
-      std::ostringstream m;
-      m << "recorder " << c.field << " = " << c.value
-        << " must be positive and give 1 .. 1e9 counts (or ns)";
-      return make_error(Errc::kInvalidArgument, m.str());
+      return make_error(Errc::kInvalidArgument,
+                        std::string("recorder ") + c.field + " = " + general_text(c.value) +
+                            " must be positive and give 1 .. 1e9 counts (or ns)");
     }
   }
   return RecorderLimits{static_cast<std::int32_t>(turn), static_cast<std::int32_t>(travel),

@@ -6,10 +6,11 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <sstream>
+#include <string>
 
 #include "odo/hal/bytes.hpp"
 #include "odo/hal/crc.hpp"
+#include "odo/hal/format.hpp"
 #include "odo/odometry/kinematics.hpp"
 
 namespace odo::calib {
@@ -134,9 +135,7 @@ Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
   if (bytes.size() < kRecordV1Bytes) return corrupt("shorter than a version-1 record");
   const auto magic = get<std::uint32_t>(bytes, 0);
   if (magic != kRecordMagic) {
-    std::ostringstream m;
-    m << "no record magic (found 0x" << std::hex << magic << ")";
-    return corrupt(m.str());
+    return corrupt("no record magic (found 0x" + hex_text(magic) + ")");
   }
   const auto version = get<std::uint16_t>(bytes, 4);
   const auto length = get<std::uint16_t>(bytes, 6);
@@ -150,9 +149,8 @@ Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
   const auto stored = get<std::uint32_t>(bytes, length - 4U);
   const auto computed = crc32(bytes.first(length - 4U));
   if (stored != computed) {
-    std::ostringstream m;
-    m << "CRC mismatch (stored 0x" << std::hex << stored << ", computed 0x" << computed << ")";
-    return corrupt(m.str());
+    return corrupt("CRC mismatch (stored 0x" + hex_text(stored) + ", computed 0x" +
+                   hex_text(computed) + ")");
   }
   CalibrationRecord r;
   r.sequence = get<std::uint64_t>(bytes, 8);

@@ -4,7 +4,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <string>
 
 #include "odo/odometry/kinematics.hpp"
 #include "selfcal_model.hpp"

@@ -1,8 +1,10 @@
 #include "odo/calibration/store.hpp"
 
 #include <algorithm>
-#include <sstream>
+#include <string>
 #include <vector>
+
+#include "odo/hal/format.hpp"
 
 namespace odo::calib {
 namespace {
@@ -32,20 +34,18 @@ const char* status_name(StoreStatus s) noexcept {
 }
 
 std::string LoadResult::describe() const {
-  std::ostringstream m;
-  m << status_name(status);
-  if (record) m << ", sequence " << record->sequence << " in slot " << (slot == 0 ? 'A' : 'B');
-  if (record && record->cleared) m << " (reset marker)";
+  std::string m = status_name(status);
+  if (record)
+    m += ", sequence " + decimal_text(record->sequence) + (slot == 0 ? " in slot A" : " in slot B");
+  if (record && record->cleared) m += " (reset marker)";
   if (status == StoreStatus::kCorrupt || (status == StoreStatus::kUncalibrated && !record)) {
     for (int i = 0; i < 2; ++i) {
       const SlotInfo& s = slots[static_cast<std::size_t>(i)];
-      m << "; slot " << (i == 0 ? 'A' : 'B') << ": "
-        << (s.valid   ? "valid"
-            : s.blank ? "blank"
-                      : s.problem);
+      m += i == 0 ? "; slot A: " : "; slot B: ";
+      m += s.valid ? "valid" : s.blank ? "blank" : s.problem.c_str();
     }
   }
-  return m.str();
+  return m;
 }
 
 Result<StoreLayout> plan_layout(const NvGeometry& g) {
@@ -57,10 +57,11 @@ Result<StoreLayout> plan_layout(const NvGeometry& g) {
     l.slot_size = std::min(kByteSlotMax, g.size / 2) / unit * unit;
   }
   if (l.slot_size < kRecordV1Bytes || 2 * l.slot_size > g.size) {
-    std::ostringstream m;
-    m << "medium of " << g.size << " bytes (erase block " << g.erase_block
-      << ") is too small for two calibration slots of at least " << kRecordV1Bytes << " bytes";
-    return make_error(Errc::kUnsupported, m.str());
+    return make_error(Errc::kUnsupported,
+                      "medium of " + decimal_text(g.size) + " bytes (erase block " +
+                          decimal_text(g.erase_block) +
+                          ") is too small for two calibration slots of at least " +
+                          decimal_text(kRecordV1Bytes) + " bytes");
   }
   l.slot_offset = {0, l.slot_size};
   return l;

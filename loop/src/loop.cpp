@@ -1,7 +1,7 @@
 #include "odo/loop/loop.hpp"
 
 #include <cmath>
-#include <sstream>
+#include <string>
 
 #include "odo/hal/field_range.hpp"
 #include "odo/odometry/count_delta.hpp"

@@ -75,12 +75,18 @@ void Odometry::advance_fused(double d_l, double d_r, double dt, double dtheta, d
 void Odometry::integrate(double d_l, double d_r, double ds, double dth, double dt) noexcept {
   d_left_ = d_l;
   d_right_ = d_r;
+  dth_ = dth;
   integ_.step_arc(ds, dth);
   distance_ += std::fabs(ds);
   if (dt > 0.0) {
-    const double inv_dt = 1.0 / dt;
-    v_ = ds * inv_dt;
-    w_ = dth * inv_dt;
+    // A fixed-rate loop's ticks have one length: its reciprocal is divided once (a division is
+    // ~570 instructions on a Cortex-M4, the same bits either way).
+    if (dt != dt_of_) {
+      dt_of_ = dt;
+      inv_dt_ = 1.0 / dt;
+    }
+    v_ = ds * inv_dt_;
+    w_ = dth * inv_dt_;
   }
 }
 

@@ -1,5 +1,7 @@
 #include "odo/protocol/serial_counts.hpp"
 
+#include <array>
+
 namespace odo::protocol {
 namespace {
 
@@ -21,16 +23,31 @@ std::uint32_t get_u32(const std::uint8_t* p) noexcept {
 
 }  // namespace
 
-std::uint16_t crc16_ccitt_false(std::span<const std::uint8_t> data) noexcept {
-  // Bitwise rather than a 512-byte table: 16 bytes per record, and the microcontroller's flash
-  // is worth more than the few hundred cycles.
-  std::uint16_t crc = 0xFFFF;
-  for (const std::uint8_t b : data) {
-    crc = static_cast<std::uint16_t>(crc ^ (b << 8));
-    for (int i = 0; i < 8; ++i)
-      crc = static_cast<std::uint16_t>((crc & 0x8000) ? (crc << 1) ^ 0x1021 : crc << 1);
+namespace {
+
+// The CRC of each 4-bit value in the top nibble, shifted out through the polynomial 0x1021:
+// a nibble at a time needs 32 bytes of table where a byte at a time needs 512, and it is ~6x
+// fewer instructions than a bit at a time (~1000 a record on a Cortex-M4 before).
+constexpr std::array<std::uint16_t, 16> make_crc16_nibbles() noexcept {
+  std::array<std::uint16_t, 16> t{};
+  for (unsigned n = 0; n < 16; ++n) {
+    unsigned c = n << 12;
+    for (int i = 0; i < 4; ++i) c = (c & 0x8000U) ? (c << 1) ^ 0x1021U : c << 1;
+    t[n] = static_cast<std::uint16_t>(c);
   }
-  return crc;
+  return t;
+}
+constexpr auto kCrc16Nibbles = make_crc16_nibbles();
+
+}  // namespace
+
+std::uint16_t crc16_ccitt_false(std::span<const std::uint8_t> data) noexcept {
+  unsigned crc = 0xFFFF;
+  for (const std::uint8_t b : data) {
+    crc = ((crc << 4) & 0xFFFFU) ^ kCrc16Nibbles[(crc >> 12) ^ (b >> 4U)];
+    crc = ((crc << 4) & 0xFFFFU) ^ kCrc16Nibbles[(crc >> 12) ^ (b & 0xFU)];
+  }
+  return static_cast<std::uint16_t>(crc);
 }
 
 std::size_t cobs_encode(std::span<const std::uint8_t> in, std::span<std::uint8_t> out) noexcept {

@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <numbers>
-#include <sstream>
+#include <string>
+
+#include "odo/hal/format.hpp"
 
 namespace odo::sim {
 namespace {
@@ -97,9 +99,8 @@ double scenario_duration(const Scenario& s) {
 
 Result<SimRobot> SimRobot::create(const RobotGeometry& g, Scenario scenario, const Pose2& start) {
   auto bad = [](const char* f, double v) {
-    std::ostringstream m;
-    m << "sim robot " << f << " = " << v << " must be finite and > 0";
-    return make_error(Errc::kInvalidArgument, m.str());
+    return make_error(Errc::kInvalidArgument, std::string("sim robot ") + f + " = " +
+                                                  general_text(v) + " must be finite and > 0");
   };
   if (!(g.wheel_diameter_left > 0 && std::isfinite(g.wheel_diameter_left)))
     return bad("wheel_diameter_left", g.wheel_diameter_left);

@@ -6,11 +6,12 @@
 #pragma once
 
 #include <cstdint>
-#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <string>
 #include <utility>
+
+#include "odo/hal/format.hpp"
 
 namespace odo {
 
@@ -85,18 +86,13 @@ struct RangeRow {
 // (numbers as %g prints them, with the digits needed to give the value back).
 inline std::string range_text(const FieldRange& r) {
   auto num = [&](double v, std::int64_t i) {
-    char b[32];
-    if (r.integer) {
-      std::snprintf(b, sizeof b, "%lld", static_cast<long long>(i));
-    } else {
-      // %g, with more digits where 6 would not give the value back: 10.00001 must not read as
-      // the limit 10 it lies beyond.
-      for (int p = 6; p <= 17; ++p) {
-        std::snprintf(b, sizeof b, "%.*g", p, v);
-        if (std::strtod(b, nullptr) == v || !(v == v)) break;
-      }
-    }
-    return std::string(b);
+    if (r.integer) return decimal_text(i);
+    // %g, with more digits where 6 would not give the value back: 10.00001 must not read as
+    // the limit 10 it lies beyond.
+    std::string t = general_text(v);
+    for (int p = 7; p <= 17 && v == v && std::strtod(t.c_str(), nullptr) != v; ++p)
+      t = general_text(v, p);
+    return t;
   };
   const std::string u = r.unit.empty() ? std::string() : " " + r.unit;
   std::string m = "= " + num(r.value, r.ivalue);

@@ -140,7 +140,8 @@ class Odometry {
     // and cosine of it spare a trigonometric call.
     const double s0 = sin_theta(), c0 = cos_theta();
     update(dn_left, dn_right, dt);
-    cov_.step_sc(s0, c0, d_left_, d_right_, k_.wheelbase());
+    // update's heading change is (d_R - d_L) / b: the covariance's phi, already divided.
+    cov_.step_sc_phi(s0, c0, d_left_, d_right_, k_.wheelbase(), dth_);
   }
   // reset: set the pose, taken as exact (zero covariance); velocities and distance are kept.
   void reset(const Pose2& p) noexcept {
@@ -165,7 +166,7 @@ class Odometry {
   void advance_travel(double d_l, double d_r, double dt) noexcept {
     const double s0 = sin_theta(), c0 = cos_theta();
     update_travel(d_l, d_r, dt);
-    cov_.step_sc(s0, c0, d_left_, d_right_, k_.wheelbase());
+    cov_.step_sc_phi(s0, c0, d_left_, d_right_, k_.wheelbase(), dth_);
   }
   // update_travel: update() from wheel travels d_l, d_r [m] (the pose only).
   void update_travel(double d_l, double d_r, double dt) noexcept;
@@ -203,6 +204,9 @@ class Odometry {
   double distance_ = 0.0;
   double d_left_ = 0.0;
   double d_right_ = 0.0;
+  double dth_ = 0.0;     // heading change of the last tick [rad]
+  double dt_of_ = 0.0;   // the tick length [s] that inv_dt_ is the reciprocal of
+  double inv_dt_ = 0.0;  // 1.0 / dt_of_ [1/s]
 };
 
 }  // namespace odo
