@@ -113,6 +113,8 @@ nlohmann::json Ros2Output::json() const {
           {"spin_late", st.spin_late},
           {"due_waits", st.due_waits},
           {"stale_published", st.stale_published},
+          {"free_run_published", st.free_run_published},
+          {"unpolled_published", st.unpolled_published},
           {"spin_wait_sum", to_seconds(st.spin_wait_sum_ns)}};
 }
 

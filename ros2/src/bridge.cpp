@@ -79,7 +79,8 @@ struct Bridge::Impl {
   std::atomic<std::uint64_t> odom_published{0}, tf_published{0}, unchanged_skipped{0},
       write_errors{0}, set_pose_received{0}, set_pose_rejected{0};
   std::atomic<std::int64_t> write_age_sum_ns{0}, write_age_max_ns{0}, last_published{0};
-  std::atomic<std::uint64_t> spin_count{0}, spin_late{0}, due_waits{0}, stale_published{0};
+  std::atomic<std::uint64_t> spin_count{0}, spin_late{0}, due_waits{0}, stale_published{0},
+      free_run_published{0}, unpolled_published{0};
   std::atomic<std::int64_t> spin_wait_sum_ns{0};
   std::array<std::atomic<std::uint32_t>, kAgeBins> age_hist{};
 
@@ -255,6 +256,8 @@ Bridge::Impl::Published Bridge::Impl::publish_due(TimeNs due) {
     if (now == woke) spin_late.fetch_add(1, std::memory_order_relaxed);
     spin_count.fetch_add(1, std::memory_order_relaxed);
     spin_wait_sum_ns.fetch_add(now - woke, std::memory_order_relaxed);
+  } else {
+    unpolled_published.fetch_add(1, std::memory_order_relaxed);
   }
   return publish(s);
 }
@@ -289,6 +292,8 @@ void Bridge::Impl::run() {
     lock.unlock();
     take_set_pose();
     const Published p = due != 0 ? publish_due(due) : publish_once();
+    if (due == 0 && p == Published::kYes)
+      free_run_published.fetch_add(1, std::memory_order_relaxed);
     lock.lock();
     const auto next = next_wake(p, chr::steady_clock::now(), due);
     cv.wait_until(lock, next, [this] { return stopping; });
@@ -370,6 +375,8 @@ BridgeStats Bridge::stats() const {
   st.spin_late = r(i.spin_late);
   st.due_waits = r(i.due_waits);
   st.stale_published = r(i.stale_published);
+  st.free_run_published = r(i.free_run_published);
+  st.unpolled_published = r(i.unpolled_published);
   st.spin_wait_sum_ns = i.spin_wait_sum_ns.load(std::memory_order_relaxed);
   return st;
 }

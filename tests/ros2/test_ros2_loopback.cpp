@@ -260,11 +260,17 @@ TEST(Ros2Bridge, EarlyWakeUpKeepsTheRateAndStillSendsTheLastSampleAtStop) {
   EXPECT_LE(st.odom_published, static_cast<std::uint64_t>(ran_s * 100) + 2) << ran_s << " s";
   EXPECT_GE(st.odom_published, 60u);
   EXPECT_EQ(st.tf_published, st.odom_published);
-  // Every write but the first (no phase yet) and the last (after stop) followed a poll, or a
-  // wait for a tick the simulated loop (not real-time here) made late, or replaced a tick that
-  // never came; a few may have fallen back to the free-running period (the thread woke late).
-  EXPECT_GE(st.spin_count + st.due_waits + st.stale_published + 10, st.odom_published)
-      << "spin_late " << st.spin_late;
+  // Every write but the last (after stop) is counted in one way it went out: after the poll, for
+  // the due tick without a poll (the thread woke late, or waited for a tick the simulated loop
+  // made late), in place of a tick that never came, or with no due tick (the first, and after a
+  // wake-up the thread missed). Before, the late wake-ups were not counted and at most 10 were
+  // allowed: red in a fresh-chroot CI run on a machine loaded beside it (13). How many go
+  // through the poll is the scheduler's business, a figure (BENCHMARKS.md), not an assertion.
+  const std::uint64_t counted =
+      st.spin_count + st.unpolled_published + st.stale_published + st.free_run_published;
+  EXPECT_LE(counted, st.odom_published);
+  EXPECT_GE(counted + 1, st.odom_published) << "spin_late " << st.spin_late;
+  EXPECT_GE(st.free_run_published, 1u);  // the first write
   EXPECT_GT(st.spin_count, 0u);
   EXPECT_GT(st.spin_wait_sum_ns, 0);
   EXPECT_EQ(st.last_published, final_sample.sample_time);

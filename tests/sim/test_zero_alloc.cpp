@@ -385,8 +385,9 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   }
   // It really ran: every tick counted, motion integrated, statistics kept, frames sent.
   EXPECT_EQ(loop->stats().ticks, kTicks);
-  // 50 + 50 + 50 + 10 + 10 + 1 frames per second of loop time, plus the six final frames.
-  EXPECT_EQ((*can)->counters().sent, 171u * (kTicks / 1000) + 6u);
+  // 50 + 50 + 50 + 10 + 10 (Status) + 10 (EncoderFaults) + 1 frames per second of loop time,
+  // plus the seven final frames.
+  EXPECT_EQ((*can)->counters().sent, 181u * (kTicks / 1000) + 7u);
   EXPECT_EQ((*can)->counters().dropped(), 0u);
   EXPECT_EQ((*can)->counters().set_pose_applied, 1u);
   EXPECT_EQ(loop->commands_applied(), 2u);  // the calibration and the set-pose command

@@ -49,6 +49,12 @@ struct BridgeStats {
   // and publishes of an older sample because the due tick had not come half a period after it.
   std::uint64_t due_waits = 0;
   std::uint64_t stale_published = 0;
+  // Publishes of the newest sample with no due tick to look for: the first (no phase yet), and
+  // each after a wake-up already missed (the thread was not scheduled in time: it skips ticks).
+  std::uint64_t free_run_published = 0;
+  // Publishes of the due tick without polling for it: spin_us is 0, or the thread woke after
+  // due + spin_us, or it had waited for the late tick (due_waits).
+  std::uint64_t unpolled_published = 0;
 };
 
 class Bridge {
