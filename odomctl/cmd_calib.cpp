@@ -27,7 +27,7 @@ void add_store_options(CLI::App* c, StoreOpts& o, bool json) {
   c->add_option("--store", o.path, "store: a file, an nvmem file or /dev/mtdN")
       ->capture_default_str();
   c->add_option("--backend", o.backend, "auto | file | nvmem | mtd (auto: from the path)")
-      ->check(CLI::IsMember(fw::choice_names<fw::StoreBackend>()))
+      ->check(CLI::IsMember(fw::choice_names<NvBackend>()))
       ->capture_default_str();
   if (json) c->add_flag("--json", o.json, "print one JSON object");
 }
@@ -36,8 +36,7 @@ void add_store_options(CLI::App* c, StoreOpts& o, bool json) {
 std::optional<fw::OpenStore> open_loaded(const char* cmd, const StoreOpts& o,
                                          calib::LoadResult& loaded, int& exit_code) {
   // --backend is one of the spellings (CLI::IsMember above).
-  const auto backend =
-      fw::parse_choice<fw::StoreBackend>(o.backend).value_or(fw::StoreBackend::kAuto);
+  const auto backend = fw::parse_choice<NvBackend>(o.backend).value_or(NvBackend::kAuto);
   auto s = fw::open_calibration_store(o.path, backend);
   if (!s) {
     std::cerr << "odomctl calib " << cmd << ": " << s.error().message << "\n";

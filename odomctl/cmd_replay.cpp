@@ -28,9 +28,9 @@ nlohmann::json gyro_json(const FusionCounters& c) {
 
 // run_replay: `odomctl ... replay` once its options are parsed; sets exit_code.
 void run_replay(const ReplayOpts& o, int& exit_code) {
-  auto k = make_kinematics(o.kin);
-  if (!k) {
-    std::cerr << "odomctl replay: " << k.error().message << "\n";
+  auto run = log_run(o.kin);
+  if (!run) {
+    std::cerr << "odomctl replay: " << run.error().message << "\n";
     exit_code = kExitBadInput;
     return;
   }
@@ -40,9 +40,10 @@ void run_replay(const ReplayOpts& o, int& exit_code) {
     exit_code = kExitBadInput;
     return;
   }
-  analysis::ReplayGyro gyro;  // the loop's default fusion parameters (README "Gyro")
+  analysis::ReplayGyro gyro;
   gyro.use = !o.no_gyro;
-  auto r = analysis::replay_ticks(in, o.ticks, *k, o.kin.bits, gyro);
+  gyro.params = run->fusion;
+  auto r = analysis::replay_ticks(in, o.ticks, run->kinematics, o.kin.bits, gyro);
   if (!r) {
     std::cerr << "odomctl replay: " << r.error().message << "\n";
     exit_code = kExitBadInput;

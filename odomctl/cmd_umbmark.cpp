@@ -215,7 +215,7 @@ void add_scale(CLI::App& parent, int& exit_code) {
 }  // namespace
 
 bool save_factors(const std::string& path, calib::CalibrationRecord rec, const char* cmd) {
-  auto s = fw::open_calibration_store(path, fw::StoreBackend::kAuto);
+  auto s = fw::open_calibration_store(path, NvBackend::kAuto);
   if (!s) {
     std::cerr << "odomctl " << cmd << ": " << s.error().message << "\n";
     return false;
@@ -252,7 +252,7 @@ calib::CalibrationRecord sim_record(const analysis::UmbmarkSimResult& r) {
 struct SimulateOpts {
   analysis::UmbmarkSimOptions sim;
   std::string robot = "labmate", noise = "none";  // as typed; parsed into sim before run_simulate
-  std::string store, plot, csv, eb_form = "umbmark";
+  std::string store, plot, csv, eb_form = "umbmark", gyro = "none";  // choices as typed
   bool json = false;
 };
 
@@ -280,13 +280,13 @@ void print_gyro_comparison(const analysis::UmbmarkGyroComparison& g, const std::
 
 // simulate_options_ok: the options, the formula and every output path, before any square.
 bool simulate_options_ok(SimulateOpts& o) {
-  if (o.eb_form != "umbmark" && o.eb_form != "chong") {
-    std::cerr << "odomctl umbmark simulate: --eb-form = '" << o.eb_form
-              << "' must be umbmark or chong\n";
+  auto formula =
+      parse_choice_of<calib::WheelbaseFormula>(calib::kWheelbaseFormulas, "--eb-form", o.eb_form);
+  if (!formula) {
+    std::cerr << "odomctl umbmark simulate: " << formula.error().message << "\n";
     return false;
   }
-  o.sim.formula = o.eb_form == "chong" ? calib::WheelbaseFormula::kChongKleeman9
-                                       : calib::WheelbaseFormula::kUmbmark629;
+  o.sim.formula = *formula;
   if (auto s = analysis::check_umbmark_sim_options(o.sim); !s) {
     std::cerr << "odomctl umbmark simulate: " << s.error().message << "\n";
     return false;
@@ -390,7 +390,7 @@ void run_simulate(SimulateOpts o, int& exit_code) {  // a copy: sets o.sim.formu
   if (o.json) {
     print_simulate_json(*r);
   } else {
-    print_simulate_text(*r, o.sim.gyro);
+    print_simulate_text(*r, o.gyro);
   }
   exit_code = kExitOk;
 }
@@ -408,7 +408,7 @@ void add_simulate(CLI::App& parent, int& exit_code) {
   c->add_option("--noise", o->noise, "none | paper (floor roughness, reference error)");
   c->add_flag("--bumps", o->sim.bumps, "add extended-UMBmark runs (ten 10 mm bumps)");
   c->add_option("--seed", o->sim.seed, "random seed (default 1)");
-  c->add_option("--gyro", o->sim.gyro,
+  c->add_option("--gyro", o->gyro,
                 "none | consumer | industrial: also compare odometry with the gyro fused");
   c->add_option("--store", o->store, "write the final factors to this calibration store");
   c->add_option("--plot", o->plot, "write an SVG of the return errors before and after");
@@ -419,7 +419,10 @@ void add_simulate(CLI::App& parent, int& exit_code) {
   c->callback([o, &exit_code] {
     const char* cmd = "umbmark simulate";
     if (take_choice(analysis::parse_umbmark_robot(o->robot), o->sim.robot, cmd, exit_code) &&
-        take_choice(analysis::parse_umbmark_noise(o->noise), o->sim.noise, cmd, exit_code))
+        take_choice(analysis::parse_umbmark_noise(o->noise), o->sim.noise, cmd, exit_code) &&
+        take_choice(
+            parse_choice_of<analysis::UmbmarkGyro>(analysis::kUmbmarkGyros, "--gyro", o->gyro),
+            o->sim.gyro, cmd, exit_code))
       run_simulate(*o, exit_code);
   });
 }

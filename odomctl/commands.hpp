@@ -7,6 +7,7 @@
 #include <string>
 
 #include "odo/hal/result.hpp"
+#include "odo/odometry/gyrodometry.hpp"
 #include "odo/odometry/kinematics.hpp"
 
 namespace odo::ctl {
@@ -66,6 +67,10 @@ struct KinematicsOpts {
   double wheel_diameter = 0, counts_per_rev = 0, gear_ratio = 1, wheelbase = 0;  // m, -, -, m
   double cl = 1, cr = 1;
   int bits = 64;
+  // --config: odometryd's config file, read through the daemon's own reader and tables: its
+  // [robot] with the calibration store it names applied, [error_model] and [gyro] (instead of
+  // the geometry options, which it excludes).
+  std::string config;
 };
 
 // KinematicsHelp: the wording of --wheelbase, --cl and --cr, which differs by command.
@@ -79,8 +84,20 @@ struct KinematicsHelp {
 // --cr and --counter-bits on `c`, stored in `k` (which must outlive the parse).
 void add_kinematics_options(CLI::App& c, KinematicsOpts& k, const KinematicsHelp& help);
 
-// make_kinematics: the Kinematics of `k`; the error names the field and its range.
+// make_kinematics: the Kinematics of `k` (of its --config when given); the error names the
+// field and its range, or the config file's line.
 Result<Kinematics> make_kinematics(const KinematicsOpts& k);
+
+// LogRun: what a log command runs the loop's code with: the kinematics, and the gyrodometry
+// parameters odometryd would run with (its config's [gyro] and [error_model] with --config,
+// else the fusion's defaults; tick and heading_quantum are set by the caller, as the loop sets
+// them from its rate and kinematics).
+struct LogRun {
+  Kinematics kinematics;
+  GyrodometryParams fusion;
+};
+// log_run: the LogRun of `k`, reading --config once; errors as make_kinematics.
+Result<LogRun> log_run(const KinematicsOpts& k);
 
 // add_replay: `odomctl replay` (integrate a log of raw counts).
 void add_replay(CLI::App& app, int& exit_code);

@@ -4,6 +4,10 @@
 #   default     RelWithDebInfo: unit, sim, cli tiers and the UMBmark noise study (label study)
 #   soak        the `soak` tier of the default build: 24 h of simulated driving with random
 #               faults in virtual time (ODO_SOAK=0 skips it)
+#   mcu         (after default) the microcontroller firmware: preset mcu-stm32f405 built, then
+#               tests/mcu/test_mcu_qemu.sh in qemu-system-arm (ODO_MCU=0 skips it; under CI a
+#               missing toolchain or QEMU fails it); the kernel tier's kernel_mcu_slcan uses its
+#               image
 #   kernel      the `kernel` tier of the default build, inside a QEMU VM with Debian's kernel
 #               (tools/vm-run.sh: vcan, gpio-sim, mtdram, at24); if the VM cannot start, the stage
 #               fails under CI; elsewhere those tests run on the host, where each one reports
@@ -24,8 +28,10 @@
 #               tests/package/check_deb.sh; the amd64 one is installed, run, verified with
 #               systemd-analyze, removed and purged on this machine (CI is throw-away), and
 #               installed with apt on a fresh debootstrap chroot (tests/package/fresh_install.sh)
+#   rules       after default: tools/check_core.sh (the core rooms portable: no OS header, thread
+#               or stream, built with -fno-exceptions -fno-rtti; no function over 60 lines)
 # Environment: ODO_JOBS (parallel build jobs, default nproc), ODO_CONFIGS (space-separated
-# subset of the configurations above), ODO_SOAK=0, ODO_KERNEL=0, ODO_PACKAGES=0 (skip those
+# subset of the configurations above), ODO_RULES=0, ODO_SOAK=0, ODO_KERNEL=0, ODO_MCU=0, ODO_PACKAGES=0 (skip those
 # stages), ODO_FRESH_INSTALL=0 (no chroot install).
 #
 # A skip is for a developer's machine that lacks something, never for CI: with CI=true (as CI
@@ -209,6 +215,46 @@ stage_fresh_install() {  # the amd64 package on a freshly bootstrapped Debian 12
   summary+=("fresh install amd64: $r ($(($(date +%s) - t0)) s)")
 }
 
+stage_mcu() {  # the microcontroller firmware (issue 36): its preset's build, the QEMU tests
+  local t0 r=ok log=build/mcu.log line p f
+  echo "=== mcu ==="
+  t0=$(date +%s)
+  if ! command -v qemu-system-arm >/dev/null || ! command -v arm-none-eabi-g++ >/dev/null; then
+    # setup.sh --tests installs both: a machine without them cannot run the stage.
+    if in_ci; then r="FAILED under CI (qemu-system-arm or arm-none-eabi-g++ missing)"; status=1
+      n_fail=$((n_fail + 1))
+    else r="skipped (qemu-system-arm or arm-none-eabi-g++ missing)"; n_skip=$((n_skip + 1)); fi
+    summary+=("mcu: $r ($(($(date +%s) - t0)) s)")
+    return 0
+  fi
+  set +e
+  {
+    cmake --preset mcu-stm32f405 -DODO_WERROR="$(in_ci && echo ON || echo OFF)" &&
+      cmake --build --preset mcu-stm32f405 -j "$jobs" &&
+      ODOMETRYD=build/default/firmware/odometryd ODOMCTL=build/default/odomctl/odomctl \
+        tests/mcu/test_mcu_qemu.sh "$ODO_ROOT" build/mcu-stm32f405/board/odo_mcu_qemu.elf
+  } >"$log" 2>&1
+  local rc=$?
+  set -e
+  grep -E '^(FAIL|test_mcu_qemu)|odo_mcu(_qemu)?\.elf$' "$log" || true
+  line=$(grep -E '^test_mcu_qemu: [0-9]+ passed, [0-9]+ failed' "$log" | tail -1 || true)
+  if [[ -n $line ]]; then
+    p=$(sed -E 's/.*: ([0-9]+) passed.*/\1/' <<<"$line") f=$(sed -E 's/.* ([0-9]+) failed.*/\1/' <<<"$line")
+    n_pass=$((n_pass + p)) n_fail=$((n_fail + f))
+  fi
+  if [[ $rc != 0 ]]; then
+    r="FAILED (see $log)"; status=1
+    [[ -n $line ]] || n_fail=$((n_fail + 1))  # the build failed before any check ran
+  fi
+  # The default tree's tests that need the image (label mcu: odometryd's serial backend against
+  # the firmware in QEMU); gated, so a skip (no image) fails under CI.
+  if ! gated "mcu" build/mcu-ctest.log ctest --test-dir build/default -L '^mcu$' \
+      --output-on-failure; then
+    r="FAILED (see build/mcu-ctest.log)"; status=1
+  fi
+  summary+=("mcu: $r ($(($(date +%s) - t0)) s)")
+}
+
 stage_package() {  # the Debian package of one build tree
   local c=$1 t0 r log
   echo "=== package of $c ==="
@@ -230,6 +276,21 @@ stage_package() {  # the Debian package of one build tree
   fi
 }
 
+# stage_rules: the house rules no compiler checks (tools/check_core.sh): the core rooms portable
+# (no OS header, thread or stream; built with -fno-exceptions -fno-rtti) and no function over
+# 60 lines. A broken rule fails the run like a failed test.
+stage_rules() {
+  local t0=$SECONDS
+  if tools/check_core.sh portable functions 2>&1 | tee build/rules.log; then
+    summary+=("rules: ok ($((SECONDS - t0)) s)")
+    n_pass=$((n_pass + 1))
+  else
+    summary+=("rules: FAILED ($((SECONDS - t0)) s; build/rules.log)")
+    failures+=("rules: $(grep -m1 '^check_core:' build/rules.log || echo 'see build/rules.log')")
+    n_fail=$((n_fail + 1)) status=1
+  fi
+}
+
 main() {
   cd "$ODO_ROOT"
   jobs=${ODO_JOBS:-$(nproc)}
@@ -240,16 +301,21 @@ main() {
   for c in $configs; do
     stage_config "$c"
     if [[ $c == default ]]; then
+      if [[ ${ODO_RULES:-1} == 1 ]]; then stage_rules; fi
       if [[ ${ODO_SOAK:-1} == 1 ]]; then stage_soak; fi
+      # mcu before kernel: the kernel tier's kernel_mcu_slcan runs the image stage mcu builds.
+      if [[ ${ODO_MCU:-1} == 1 ]]; then stage_mcu; fi  # needs the default tree's odometryd
       if [[ ${ODO_KERNEL:-1} == 1 ]]; then stage_kernel; fi
     fi
     # The ASan tree's kernel tier (the drivers' parsing of what the kernel hands them), but for
+    # the 120 s drive of ResumeCanVcan.OneWheelStallingSender (the frame path of its short
+    # neighbours, 122 s in the default tree) and
     # the three tests that SIGKILL a program over and over (100 kills during motion, the store's
     # writer killed at every point of a save): the same paths as their short neighbours, and
     # 5 of ASan's 7 min in the VM. From the tsan tree, the one driver with a thread of its own
     # (the GPIO decoder's event thread; the firmware's threads are in tsan's own tiers).
     if [[ ${ODO_KERNEL:-1} == 1 && $c == debug-asan ]]; then
-      stage_kernel "$c" "kernel $c" --exclude-regex "SigkilledWriter|HundredSigkills"
+      stage_kernel "$c" "kernel $c" --exclude-regex "SigkilledWriter|HundredSigkills|OneWheelStalling"
     elif [[ ${ODO_KERNEL:-1} == 1 && $c == tsan ]]; then
       stage_kernel "$c" "kernel $c" --tests-regex '^GpioQuadratureKernel\.'
     fi

@@ -1,12 +1,11 @@
 // Monte Carlo of the twist covariance the ROS 2 output publishes (issue 19): the simulated robot
 // with wheel noise on its true travel, the firmware's loop measuring (v, omega) over one tick,
-// against ros2::twist_covariance_from_wheels for that tick's wheel travels.
+// against twist_covariance for the wheel travels the loop measured on that tick.
 #include <cmath>
 
 #include "mc_robot.hpp"
 #include "odo/analysis/error_model_tools.hpp"
 #include "odo/analysis/seed.hpp"
-#include "odo/ros2/mapping.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_run.hpp"
 #include "odo/sim/wheel_noise.hpp"
@@ -40,9 +39,7 @@ Result<std::array<double, 2>> one_tick_error(const sim::RobotGeometry& g, const 
   // sample covariance alone).
   const double dth = p1.theta - p0.theta, mid = p0.theta + 0.5 * dth;
   const double ds = (p1.x - p0.x) * std::cos(mid) + (p1.y - p0.y) * std::sin(mid);
-  const double b = o.wheelbase;
-  predicted = ros2::twist_covariance_from_wheels((v - 0.5 * b * w) * dt, (v + 0.5 * b * w) * dt, dt,
-                                                 b, o.k);
+  predicted = twist_covariance(loop.snapshot().motion, o.k);
   return std::array<double, 2>{ds / dt - v, dth / dt - w};
 }
 

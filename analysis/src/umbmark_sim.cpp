@@ -174,18 +174,13 @@ Result<UmbmarkRobot> parse_umbmark_robot(std::string_view text) {
 }
 
 Result<UmbmarkNoise> parse_umbmark_noise(std::string_view text) {
-  if (auto n = choice_value<UmbmarkNoise>(kUmbmarkNoises, text)) return *n;
-  return make_error(Errc::kInvalidArgument, "--noise = '" + std::string(text) + "' must be " +
-                                                choice_join(kUmbmarkNoises, " or "));
+  return parse_choice_of<UmbmarkNoise>(kUmbmarkNoises, "--noise", text);
 }
 
 Status check_umbmark_sim_options(const UmbmarkSimOptions& o) {
   if (o.runs < 1 || o.runs > 1000) return range_error(integer_range("--runs", o.runs, 1, 1000));
   if (o.passes < 1 || o.passes > 10) return range_error(integer_range("--passes", o.passes, 1, 10));
   if (!(o.side >= 0.5 && o.side <= 20.0)) return range_error({"--side", o.side, 0.5, 20.0, "m"});
-  if (o.gyro != "none" && o.gyro != "consumer" && o.gyro != "industrial")
-    return make_error(Errc::kInvalidArgument,
-                      "--gyro = '" + o.gyro + "' must be none, consumer or industrial");
   return Ok{};
 }
 
@@ -195,7 +190,8 @@ Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
   Driver drv{o, sim::labmate_geometry(kNominalDiameter), 0, 0, 0, progress};
   // Pass 1 drives a "before" set (plus the bump runs) and a verification; later passes reuse
   // the previous verification as their "before" set.
-  drv.total = 2 * o.runs * (1 + (o.bumps ? 1 : 0) + o.passes + (o.gyro != "none" ? 7 : 0));
+  drv.total =
+      2 * o.runs * (1 + (o.bumps ? 1 : 0) + o.passes + (o.gyro != UmbmarkGyro::kNone ? 7 : 0));
   UmbmarkSimResult res;
   auto first = drv.set(Factors{1.0, 1.0, kNominalWheelbase}, false);
   if (!first) return std::move(first).error();
@@ -219,8 +215,9 @@ Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
     res.passes.push_back(UmbmarkSimPass{std::move(before), std::move(r).value(), *after});
     before = std::move(after).value();
   }
-  if (o.gyro != "none") {
-    const sim::GyroModel m = o.gyro == "industrial" ? sim::industrial_gyro() : sim::consumer_gyro();
+  if (o.gyro != UmbmarkGyro::kNone) {
+    const sim::GyroModel m =
+        o.gyro == UmbmarkGyro::kIndustrial ? sim::industrial_gyro() : sim::consumer_gyro();
     auto g = gyro_comparison(drv, res.passes.front().before.factors,
                              res.passes.back().result.composed, m);
     if (!g) return std::move(g).error();

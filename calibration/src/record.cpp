@@ -2,26 +2,18 @@
 
 #include <ctime>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <sstream>
 
 #include "odo/hal/bytes.hpp"
+#include "odo/hal/crc.hpp"
+#include "odo/odometry/kinematics.hpp"
 
 namespace odo::calib {
 namespace {
-
-constexpr std::array<std::uint32_t, 256> make_crc_table() {
-  std::array<std::uint32_t, 256> t{};
-  for (std::uint32_t i = 0; i < 256; ++i) {
-    std::uint32_t c = i;
-    for (int k = 0; k < 8; ++k) c = (c & 1U) ? 0xEDB88320U ^ (c >> 1) : c >> 1;
-    t[i] = c;
-  }
-  return t;
-}
-constexpr auto kCrcTable = make_crc_table();
 
 // Flag bits: which optional fields are present.
 constexpr std::uint32_t kFlagCleared = 1U << 0;
@@ -69,12 +61,6 @@ Status validate_fit(const FixFitProvenance& f) {
 }
 
 }  // namespace
-
-std::uint32_t crc32(std::span<const std::uint8_t> data) noexcept {
-  std::uint32_t c = 0xFFFFFFFFU;
-  for (std::uint8_t b : data) c = kCrcTable[(c ^ b) & 0xFFU] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFU;
-}
 
 Result<std::vector<std::uint8_t>> encode_record(const CalibrationRecord& r) {
   if (r.method.size() >= kMethodBytes)
@@ -187,13 +173,25 @@ Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
   if (flags & kFlagEmaxBefore) r.e_max_before = v[5];
   if (flags & kFlagEmaxAfter) r.e_max_after = v[6];
   const auto* m = reinterpret_cast<const char*>(bytes.data() + 88);
-  r.method.assign(m, strnlen(m, kMethodBytes - 1));
+  // std::find, not POSIX strnlen (not declared by a bare-metal C library in strict C++20).
+  r.method.assign(m, std::find(m, m + (kMethodBytes - 1), '\0'));
   if (flags & kFlagFit) {
     auto f = decode_fit(bytes, version, length);
     if (!f) return std::move(f).error();
     r.fit = *f;
   }
   return r;
+}
+
+Result<KinematicParams> apply_record(const KinematicParams& nominal, const CalibrationRecord& r) {
+  if (auto range = validate_record(r); !range) return std::move(range).error();
+  KinematicParams p = nominal;
+  p.c_l = r.c_l;
+  p.c_r = r.c_r;
+  if (r.wheelbase) p.wheelbase = *r.wheelbase;
+  if (r.wheel_diameter) p.wheel_diameter = *r.wheel_diameter;
+  if (auto ok = Kinematics::create(p); !ok) return std::move(ok).error();
+  return p;
 }
 
 Status validate_record(const CalibrationRecord& r) {

@@ -1,5 +1,7 @@
 #include "odo/drivers/can_encoder.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "odo/drivers/count_plausibility.hpp"
@@ -11,9 +13,14 @@ namespace {
 constexpr std::uint32_t kOdriveGetEncoderCount = 0x00A;
 constexpr std::uint32_t kMaxStdId = 0x7FF;
 constexpr std::uint32_t kMaxExtId = 0x1FFFFFFF;
-// Receive stamps are taken when a frame is read, not when the sender latched its count: two
-// frames may arrive closer together than they were sent. The jump limit allows this much
-// latency jitter on top of the time between the frames [s].
+// The jump limit's time tolerance [s]. A frame's count is latched by the controller at l_k and
+// stamped by the kernel on arrival at a_k = l_k + d_k, with the sender's latency d_k (its message
+// timer, the transmit queue, bus arbitration) in [d_min, d_max]. The wheel can move at most
+// v_max * (l_k - l_(k-1)) = v_max * (a_k - a_(k-1) - (d_k - d_(k-1))) <= v_max * (a_k - a_(k-1)
+// + J) with the latency jitter J = d_max - d_min: the stamps' difference plus J is the time to
+// allow, never the time between the loop's reads (a frame read late by the loop and the next
+// read early made that far shorter, issue 39). J = 5 ms covers an ODrive's cyclic timer jitter
+// (1 ms ticks) and a full-length frame queued behind a 1 Mbit/s bus at full load for a few ms.
 constexpr double kLatencySlack = 0.005;
 
 }  // namespace
@@ -76,8 +83,8 @@ Result<CanEncoderSource> CanEncoderSource::create(CanBus& bus, const CanEncoderC
   if (cfg.timeout <= 0) return bad("timeout must be > 0 s");
   if (!(cfg.max_counts_per_s > 0.0 && cfg.max_counts_per_s <= 1e9))
     return bad("max_counts_per_s must be in (0, 1e9] counts/s");
-  if (cfg.max_frames_per_read < 1 || cfg.max_frames_per_read > 4096)
-    return bad("max_frames_per_read must be in [1, 4096]");
+  if (auto s = check_row(kCanMaxFramesPerRead, "", cfg.max_frames_per_read); !s)
+    return std::move(s).error();
   if (cfg.request_period < 0) return bad("request_period must be >= 0 s");
   return CanEncoderSource(bus, cfg);
 }
@@ -86,6 +93,8 @@ void CanEncoderSource::accept(int i, std::int64_t value, TimeNs stamp,
                               std::uint32_t& flags) noexcept {
   Wheel& w = wheel_[static_cast<std::size_t>(i)];
   const int bits = counter_bits();
+  // Stamps of one socket never go back; a clock conversion could by a few ns: held.
+  if (w.primed && stamp < w.last_stamp) stamp = w.last_stamp;
   const bool reverse = i == 0 ? cfg_.reverse_left : cfg_.reverse_right;
   const std::int64_t raw = reverse ? wrap_sub(0, value, bits) : wrap_bits(value, bits);
   if (!w.primed) {
@@ -105,6 +114,28 @@ void CanEncoderSource::accept(int i, std::int64_t value, TimeNs stamp,
   }
   w.last_raw = raw;
   w.last_stamp = stamp;
+  w.newest = (w.newest + 1) % kHistory;
+  w.history[w.newest] = Stamped{stamp, wrap_sub(raw, w.offset, bits)};
+  if (w.kept < kHistory) ++w.kept;
+}
+
+std::int64_t CanEncoderSource::count_at(const Wheel& w, TimeNs t) const noexcept {
+  // Newest first: the frame at or before t, and the one after it.
+  std::size_t after = w.newest;
+  for (std::size_t k = 0; k < w.kept; ++k) {
+    const std::size_t at = (w.newest + kHistory - k) % kHistory;
+    const Stamped& f = w.history[at];
+    if (f.stamp <= t) {
+      if (k == 0) return f.count;  // t at or after the newest frame: its count
+      const Stamped& g = w.history[after];
+      const int bits = counter_bits();
+      const double frac = static_cast<double>(t - f.stamp) / static_cast<double>(g.stamp - f.stamp);
+      const double step = static_cast<double>(wrap_sub(g.count, f.count, bits));
+      return wrap_add(f.count, std::llround(frac * step), bits);
+    }
+    after = at;
+  }
+  return w.history[after].count;  // before every kept frame: the oldest
 }
 
 void CanEncoderSource::send_requests(TimeNs now) noexcept {
@@ -126,14 +157,7 @@ void CanEncoderSource::send_requests(TimeNs now) noexcept {
   }
 }
 
-EncoderSample CanEncoderSource::read(TimeNs now) noexcept {
-  EncoderSample s;
-  s.stamp = now;
-  send_requests(now);
-  // Only the newest count of each wheel in this batch matters (cumulative counts).
-  std::array<std::int64_t, 2> newest{};
-  std::array<TimeNs, 2> newest_stamp{};
-  std::array<bool, 2> got{false, false};
+int CanEncoderSource::drain(TimeNs now, std::uint32_t& flags) noexcept {
   const std::array<const CanCountLayout*, 2> ls{&cfg_.left, &cfg_.right};
   CanFrame f;
   int n = 0;
@@ -144,9 +168,9 @@ EncoderSample CanEncoderSource::read(TimeNs now) noexcept {
       std::int64_t v = 0;
       switch (decode_count(f, *ls[i], v)) {
         case CanDecode::kOk:
-          newest[i] = v;
-          newest_stamp[i] = f.stamp != 0 ? f.stamp : now;
-          got[i] = true;
+          // Every frame, not only a read's newest: the jump check and the interpolation work
+          // on each frame's own stamp.
+          accept(static_cast<int>(i), v, f.stamp != 0 ? f.stamp : now, flags);
           ++stats_.decoded;
           ours = true;
           break;
@@ -164,19 +188,32 @@ EncoderSample CanEncoderSource::read(TimeNs now) noexcept {
     }
     if (!ours) ++stats_.foreign;
   }
-  if (n == cfg_.max_frames_per_read) ++stats_.capped_reads;
+  return n;
+}
+
+EncoderSample CanEncoderSource::read(TimeNs now) noexcept {
+  EncoderSample s;
+  send_requests(now);
+  if (drain(now, s.flags) == cfg_.max_frames_per_read) ++stats_.capped_reads;
+  bool all_fresh = true;
   for (int i = 0; i < 2; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    if (got[k]) accept(i, newest[k], newest_stamp[k], s.flags);
-    Wheel& w = wheel_[k];
+    Wheel& w = wheel_[static_cast<std::size_t>(i)];
     const bool stale = !w.primed || now - w.last_stamp > cfg_.timeout;
     if (stale && !w.stale && w.primed) ++counters_.stale_events;
     w.stale = stale;
     if (stale) s.flags |= i == 0 ? kEncoderStaleLeft : kEncoderStaleRight;
+    all_fresh = all_fresh && !stale;
   }
-  const int bits = counter_bits();
-  s.left = wheel_[0].primed ? wrap_sub(wheel_[0].last_raw, wheel_[0].offset, bits) : 0;
-  s.right = wheel_[1].primed ? wrap_sub(wheel_[1].last_raw, wheel_[1].offset, bits) : 0;
+  // One instant for both wheels: the older newest frame (the other wheel interpolated to it);
+  // with a stale wheel there is none, and the read time is used as before. Never back in time.
+  TimeNs t = all_fresh ? std::min(wheel_[0].last_stamp, wheel_[1].last_stamp) : now;
+  if (t < last_sample_) t = last_sample_;
+  last_sample_ = t;
+  s.stamp = t;
+  s.left = wheel_[0].primed ? count_at(wheel_[0], t) : 0;
+  s.right = wheel_[1].primed ? count_at(wheel_[1], t) : 0;
+  s.left_rejected = wheel_[0].offset;  // the controller holds left + offset (issue 39)
+  s.right_rejected = wheel_[1].offset;
   s.counters = counters_;
   return s;
 }

@@ -30,8 +30,8 @@ Result<CanGyroSource> CanGyroSource::create(CanBus& bus, const CanGyroConfig& cf
     return bad("CAN gyro: offset must be in [-1000, 1000] rad/s");
   if (cfg.sign != 1 && cfg.sign != -1) return bad("CAN gyro: sign must be +1 or -1");
   if (cfg.stale_timeout <= 0) return bad("CAN gyro: stale_timeout must be > 0 s");
-  if (cfg.max_frames_per_read < 1 || cfg.max_frames_per_read > 4096)
-    return bad("CAN gyro: max_frames_per_read must be in [1, 4096]");
+  if (auto s = check_row(kCanMaxFramesPerRead, "CAN gyro: ", cfg.max_frames_per_read); !s)
+    return std::move(s).error();
   CanGyroSource g(bus, cfg);
   // A range that does not contain 0 cannot report a robot at rest (an unsigned field without
   // its offset): every sample would be flagged or wrong.

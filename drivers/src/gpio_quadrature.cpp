@@ -270,8 +270,7 @@ GpioQuadratureEncoder::~GpioQuadratureEncoder() {
 
 Result<std::unique_ptr<GpioQuadratureEncoder>> GpioQuadratureEncoder::open(
     const GpioQuadratureConfig& cfg) {
-  if (cfg.batch < 1 || cfg.batch > 1024)
-    return make_error(Errc::kInvalidArgument, "gpio: batch must be in [1, 1024] events");
+  if (auto s = check_row(kGpioBatch, "gpio: ", cfg.batch); !s) return std::move(s).error();
   if (cfg.reorder_window < 0 || cfg.reorder_window > 100'000'000)
     return make_error(Errc::kInvalidArgument, "gpio: reorder_window must be in [0, 0.1] s");
   if (cfg.idle_check < 10'000'000 || cfg.idle_check > 10 * kNsPerSecond)

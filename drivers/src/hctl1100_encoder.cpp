@@ -29,10 +29,10 @@ Result<Hctl1100Encoder> Hctl1100Encoder::create(ParallelBus& bus, const Hctl1100
   if (cfg.unit_left == cfg.unit_right) return bad("hctl1100: both wheels on the same chip select");
   if (!(cfg.max_counts_per_s > 0.0 && cfg.max_counts_per_s <= 1e8))
     return bad("hctl1100: max_counts_per_s must be in (0, 1e8] counts/s");
-  if (cfg.agree_window < 0 || cfg.agree_window > 64)
-    return bad("hctl1100: agree_window must be in [0, 64] counts");
-  if (cfg.max_attempts < 2 || cfg.max_attempts > 16)
-    return bad("hctl1100: max_attempts must be in [2, 16]");
+  if (auto s = check_row(kHctlAgreeWindow, "hctl1100: ", cfg.agree_window); !s)
+    return std::move(s).error();
+  if (auto s = check_row(kHctlMaxAttempts, "hctl1100: ", cfg.max_attempts); !s)
+    return std::move(s).error();
   return Hctl1100Encoder(bus, cfg);
 }
 
@@ -108,6 +108,8 @@ EncoderSample Hctl1100Encoder::read(TimeNs now) noexcept {
   }
   s.left = out[0];
   s.right = out[1];
+  s.left_rejected = wheel_[0].offset;  // the chip holds out + offset (24-bit wrap)
+  s.right_rejected = wheel_[1].offset;
   s.counters = counters_;
   return s;
 }

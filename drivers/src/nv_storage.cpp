@@ -74,20 +74,6 @@ Status fsync_dir(const std::string& file) {
 
 }  // namespace
 
-const char* nv_backend_name(NvBackend b) noexcept {
-  switch (b) {
-    case NvBackend::kFile:
-      return "file";
-    case NvBackend::kNvmem:
-      return "nvmem";
-    case NvBackend::kMtd:
-      return "mtd";
-    case NvBackend::kAuto:
-      break;
-  }
-  return "auto";
-}
-
 NvBackend detect_nv_backend(std::string_view path) noexcept {
   if (path.starts_with("/dev/mtd")) return NvBackend::kMtd;
   if (path.starts_with("/sys/") || path.ends_with("/nvmem") || path == "nvmem")

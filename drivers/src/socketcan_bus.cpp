@@ -6,6 +6,7 @@
 #include <net/if.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -17,6 +18,21 @@ namespace odo::drivers {
 namespace {
 
 static_assert(sizeof(can_filter) == 2 * sizeof(std::uint32_t), "can_filter is two canid_t");
+
+// receive_stamp: the kernel's stamp in `msg` on CLOCK_MONOTONIC, or now without one.
+TimeNs receive_stamp(msghdr& msg) noexcept {
+  const TimeNs mono = monotonic_now();
+  for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
+    if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_TIMESTAMPNS) continue;
+    timespec k{};
+    std::memcpy(&k, CMSG_DATA(c), sizeof k);
+    timespec rt{};
+    ::clock_gettime(CLOCK_REALTIME, &rt);
+    auto ns = [](const timespec& t) { return TimeNs{t.tv_sec} * kNsPerSecond + t.tv_nsec; };
+    return kernel_stamp_to_monotonic(ns(k), ns(rt), mono);
+  }
+  return mono;
+}
 
 }  // namespace
 
@@ -49,6 +65,12 @@ bool from_socketcan_id(std::uint32_t can_id, CanFrame& f) noexcept {
   f.rtr = false;  // remote requests never get here (filtered above and in the kernel)
   f.id = f.extended ? (can_id & CAN_EFF_MASK) : (can_id & CAN_SFF_MASK);
   return true;
+}
+
+TimeNs kernel_stamp_to_monotonic(TimeNs kernel_rt, TimeNs rt_now, TimeNs mono_now) noexcept {
+  constexpr TimeNs kMaxAge = 10 * kNsPerSecond;
+  const TimeNs age = rt_now - kernel_rt;
+  return age > 0 && age <= kMaxAge ? mono_now - age : mono_now;
 }
 
 SocketCanBus::SocketCanBus(SocketCanOptions o) : opts_(std::move(o)) {
@@ -105,6 +127,11 @@ int SocketCanBus::open_socket(const char*& stage) noexcept {
   const int own = opts_.receive_own ? 1 : 0;
   if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_RECV_OWN_MSGS, &own, sizeof own) < 0)
     return fail("setsockopt(CAN_RAW_RECV_OWN_MSGS)");
+  // The kernel's receive time of each frame (issue 39): the jump check and the wheels' common
+  // instant need when a frame arrived, not when the loop got round to reading it.
+  const int on = 1;
+  if (::setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on) < 0)
+    return fail("setsockopt(SO_TIMESTAMPNS)");
   if (opts_.rx_buffer_bytes > 0 &&
       ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &opts_.rx_buffer_bytes, sizeof(int)) < 0)
     return fail("setsockopt(SO_RCVBUF)");
@@ -184,7 +211,14 @@ bool SocketCanBus::receive(CanFrame& out) noexcept {
   if (fd_ < 0 && !try_reopen()) return false;
   for (;;) {
     can_frame cf{};
-    const ssize_t n = ::recv(fd_, &cf, sizeof cf, MSG_DONTWAIT);
+    iovec iov{&cf, sizeof cf};
+    alignas(cmsghdr) std::uint8_t control[CMSG_SPACE(sizeof(timespec))];
+    msghdr msg{};
+    msg.msg_iov = &iov;
+    msg.msg_iovlen = 1;
+    msg.msg_control = control;
+    msg.msg_controllen = sizeof control;
+    const ssize_t n = ::recvmsg(fd_, &msg, MSG_DONTWAIT);
     if (n < 0) {
       // EAGAIN: nothing waiting. ENETDOWN is reported once after the link went down;
       // ENODEV after the interface vanished: re-open later.
@@ -196,7 +230,7 @@ bool SocketCanBus::receive(CanFrame& out) noexcept {
     out.len = cf.can_dlc > 8 ? 8 : cf.can_dlc;
     out.data = {};
     std::memcpy(out.data.data(), cf.data, out.len);
-    out.stamp = monotonic_now();
+    out.stamp = receive_stamp(msg);
     ++counters_.received;
     return true;
   }

@@ -10,22 +10,8 @@ using calib::CalibrationRecord;
 using calib::LoadResult;
 using calib::StoreStatus;
 
-Result<OpenStore> open_calibration_store(const std::string& path, StoreBackend backend) {
-  drivers::NvBackend k = drivers::NvBackend::kAuto;
-  switch (backend) {
-    case StoreBackend::kAuto:
-      k = drivers::detect_nv_backend(path);
-      break;
-    case StoreBackend::kFile:
-      k = drivers::NvBackend::kFile;
-      break;
-    case StoreBackend::kNvmem:
-      k = drivers::NvBackend::kNvmem;
-      break;
-    case StoreBackend::kMtd:
-      k = drivers::NvBackend::kMtd;
-      break;
-  }
+Result<OpenStore> open_calibration_store(const std::string& path, NvBackend backend) {
+  const NvBackend k = backend == NvBackend::kAuto ? drivers::detect_nv_backend(path) : backend;
   OpenStore o;
   o.backend = drivers::nv_backend_name(k);
   auto m = drivers::open_nv_storage(path, k);
@@ -65,20 +51,15 @@ AppliedCalibration apply_calibration(const KinematicParams& nominal,
     return a;
   }
   const CalibrationRecord& r = *l.record;
-  KinematicParams p = nominal;
-  p.c_l = r.c_l;
-  p.c_r = r.c_r;
-  if (r.wheelbase) p.wheelbase = *r.wheelbase;
-  if (r.wheel_diameter) p.wheel_diameter = *r.wheel_diameter;
-  auto ok = Kinematics::create(p);
-  auto range = calib::validate_record(r);
-  if (!ok || !range) {
+  auto applied = calib::apply_record(nominal, r);
+  if (!applied) {
     a.state = StoreStatus::kCorrupt;
-    m << "ERROR: stored values rejected (" << (!range ? range.error().message : ok.error().message)
+    m << "ERROR: stored values rejected (" << applied.error().message
       << "); running on NOMINAL values";
     a.report = m.str();
     return a;
   }
+  const KinematicParams p = *applied;
   a.params = p;
   a.state = StoreStatus::kOk;
   a.sequence = r.sequence;
@@ -91,7 +72,7 @@ AppliedCalibration apply_calibration(const KinematicParams& nominal,
 }
 
 AppliedCalibration read_and_apply(const KinematicParams& nominal, const std::string& path,
-                                  StoreBackend backend) {
+                                  NvBackend backend) {
   if (path.empty()) {
     AppliedCalibration a;
     a.params = nominal;

@@ -5,9 +5,14 @@
 #include <cstring>
 #include <sstream>
 
+#include "odo/drivers/can_encoder.hpp"
+#include "odo/drivers/gpio_quadrature.hpp"
+#include "odo/drivers/hctl1100_encoder.hpp"
+#include "odo/drivers/serial_port.hpp"
 #include "odo/firmware/toml_reader.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
+#include "odo/odometry/gyrodometry.hpp"
 #include "odo/protocol/can_protocol.hpp"
 #include "odo/ros2/config.hpp"
 
@@ -96,8 +101,8 @@ void read_hctl1100(TableReader t, Hctl1100Section& s) {
   s.control_active_low = t.boolean("control_active_low", s.control_active_low);
   s.settle = t.number("settle", s.settle, 0.0, 0.1, "s");
   s.max_speed = t.number("max_speed", s.max_speed, 0.01, 100.0, "m/s");
-  s.agree_window = static_cast<int>(t.integer("agree_window", s.agree_window, 0, 64));
-  s.max_attempts = static_cast<int>(t.integer("max_attempts", s.max_attempts, 2, 16));
+  s.agree_window = static_cast<int>(t.integer(s.agree_window, drivers::kHctlAgreeWindow));
+  s.max_attempts = static_cast<int>(t.integer(s.max_attempts, drivers::kHctlMaxAttempts));
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
   s.reverse_right = t.boolean("reverse_right", s.reverse_right);
   s.latch = t.choice("latch", s.latch);
@@ -116,7 +121,7 @@ void read_gpio(TableReader t, GpioSection& s) {
   s.active_low = t.boolean("active_low", s.active_low);
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
   s.reverse_right = t.boolean("reverse_right", s.reverse_right);
-  s.batch = static_cast<int>(t.integer("batch", s.batch, 1, 1024));
+  s.batch = static_cast<int>(t.integer(s.batch, drivers::kGpioBatch));
   s.reorder_window = t.number("reorder_window", s.reorder_window, 0.0, 0.1, "s");
   s.idle_check = t.number("idle_check", s.idle_check, 0.01, 10.0, "s");
   t.finish();
@@ -134,7 +139,7 @@ void read_can_encoder(TableReader t, CanEncoderSection& s) {
   s.max_speed = t.number("max_speed", s.max_speed, 0.01, 100.0, "m/s");
   s.request_rate = t.number("request_rate", s.request_rate, 0.0, 1000.0, "Hz");
   s.max_frames_per_read =
-      static_cast<int>(t.integer("max_frames_per_read", s.max_frames_per_read, 1, 4096));
+      static_cast<int>(t.integer(s.max_frames_per_read, drivers::kCanMaxFramesPerRead));
   s.extended = t.boolean("extended", s.extended);
   const std::int64_t max_id = s.extended ? 0x1FFFFFFF : 0x7FF;
   s.left_id = t.integer("left_id", s.left_id, 0, max_id);
@@ -159,6 +164,23 @@ void read_can_encoder(TableReader t, CanEncoderSection& s) {
   s.sim_period = t.number("sim_period", s.sim_period, 0.001, 1.0, "s");
   s.sim_stop_left_after = t.number("sim_stop_left_after", s.sim_stop_left_after, -1.0, 1e6, "s");
   s.sim_stop_right_after = t.number("sim_stop_right_after", s.sim_stop_right_after, -1.0, 1e6, "s");
+  t.finish();
+}
+
+void read_serial(TableReader t, SerialSection& s) {
+  s.link = t.choice("link", s.link);
+  s.device = t.string("device", s.device);
+  s.device_where = t.location("device");
+  s.protocol = t.choice("protocol", s.protocol);
+  s.baud = static_cast<int>(t.integer("baud", s.baud, 1, 4000000));
+  if (!drivers::supported_baud(s.baud))
+    t.reject("baud", "= " + std::to_string(s.baud) + " is not a supported baud rate (" +
+                         drivers::baud_list() + ")");
+  s.bits_left = static_cast<int>(t.integer("bits_left", s.bits_left, 8, 32));
+  s.bits_right = static_cast<int>(t.integer("bits_right", s.bits_right, 8, 32));
+  s.reverse_left = t.boolean("reverse_left", s.reverse_left);
+  s.reverse_right = t.boolean("reverse_right", s.reverse_right);
+  for (const auto& n : kSerialNumbers) s.*n.member = t.number(s.*n.member, n.row);
   t.finish();
 }
 
@@ -257,30 +279,24 @@ void read_selfcal(TableReader t, SelfCalSection& s) {
 }
 
 // ---- [gyro] ----
-// The numeric keys of [gyro] and their ranges: the one table the reader takes them from.
-struct GyroRange {
-  const char* key;
-  double GyroSection::*member;
-  double lo, hi;
-  const char* unit;
-};
-constexpr GyroRange kGyroRanges[] = {
-    {"rate", &GyroSection::rate, 0.0, 100000.0, "Hz"},
-    {"stale_timeout", &GyroSection::stale_timeout, 0.001, 10.0, "s"},
-    {"noise_density", &GyroSection::noise_density, 0.0, 0.1, "rad/s/sqrt(Hz)"},
-    {"bias_instability", &GyroSection::bias_instability, 0.0, 0.1, "rad/s"},
-    {"scale_tolerance", &GyroSection::scale_tolerance, 0.0, 0.5, ""},
-    {"delay", &GyroSection::delay, 0.0, 1.0, "s"},
-    {"delay_tolerance", &GyroSection::delay_tolerance, 0.0, 1.0, "s"},
-    {"window", &GyroSection::window, 0.01, 10.0, "s"},
-    {"k_sigma", &GyroSection::k_sigma, 1.0, 20.0, ""},
-    {"max_wheel_speed", &GyroSection::max_wheel_speed, 0.01, 100.0, "m/s"},
-    {"max_wheel_accel", &GyroSection::max_wheel_accel, 0.01, 1000.0, "m/s^2"},
-    {"still_time", &GyroSection::still_time, 0.01, 60.0, "s"},
-    {"bias_tau", &GyroSection::bias_tau, 0.01, 86400.0, "s"},
-};
+// The section's field of each of the fusion's user-set parameters, in GyroParam order.
+constexpr double GyroSection::*kGyroFusionMembers[kGyroConfigParams] = {
+    &GyroSection::noise_density, &GyroSection::bias_instability, &GyroSection::scale_tolerance,
+    &GyroSection::delay,         &GyroSection::delay_tolerance,  &GyroSection::window,
+    &GyroSection::k_sigma,       &GyroSection::max_wheel_speed,  &GyroSection::max_wheel_accel,
+    &GyroSection::still_time,    &GyroSection::bias_tau};
 
-void read_gyro(TableReader t, GyroSection& s) {
+// read_gyro_numbers: the source's numbers, then the fusion's against its own limits at this
+// loop's tick (bias_tau after still_time: its lower limit is the still_time just read).
+void read_gyro_numbers(TableReader& t, GyroSection& s, double loop_hz) {
+  for (const auto& n : kGyroSourceNumbers) s.*n.member = t.number(s.*n.member, n.row);
+  for (std::size_t i = 0; i < kGyroConfigParams; ++i) {
+    const RangeRow r = gyrodometry_range(static_cast<GyroParam>(i), 1.0 / loop_hz, s.still_time);
+    s.*kGyroFusionMembers[i] = t.number(s.*kGyroFusionMembers[i], r);
+  }
+}
+
+void read_gyro(TableReader t, GyroSection& s, double loop_hz) {
   s.backend = t.choice("backend", s.backend);
   s.device = t.string("device", s.device);
   s.axis = t.choice("axis", s.axis);
@@ -294,11 +310,7 @@ void read_gyro(TableReader t, GyroSection& s) {
   s.buffer_length = static_cast<int>(t.integer("buffer_length", s.buffer_length, 2, 65536));
   s.model = t.choice("model", s.model);
   s.seed = t.integer("seed", s.seed, 0, INT64_MAX);
-  for (const GyroRange& r : kGyroRanges)
-    s.*r.member = t.number(r.key, s.*r.member, r.lo, r.hi, r.unit);
-  if (s.bias_tau < s.still_time)
-    t.reject("bias_tau", "= " + std::to_string(s.bias_tau) + " s must be at least still_time (" +
-                             std::to_string(s.still_time) + " s)");
+  read_gyro_numbers(t, s, loop_hz);
   s.scale_estimation = t.boolean("scale_estimation", s.scale_estimation);
   if (s.backend == GyroBackend::kIio && s.device.empty())
     t.reject("device",
@@ -322,7 +334,7 @@ void read_can_gyro(TableReader t, CanGyroSection& s) {
   s.scale = t.number("scale", s.scale, 1e-9, 1.0, "rad/s per LSB");
   s.rate_offset = t.number("rate_offset", s.rate_offset, -1000.0, 1000.0, "rad/s");
   s.max_frames_per_read =
-      static_cast<int>(t.integer("max_frames_per_read", s.max_frames_per_read, 1, 4096));
+      static_cast<int>(t.integer(s.max_frames_per_read, drivers::kCanMaxFramesPerRead));
   s.sim_stop_after = t.number("sim_stop_after", s.sim_stop_after, -1.0, 1e6, "s");
   t.finish();
 }
@@ -395,6 +407,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_hctl1100(root.sub("hctl1100"), c.hctl1100);
   read_gpio(root.sub("gpio"), c.gpio);
   read_can_encoder(root.sub("can_encoder"), c.can_encoder);
+  read_serial(root.sub("serial"), c.serial);
   read_error_model(root.sub("error_model"), c.error_model);
   read_can(root.sub("can"), c.can, c.loop.rate_hz);
   ros2::Config ros2_cfg;
@@ -402,7 +415,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   c.ros2 = std::make_shared<const ros2::Config>(std::move(ros2_cfg));
   read_resume(root.sub("resume"), c.resume, c.loop.rate_hz);
   read_selfcal(root.sub("selfcal"), c.selfcal);
-  read_gyro(root.sub("gyro"), c.gyro);
+  read_gyro(root.sub("gyro"), c.gyro, c.loop.rate_hz);
   read_can_gyro(root.sub("can_gyro"), c.can_gyro);
   check_gyro_robot(root, c);
   root.finish();
@@ -414,7 +427,8 @@ bool simulated_robot(const Config& cfg) {
   const EncoderKind be = cfg.encoder.backend;
   return be == EncoderKind::kSim ||
          (be == EncoderKind::kHctl1100 && cfg.hctl1100.bus == HctlBus::kSim) ||
-         (be == EncoderKind::kCan && cfg.can_encoder.bus == CanEncoderBus::kSim);
+         (be == EncoderKind::kCan && cfg.can_encoder.bus == CanEncoderBus::kSim) ||
+         (be == EncoderKind::kSerial && cfg.serial.link == SerialLink::kSim);
 }
 
 bool simulated_gyro(const Config& cfg) {

@@ -42,7 +42,10 @@ constexpr BitName kEncoderFlagNames[] = {{kEncoderStaleLeft, "stale-left"},
                                          {kEncoderStaleRight, "stale-right"},
                                          {kEncoderInvalidTransition, "invalid-transition"},
                                          {kEncoderImplausibleJump, "implausible-jump"},
-                                         {kEncoderReadError, "read-error"}};
+                                         {kEncoderReadError, "read-error"},
+                                         {kEncoderLinkError, "link-error"},
+                                         {kEncoderControllerReset, "controller-reset"},
+                                         {kEncoderNoValidData, "no-valid-data(wrong-baud?)"}};
 constexpr BitName kGyroFlagNames[] = {{kGyroStarting, "starting"},
                                       {kGyroStale, "stale"},
                                       {kGyroSaturated, "saturated"},
@@ -102,7 +105,12 @@ std::string counters_text(const EncoderCounters& c) {
   return counts_text({{{"invalid", c.invalid_transitions},
                        {"jumps", c.implausible_jumps},
                        {"stale", c.stale_events},
-                       {"read_errors", c.read_errors}}});
+                       {"read_errors", c.read_errors}}}) +
+         // The serial link's (all 0 for the other backends: then nothing is printed).
+         counts_text({{{"link_errors", c.link_errors},
+                       {"gaps", c.sequence_gaps},
+                       {"resets", c.controller_resets},
+                       {"reconnects", c.reconnects}}});
 }
 
 // print_status: one status line; `truth` is the simulation's newest sample (null: none).
@@ -216,6 +224,10 @@ nlohmann::json report_json(const loop::LoopSnapshot& s, const loop::LoopStats& s
   j["implausible_jumps"] = s.encoder_counters.implausible_jumps;
   j["stale_events"] = s.encoder_counters.stale_events;
   j["read_errors"] = s.encoder_counters.read_errors;
+  j["link_errors"] = s.encoder_counters.link_errors;
+  j["sequence_gaps"] = s.encoder_counters.sequence_gaps;
+  j["controller_resets"] = s.encoder_counters.controller_resets;
+  j["reconnects"] = s.encoder_counters.reconnects;
   j["calibration_state"] = static_cast<int>(s.calibration_state);
   if (s.gyro.enabled) j["gyro"] = gyro_json(s.gyro);
   if (can != nullptr) j["can"] = can_json(*can);
@@ -337,6 +349,9 @@ int Daemon::configure() {
   if (cfg_->encoder.backend == EncoderKind::kCan &&
       cfg_->can_encoder.bus == CanEncoderBus::kSocketCan)
     lc.start_wait = from_seconds(cfg_->can_encoder.timeout);
+  // Likewise a microcontroller on a serial line (an Arduino reboots when its port opens).
+  if (cfg_->encoder.backend == EncoderKind::kSerial && cfg_->serial.link == SerialLink::kTty)
+    lc.start_wait = from_seconds(cfg_->serial.start_wait);
   auto created = loop::OdometryLoop::create(lc, *calibrated, *encoder, rig_->clock(), rig_->gyro());
   if (!created) return fail(cfg_->source + ": " + created.error().message);
   loop_ = std::move(created).value();
@@ -346,8 +361,7 @@ int Daemon::configure() {
   if (!can) return fail(cfg_->source + ": " + can.error().message);
   can_ = std::move(can).value();
   // ROS 2 output ([ros2] enabled): an observer of the loop plus the DDS thread.
-  auto ros2 = Ros2Output::create(cfg_->ros2.get(), cfg_->loop.rate_hz,
-                                 calibrated->params().wheelbase, cfg_->error_model, *loop_);
+  auto ros2 = Ros2Output::create(cfg_->ros2.get(), cfg_->loop.rate_hz, cfg_->error_model, *loop_);
   if (!ros2) return fail(cfg_->source + ": " + ros2.error().message);
   ros2_ = std::move(ros2).value();
   if (selfcal_) selfcal_->attach(*loop_, can_.get());

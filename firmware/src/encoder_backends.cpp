@@ -9,7 +9,9 @@
 #include "odo/drivers/gpio_quadrature.hpp"
 #include "odo/drivers/gpiod_parallel_bus.hpp"
 #include "odo/drivers/hctl1100_encoder.hpp"
+#include "odo/drivers/serial_port.hpp"
 #include "odo/drivers/socketcan_bus.hpp"
+#include "odo/firmware/serial_peer.hpp"
 #include "odo/sim/robot_buses.hpp"
 
 namespace odo::fw {
@@ -150,7 +152,135 @@ std::string can_text(const CanEncoderSection& s, const drivers::CanEncoderConfig
   return d.str();
 }
 
+class SerialTtyBackend final : public EncoderBackend {
+ public:
+  SerialTtyBackend(std::unique_ptr<drivers::SerialPort> port, const protocol::SerialSourceConfig& c,
+                   std::string d)
+      : port_(std::move(port)), source_(*port_, c), desc_(std::move(d)) {}
+  EncoderSource& encoder() noexcept override { return source_; }
+  const std::string& describe() const noexcept override { return desc_; }
+
+ private:
+  std::unique_ptr<drivers::SerialPort> port_;  // the source points at it
+  protocol::SerialCountsSource source_;
+  std::string desc_;
+};
+
+// SerialSimBackend: a simulated controller (SerialPeerModel) following the robot, its bytes in a
+// fixed ring read by the real source: before each read the controller sends what is due.
+class SerialSimBackend final : public EncoderBackend, public EncoderSource, public ByteLink {
+ public:
+  SerialSimBackend(const Config& cfg, const Kinematics& k, sim::SimRobot& robot, TimeNs epoch,
+                   std::string d)
+      : model_(cfg.serial.protocol),
+        protocol_(cfg.serial.protocol),
+        robot_(robot),
+        epoch_(epoch),
+        period_(from_seconds(cfg.serial.sim_period)),
+        source_(*this, serial_source_config(cfg.serial, k.params())),
+        desc_(std::move(d)) {}
+  EncoderSample read(TimeNs now) noexcept override {
+    now_ = now;
+    if (protocol_ == SerialProtocol::kDiffodom) {
+      for (const TimeNs t = now - epoch_; next_ <= t; next_ += period_) send_at(next_);
+    }
+    if (now - epoch_ > robot_.time()) robot_.advance_to(now - epoch_);
+    return source_.read(now);
+  }
+  int counter_bits() const noexcept override { return source_.counter_bits(); }
+  int read(std::span<std::uint8_t> out, TimeNs& /*arrival: the read's*/) noexcept override {
+    std::size_t n = 0;
+    for (; n < out.size() && tail_ != head_; ++n, ++tail_) out[n] = ring_[tail_ % ring_.size()];
+    return static_cast<int>(n);
+  }
+  bool write(std::span<const std::uint8_t> data) noexcept override {
+    // The board answers at once, with its counts of the moment of the request.
+    model_.on_host_bytes(data);
+    send_at(now_ - epoch_);
+    return true;
+  }
+  bool reopen() noexcept override { return true; }
+  EncoderSource& encoder() noexcept override { return *this; }
+  const std::string& describe() const noexcept override { return desc_; }
+
+ private:
+  void send_at(TimeNs t) noexcept {
+    if (t > robot_.time()) robot_.advance_to(t);
+    std::array<std::uint8_t, SerialPeerModel::kMaxOut> buf{};
+    const std::size_t n = model_.sample(t, robot_.counts_left(), robot_.counts_right(), buf);
+    // A full ring drops the newest bytes, as a UART's would: the source sees a gap.
+    for (std::size_t i = 0; i < n && head_ - tail_ < ring_.size(); ++i, ++head_)
+      ring_[head_ % ring_.size()] = buf[i];
+  }
+
+  SerialPeerModel model_;
+  SerialProtocol protocol_;
+  sim::SimRobot& robot_;
+  TimeNs epoch_;
+  TimeNs period_;
+  TimeNs next_ = 0;
+  TimeNs now_ = 0;
+  std::array<std::uint8_t, 4096> ring_{};
+  std::size_t head_ = 0;
+  std::size_t tail_ = 0;
+  protocol::SerialCountsSource source_;
+  std::string desc_;
+};
+
+std::string serial_text(const SerialSection& s) {
+  std::ostringstream d;
+  d << name_of(s.protocol) << " counts over a serial line (" << s.bits_left << "/" << s.bits_right
+    << "-bit counters, stale after " << s.timeout * 1e3 << " ms";
+  if (s.protocol == SerialProtocol::kArduinoBridge) d << ", polled at " << s.poll_rate << " Hz";
+  d << ")";
+  return d.str();
+}
+
 }  // namespace
+
+protocol::SerialSourceConfig serial_source_config(const SerialSection& s,
+                                                  const KinematicParams& p) {
+  protocol::SerialSourceConfig c;
+  c.protocol = s.protocol == SerialProtocol::kDiffodom ? protocol::SerialProtocol::kDiffodom
+                                                       : protocol::SerialProtocol::kArduinoBridge;
+  c.bits_left = s.bits_left;
+  c.bits_right = s.bits_right;
+  c.reverse_left = s.reverse_left;
+  c.reverse_right = s.reverse_right;
+  c.timeout = from_seconds(s.timeout);
+  c.reopen_period = from_seconds(s.reopen_period);
+  c.poll_period = from_seconds(1.0 / s.poll_rate);
+  c.max_counts_per_s = s.max_speed * counts_per_metre(p);
+  c.clock_window = from_seconds(s.clock_window);
+  return c;
+}
+
+Result<std::unique_ptr<EncoderBackend>> make_serial_tty_backend(const Config& cfg,
+                                                                const Kinematics& k) {
+  const SerialSection& s = cfg.serial;
+  auto port = drivers::SerialPort::open(s.device, s.baud, from_seconds(s.reopen_period));
+  if (!port) {
+    Error e = std::move(port).error();
+    e.message = s.device_where + " " + e.message;
+    return e;
+  }
+  std::ostringstream d;
+  d << serial_text(s) << " on " << s.device << " at " << s.baud << " baud";
+  return std::unique_ptr<EncoderBackend>(
+      new SerialTtyBackend(std::move(port).value(), serial_source_config(s, k.params()), d.str()));
+}
+
+Result<std::unique_ptr<EncoderBackend>> make_serial_sim_backend(const Config& cfg,
+                                                                const Kinematics& k,
+                                                                sim::SimRobot& robot,
+                                                                TimeNs epoch) {
+  std::ostringstream d;
+  d << serial_text(cfg.serial) << ", from a simulated controller";
+  if (cfg.serial.protocol == SerialProtocol::kDiffodom)
+    d << " every " << cfg.serial.sim_period * 1e3 << " ms";
+  d << " following the simulated robot";
+  return std::unique_ptr<EncoderBackend>(new SerialSimBackend(cfg, k, robot, epoch, d.str()));
+}
 
 drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const KinematicParams& p) {
   drivers::CanEncoderConfig c;

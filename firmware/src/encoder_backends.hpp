@@ -12,6 +12,7 @@
 #include "odo/hal/encoder.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/kinematics.hpp"
+#include "odo/protocol/serial_counts_source.hpp"
 
 namespace odo::sim {
 class SimRobot;
@@ -58,5 +59,21 @@ Result<std::unique_ptr<EncoderBackend>> make_can_socketcan_backend(const Config&
 // bus port, read by the real driver; sim_stop_*_after stop an axis (fault).
 Result<std::unique_ptr<EncoderBackend>> make_can_sim_backend(const Config& cfg, const Kinematics& k,
                                                              sim::SimRobot& robot, TimeNs epoch);
+
+// serial_source_config: the source configuration of [serial] for this robot (jump limit from
+// max_speed, poll period from poll_rate).
+protocol::SerialSourceConfig serial_source_config(const SerialSection& s, const KinematicParams& p);
+
+// make_serial_tty_backend: [serial] with link = "tty": the device in raw mode; a missing device,
+// one that is not a tty, an unsupported baud rate: an error naming file, line and key.
+Result<std::unique_ptr<EncoderBackend>> make_serial_tty_backend(const Config& cfg,
+                                                                const Kinematics& k);
+
+// make_serial_sim_backend: [serial] with link = "sim": a simulated controller speaking the
+// protocol follows `robot` (robot time = loop time minus `epoch`), its bytes read by the real
+// source through an in-memory link.
+Result<std::unique_ptr<EncoderBackend>> make_serial_sim_backend(const Config& cfg,
+                                                                const Kinematics& k,
+                                                                sim::SimRobot& robot, TimeNs epoch);
 
 }  // namespace odo::fw

@@ -25,10 +25,6 @@ class GyroWiring {
   virtual const std::string& describe() const noexcept = 0;
 };
 
-// gyrodometry_params: the fusion's parameters from [gyro]; keys left unset take the simulated
-// model's figures (simulated_gyro) or the consumer-class defaults (GyroNoiseModel).
-GyrodometryParams gyrodometry_params(const Config& cfg);
-
 // make_iio_gyro: [gyro] backend = "iio"; errors name the config file, the device and channel.
 Result<std::unique_ptr<GyroWiring>> make_iio_gyro(const Config& cfg);
 

@@ -14,22 +14,19 @@ namespace odo::fw {
 
 namespace {
 
+// make_scenario: the [sim] section's squares (sim_hal composes them: the microcontroller
+// firmware's simulated run drives the same path).
 sim::Scenario make_scenario(const SimSection& s, const Kinematics& k) {
   sim::SquareOptions o;
   o.side = s.side;
   o.speed = s.speed;
   o.turn_rate = s.turn_rate;
   o.pause = s.pause;
-  sim::Scenario out;
-  auto add = [&](sim::Turn dir) {
-    o.direction = dir;
-    const sim::Scenario sq = sim::square_scenario(k, o);
-    out.insert(out.end(), sq.begin(), sq.end());
-  };
-  const bool both = s.scenario == SimScenario::kSquares;
-  if (both || s.scenario == SimScenario::kSquareCcw) add(sim::Turn::kCounterClockwise);
-  if (both || s.scenario == SimScenario::kSquareCw) add(sim::Turn::kClockwise);
-  return out;
+  const sim::SquareSet set = s.scenario == SimScenario::kSquares     ? sim::SquareSet::kBoth
+                             : s.scenario == SimScenario::kSquareCcw ? sim::SquareSet::kCcw
+                             : s.scenario == SimScenario::kSquareCw  ? sim::SquareSet::kCw
+                                                                     : sim::SquareSet::kNone;
+  return sim::squares_scenario(k, o, set);
 }
 
 }  // namespace
@@ -120,24 +117,8 @@ Result<std::unique_ptr<EncoderBackend>> hardware_backend(const Config& cfg, cons
                           std::string(name_of(be)) + "\")");
   return be == EncoderKind::kGpio       ? make_gpio_backend(cfg)
          : be == EncoderKind::kHctl1100 ? make_hctl_gpio_backend(cfg, k)
+         : be == EncoderKind::kSerial   ? make_serial_tty_backend(cfg, k)
                                         : make_can_socketcan_backend(cfg, k);
-}
-
-// sim_geometry: the simulated robot's true geometry: the LabMate's errors, or the belief.
-sim::RobotGeometry sim_geometry(const SimSection& s, const KinematicParams& p) {
-  sim::RobotGeometry g;
-  g.counts_per_rev = p.counts_per_rev;
-  g.gear_ratio = p.gear_ratio;
-  if (s.robot == SimRobotKind::kLabmate) {
-    const sim::RobotGeometry lm = sim::labmate_geometry(p.wheel_diameter);
-    g.wheel_diameter_left = lm.wheel_diameter_left;
-    g.wheel_diameter_right = lm.wheel_diameter_right;
-    g.wheelbase = lm.wheelbase;
-  } else {
-    g.wheel_diameter_left = g.wheel_diameter_right = p.wheel_diameter;
-    g.wheelbase = p.wheelbase_nominal;
-  }
-  return g;
 }
 
 }  // namespace
@@ -157,7 +138,8 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
   // The simulated robot, read directly (backend sim) or through a model of the counter chip or
   // of the CAN motor controllers on their simulated bus.
   const bool modelled = cfg.encoder.backend != EncoderKind::kSim;
-  const sim::RobotGeometry g = sim_geometry(cfg.sim, k.params());
+  const sim::RobotGeometry g =
+      sim::simulated_geometry(cfg.sim.robot == SimRobotKind::kLabmate, k.params());
   sim::Scenario scenario = make_scenario(cfg.sim, k);
   // With a gyro the robot first stands still, as a real one does after power-up, so that the
   // fusion learns the gyro's bias before the first move (detection is off until then): still_time
@@ -181,9 +163,11 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
   if (modelled) {
     const TimeNs epoch = virtual_time ? 0 : impl->clock->now();
     impl->sim_epoch = epoch;
-    auto b = cfg.encoder.backend == EncoderKind::kHctl1100
+    const EncoderKind be = cfg.encoder.backend;
+    auto b = be == EncoderKind::kHctl1100
                  ? make_hctl_sim_backend(cfg, k, *impl->robot, *impl->clock, epoch)
-                 : make_can_sim_backend(cfg, k, *impl->robot, epoch);
+             : be == EncoderKind::kSerial ? make_serial_sim_backend(cfg, k, *impl->robot, epoch)
+                                          : make_can_sim_backend(cfg, k, *impl->robot, epoch);
     if (!b) return std::move(b).error();
     impl->backend = std::move(b).value();
     impl->encoder = &impl->backend->encoder();

@@ -9,18 +9,17 @@
 
 namespace odo::fw {
 
-Ros2Output::Ros2Output(double b, const ErrorModelParams& k, loop::OdometryLoop& loop)
-    : b_(b), k_(k), loop_(loop) {}
+Ros2Output::Ros2Output(const ErrorModelParams& k, loop::OdometryLoop& loop) : k_(k), loop_(loop) {}
 
 Ros2Output::~Ros2Output() {
   stop();
 }
 
 Result<std::unique_ptr<Ros2Output>> Ros2Output::create(const ros2::Config* c, double loop_hz,
-                                                       double b, const ErrorModelParams& k,
+                                                       const ErrorModelParams& k,
                                                        loop::OdometryLoop& loop) {
   if (c == nullptr || !c->enabled) return std::unique_ptr<Ros2Output>();
-  std::unique_ptr<Ros2Output> out(new Ros2Output(b, k, loop));
+  std::unique_ptr<Ros2Output> out(new Ros2Output(k, loop));
   Ros2Output* self = out.get();
   auto bridge = ros2::Bridge::create(
       *c, loop_hz, [self](ros2::OdomSample& s) { return self->read(s); },
@@ -48,15 +47,9 @@ void Ros2Output::on_tick(const loop::LoopSnapshot& snap) noexcept {
   s.pose_cov = snap.has_cov ? snap.cov : Cov3{};
   s.v = snap.v;
   s.omega = snap.w;
-  // The wheel travels of this tick, back from (v, omega) over its sample interval: the twist
-  // is their difference quotient, so its covariance is theirs (mapping.hpp).
-  const TimeNs dt_ns =
-      prev_stamp_ > 0 && snap.stamp > prev_stamp_ ? snap.stamp - prev_stamp_ : loop_.period();
-  prev_stamp_ = snap.stamp;
-  const double dt = to_seconds(dt_ns);
-  const double d_left = (snap.v - 0.5 * b_ * snap.w) * dt;
-  const double d_right = (snap.v + 0.5 * b_ * snap.w) * dt;
-  s.twist_cov = ros2::twist_covariance_from_wheels(d_left, d_right, dt, b_, k_);
+  // The twist is the tick's difference quotient of what it measured, so its covariance is the
+  // error model's for those travels, with the wheelbase and heading source of that tick.
+  s.twist_cov = twist_covariance(snap.motion, k_);
   samples_.publish();
 }
 

@@ -25,9 +25,10 @@ namespace odo::fw {
 class Ros2Output final : public loop::TickObserver {
  public:
   // create: null (and ok) when c is null or not enabled; registers the observer on loop and
-  // opens the DDS participant (configure time). b: wheelbase [m] and k: error model of the twist
-  // covariance. Errors name the [ros2] field or the DDS call.
-  static Result<std::unique_ptr<Ros2Output>> create(const ros2::Config* c, double loop_hz, double b,
+  // opens the DDS participant (configure time). k: error model of the twist covariance (the
+  // tick's travels and wheelbase come with each snapshot). Errors name the [ros2] field or the
+  // DDS call.
+  static Result<std::unique_ptr<Ros2Output>> create(const ros2::Config* c, double loop_hz,
                                                     const ErrorModelParams& k,
                                                     loop::OdometryLoop& loop);
   ~Ros2Output() override;
@@ -48,18 +49,16 @@ class Ros2Output final : public loop::TickObserver {
   nlohmann::json json() const;
 
  private:
-  Ros2Output(double b, const ErrorModelParams& k, loop::OdometryLoop& loop);
+  Ros2Output(const ErrorModelParams& k, loop::OdometryLoop& loop);
   // read: the bridge thread's SampleSource (the buffer's reader side).
   bool read(ros2::OdomSample& s);
   // post: the bridge thread's SetPoseSink.
   void post(const ros2::SetPose& p);
 
-  double b_;
   int priority_ = 0;  // [ros2] priority of the publish thread
   ErrorModelParams k_;
   loop::OdometryLoop& loop_;
   loop::TripleBuffer<ros2::OdomSample> samples_;
-  TimeNs prev_stamp_ = 0;  // loop thread: the previous tick's sample time
   std::unique_ptr<ros2::Bridge> bridge_;
   std::string describe_;
   std::atomic<std::uint64_t> set_pose_posted_{0}, set_pose_dropped_{0};

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -17,8 +18,10 @@
 #include <iomanip>
 #include <span>
 #include <sstream>
+#include <utility>
 
 #include "odo/calibration/record.hpp"
+#include "odo/hal/crc.hpp"
 
 namespace odo::fw {
 namespace {
@@ -43,6 +46,7 @@ std::uint8_t backend_id(const Config& cfg) {
     id |= static_cast<std::uint8_t>(cfg.hctl1100.bus);
   if (cfg.encoder.backend == EncoderKind::kCan)
     id |= static_cast<std::uint8_t>(cfg.can_encoder.bus);
+  if (cfg.encoder.backend == EncoderKind::kSerial) id |= static_cast<std::uint8_t>(cfg.serial.link);
   return id;
 }
 
@@ -150,7 +154,7 @@ std::uint32_t gyro_id(const Config& cfg) {
   }
   // The records' own CRC-32 of that text: any change of it is another gyro.
   const std::string text = t.str();
-  const std::uint32_t h = calib::crc32(std::span<const std::uint8_t>(
+  const std::uint32_t h = odo::crc32(std::span<const std::uint8_t>(
       reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
   return h != 0 ? h : 1;  // 0 means "no gyro"
 }
@@ -162,6 +166,9 @@ bool counters_survive_restart(const Config& cfg) {
     case EncoderKind::kCan:
       // The driver reports the controllers' own counters (drivers/can_encoder.hpp).
       return cfg.can_encoder.bus == CanEncoderBus::kSocketCan;
+    case EncoderKind::kSerial:
+      // The microcontroller's own counters (protocol/serial_counts_source.hpp).
+      return cfg.serial.link == SerialLink::kTty;
     case EncoderKind::kGpio:  // decoded by this process: edges are lost while it is down
     case EncoderKind::kSim:   // restarts with the process
       return false;
@@ -171,11 +178,28 @@ bool counters_survive_restart(const Config& cfg) {
 
 // ---- StatePersister ----
 
+namespace {
+
+// make_state_directory: creates the state file's directory when it is missing (one level: run by
+// hand there is no systemd to make /run/odometryd), with the mode systemd's RuntimeDirectory=
+// gives it, 0755 whatever the umask; true if it was made.
+bool make_state_directory(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos || slash == 0) return false;
+  const std::string dir = path.substr(0, slash);
+  if (::mkdir(dir.c_str(), 0755) != 0) return false;
+  return ::chmod(dir.c_str(), 0755) == 0;
+}
+
+}  // namespace
+
 Result<std::unique_ptr<StatePersister>> StatePersister::create(const std::string& path,
                                                                double rate_hz, double loop_hz,
                                                                const loop::OdometryLoop& loop,
                                                                const loop::StateRecord& identity) {
-  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0 && errno == ENOENT && make_state_directory(path))
+    fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd < 0) return io_error("cannot open the state file", path);
   // Both slots exist from the start; the older record in them stays readable until replaced.
   struct stat st {};
@@ -252,6 +276,27 @@ void StatePersister::write_newest() noexcept {
   }
 }
 
+namespace {
+
+// counter_jump_text: appends to the `n` bytes in `line` which wheel jumped and how far, against
+// the most it could move in the gap (issue 39); returns the new length.
+int counter_jump_text(const loop::ResumeDecision& d, char* line, std::size_t size, int n) {
+  const std::array<std::pair<const char*, std::int64_t>, 2> wheels{
+      {{"left", d.dl}, {"right", d.dr}}};
+  const std::array<double, 2> bound{d.max_dl, d.max_dr};
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (std::fabs(static_cast<double>(wheels[i].second)) <= bound[i]) continue;
+    n = std::clamp(n, 0, static_cast<int>(size) - 1);
+    n += std::snprintf(line + n, size - static_cast<std::size_t>(n),
+                       ": %s wheel %+lld counts in the %.3f s gap, at most %.0f at max_speed",
+                       wheels[i].first, static_cast<long long>(wheels[i].second), to_seconds(d.gap),
+                       std::floor(bound[i]));
+  }
+  return n;
+}
+
+}  // namespace
+
 void StatePersister::run(std::ostream& log, std::optional<loop::ResumeReason> fixed,
                          const std::string& note) {
   bool told = false;
@@ -285,6 +330,7 @@ void StatePersister::run(std::ostream& log, std::optional<loop::ResumeReason> fi
         const std::string_view name = loop::resume_reason_name(why);
         n = std::snprintf(line, sizeof line, "odometryd: resume: fresh start (%.*s)%s",
                           static_cast<int>(name.size()), name.data(), note.c_str());
+        if (why == loop::ResumeReason::kCounterJump) n = counter_jump_text(d, line, sizeof line, n);
         // A fresh pose may still come with the gyro's calibration (same chip, same boot): told
         // when it does; why the pose did not resume is the reason already.
         tell_gyro = !fixed && d.gyro_restored;
@@ -329,8 +375,9 @@ ResumeWiring prepare_resume(const Config& cfg, loop::OdometryLoop& loop,
     c.metres_per_count_right = k.metres_per_count_right();
     c.wheelbase = k.wheelbase();
     c.gyro_id = identity.gyro_id;
-    c.max_wheel_speed = cfg.encoder.backend == EncoderKind::kCan ? cfg.can_encoder.max_speed
-                                                                 : cfg.hctl1100.max_speed;
+    c.max_wheel_speed = cfg.encoder.backend == EncoderKind::kCan      ? cfg.can_encoder.max_speed
+                        : cfg.encoder.backend == EncoderKind::kSerial ? cfg.serial.max_speed
+                                                                      : cfg.hctl1100.max_speed;
     loop.resume_from(*rec, c);
     w.offered = true;
   } else if (!rec) {

@@ -26,6 +26,12 @@ void TableReader::fail(const toml::node* n, std::string_view key, const std::str
   *error_ = o.str();
 }
 
+std::string TableReader::location(std::string_view key) const {
+  const toml::node* n = table_ != nullptr ? table_->get(key) : nullptr;
+  return where(n != nullptr ? n : table_) + ": " + path_ + (path_.empty() ? "" : ".") +
+         std::string(key);
+}
+
 void TableReader::reject(std::string_view key, const std::string& what) {
   fail(table_ != nullptr ? table_->get(key) : nullptr, key, what);
 }
@@ -38,7 +44,12 @@ const toml::node* TableReader::get(std::string_view key) {
 
 double TableReader::number(std::string_view key, double def, double lo, double hi,
                            std::string_view unit) {
-  const toml::node* n = get(key);
+  const std::string k(key), u(unit);
+  return number(def, RangeRow{k.c_str(), lo, hi, u.c_str()});
+}
+
+double TableReader::number(double def, const RangeRow& row) {
+  const toml::node* n = get(row.key);
   if (n == nullptr) return def;
   double v = 0;
   if (auto f = n->value_exact<double>()) {
@@ -46,11 +57,13 @@ double TableReader::number(std::string_view key, double def, double lo, double h
   } else if (auto i = n->value_exact<std::int64_t>()) {
     v = static_cast<double>(*i);
   } else {
-    fail(n, key, "must be a number");
+    fail(n, row.key, "must be a number");
     return def;
   }
-  if (!std::isfinite(v) || v < lo || v > hi) {
-    fail(n, key, range_text({std::string(key), v, lo, hi, std::string(unit), false}));
+  if (!row.contains(v)) {
+    FieldRange r = row.range(row.key, v);
+    r.unit_on_value = false;  // "x = 3 is outside the allowed range [0, 1] m"
+    fail(n, row.key, range_text(r));
     return def;
   }
   return v;

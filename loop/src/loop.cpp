@@ -73,6 +73,8 @@ void OdometryLoop::start() noexcept {
   if (gyro_ != nullptr) fused_in_.gyro = gyro_->read(clock_->now());
   prev_left_ = s.left;
   prev_right_ = s.right;
+  prev_rejected_left_ = s.left_rejected;
+  prev_rejected_right_ = s.right_rejected;
   prev_stamp_ = s.stamp;
   unreferenced_ = s.flags & (kEncoderStaleLeft | kEncoderStaleRight);
   // Loop time starts once the reference counts are latched, however long that read took; the
@@ -87,7 +89,7 @@ void OdometryLoop::start() noexcept {
   b.pose = odom_.pose();
   b.distance = odom_.distance();
   b.cov = odom_.covariance();
-  fill_gyro_status(b.gyro);
+  fill_gyro_status(b);
   published_.publish();
   resume_decided_.store(true, std::memory_order_release);
 }
@@ -179,6 +181,7 @@ TimeNs OdometryLoop::wait_for_deadline() noexcept {
   const std::int64_t dl = wrap_delta(prev_left_, s.left, bits_);
   const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
   const double dt = to_seconds(s.stamp - prev_stamp_);
+  last_dt_ = dt;
   if (fusion_) {
     integrate_fused(dl, dr, dt, s.stamp);
   } else {
@@ -186,6 +189,8 @@ TimeNs OdometryLoop::wait_for_deadline() noexcept {
   }
   prev_left_ = s.left;
   prev_right_ = s.right;
+  prev_rejected_left_ = s.left_rejected;
+  prev_rejected_right_ = s.right_rejected;
   prev_stamp_ = s.stamp;
 }
 
@@ -213,12 +218,14 @@ void OdometryLoop::take_reference(const EncoderSample& s) noexcept {
   in.wheelbase = k.wheelbase();
   const FusedTick f = fusion_->step(in);
   last_fusion_flags_ = f.flags;
+  last_var_heading_ = f.var_heading;
   if ((f.flags & kFusionGyroUsed) == 0) {
     // Odometry's own increment and no travel correction: the plain path, which computes exactly
-    // what advance_fused would for it (Odometry::update_fused's contract), at the plain cost.
-    odom_.advance(dl, dr, dt);
+    // what advance_fused would for it (Odometry::update_fused's contract), at the plain cost,
+    // from the travels already converted for the fusion (the counts are converted once).
+    odom_.advance_travel(in.d_left, in.d_right, dt);
   } else {
-    odom_.advance_fused(dl, dr, dt, f.dtheta, f.ds, true, f.var_heading);
+    odom_.advance_fused(in.d_left, in.d_right, dt, f.dtheta, f.ds, true, f.var_heading);
   }
 }
 
@@ -241,21 +248,29 @@ void OdometryLoop::record_wakeup(TimeNs latency) noexcept {
   snap.pose = odom_.pose();
   snap.v = odom_.linear_velocity();
   snap.w = odom_.angular_velocity();
+  // What the tick measured, field by field (the gyro's part in fill_gyro_status, with a fusion).
+  snap.motion.d_left = odom_.last_d_left();
+  snap.motion.d_right = odom_.last_d_right();
+  snap.motion.dt = last_dt_;
+  snap.motion.wheelbase = odom_.kinematics().wheelbase();
   snap.distance = odom_.distance();
   snap.cov = odom_.covariance();
   snap.has_cov = true;
   snap.calibration_state = calibration_;
   snap.encoder_flags = s.flags;
   snap.encoder_counters = s.counters;
-  fill_gyro_status(snap.gyro);
+  fill_gyro_status(snap);
   // Observers see the statistics up to this tick's wake-up; the fields that change after them
   // are patched in below, so the published snapshot carries the statistics of the whole tick.
   snap.stats = stats_;
   return snap;
 }
 
-void OdometryLoop::fill_gyro_status(LoopGyroStatus& g) const noexcept {
+void OdometryLoop::fill_gyro_status(LoopSnapshot& snap) const noexcept {
   if (!fusion_) return;  // stays all zero: the default of every slot
+  snap.motion.gyro_heading = (last_fusion_flags_ & kFusionGyroUsed) != 0;
+  snap.motion.gyro_var_heading = last_var_heading_;
+  LoopGyroStatus& g = snap.gyro;
   g.enabled = true;
   g.gyro_flags = fused_in_.gyro.flags;
   g.fusion_flags = last_fusion_flags_;

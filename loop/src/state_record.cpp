@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "odo/calibration/record.hpp"
 #include "odo/hal/bytes.hpp"
+#include "odo/hal/crc.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
 
@@ -85,7 +85,7 @@ void encode_state(const StateRecord& r, StateBytes& b) noexcept {
   put(b, kGyroBias, r.gyro.bias);
   put(b, kGyroBiasTime, r.gyro.bias_time);
   put(b, kGyroScale, r.gyro.scale);
-  put(b, kCrcOffset, calib::crc32(std::span<const std::uint8_t>(b.data(), kCrcOffset)));
+  put(b, kCrcOffset, odo::crc32(std::span<const std::uint8_t>(b.data(), kCrcOffset)));
 }
 
 // decode_gyro: version 2's gyro part of `b` into r.
@@ -117,7 +117,7 @@ Result<StateRecord> decode_state(std::span<const std::uint8_t> b) {
                    " (or 1 and " + std::to_string(kStateRecordBytesV1) + ")");
   // The CRC covers everything else: a write torn at any byte fails here.
   const std::size_t crc_at = length - 4;
-  if (get<std::uint32_t>(b, crc_at) != calib::crc32(b.first(crc_at)))
+  if (get<std::uint32_t>(b, crc_at) != odo::crc32(b.first(crc_at)))
     return corrupt("CRC mismatch (torn or damaged write)");
   StateRecord r;
   r.sequence = get<std::uint64_t>(b, 8);
@@ -199,16 +199,24 @@ ResumeDecision decide_resume(const StateRecord& rec, const ResumeContext& ctx,
     return fresh(ResumeReason::kOtherKinematics);
   if (rec.calibration_sequence != ctx.calibration_sequence)
     return fresh(ResumeReason::kOtherCalibration);
+  // The controller's counts restarted at its boot: whatever they read, they are not the
+  // record's counts continued.
+  if ((current.flags & kEncoderControllerReset) != 0) return fresh(ResumeReason::kControllerReset);
   if ((current.flags & (kEncoderReadError | kEncoderStaleLeft | kEncoderStaleRight)) != 0)
     return fresh(ResumeReason::kEncoderNotReady);
-  d.dl = wrap_delta(rec.left, current.left, ctx.counter_bits);
-  d.dr = wrap_delta(rec.right, current.right, ctx.counter_bits);
+  // The record holds the counters' own values: compared with the counters' own values now (the
+  // reported counts plus any jump this process rejected), so only real motion is seen.
+  const int bits = ctx.counter_bits;
+  d.dl = wrap_delta(rec.left, counter_value(current.left, current.left_rejected, bits), bits);
+  d.dr = wrap_delta(rec.right, counter_value(current.right, current.right_rejected, bits), bits);
   // The most counts a wheel can make in the gap, plus one for quantisation; when that bound
   // reaches half the counter range the wrap rule can no longer tell the direction.
   const double gap_s = to_seconds(d.gap);
   const double max_l = ctx.max_wheel_speed * gap_s / ctx.metres_per_count_left + 1.0;
   const double max_r = ctx.max_wheel_speed * gap_s / ctx.metres_per_count_right + 1.0;
   const double half_range = std::ldexp(1.0, ctx.counter_bits - 1);
+  d.max_dl = max_l;
+  d.max_dr = max_r;
   if (max_l >= half_range || max_r >= half_range) return fresh(ResumeReason::kStale);
   if (std::fabs(static_cast<double>(d.dl)) > max_l || std::fabs(static_cast<double>(d.dr)) > max_r)
     return fresh(ResumeReason::kCounterJump);
@@ -219,8 +227,10 @@ ResumeDecision decide_resume(const StateRecord& rec, const ResumeContext& ctx,
 void fill_state_record(const OdometryLoop& loop, StateRecord& r) noexcept {
   const Odometry& o = loop.odometry();
   r.stamp = loop.last_stamp();
-  r.left = loop.last_left();
-  r.right = loop.last_right();
+  // The counters' own values, not the re-based counts the loop integrates: a jump this process
+  // rejected stays rejected after a restart (issue 39).
+  r.left = loop.last_counter_left();
+  r.right = loop.last_counter_right();
   r.counter_bits = static_cast<std::uint8_t>(loop.counter_bits());
   r.calibration_state = static_cast<std::uint8_t>(loop.calibration());
   r.metres_per_count_left = o.kinematics().metres_per_count_left();

@@ -332,6 +332,21 @@ inline void propagate_local_impl(Cov3& cov, double s0, double c0, double lx, dou
 
 }  // namespace
 
+Cov2 twist_covariance(const TickMotion& m, const ErrorModelParams& k) noexcept {
+  // v = (dL + dR) / (2 dt) and, from the wheels, omega = (dR - dL) / (b dt), with independent
+  // wheel variances wL = kL^2 |dL|, wR = kR^2 |dR|: var v = (wL + wR) / (4 dt^2),
+  // var omega = (wL + wR) / (b^2 dt^2), cov(v, omega) = (wR - wL) / (2 b dt^2). On a gyro tick
+  // omega = dtheta_gyro / dt: var omega = var_heading / dt^2, and the gyro's noise is
+  // independent of the wheels', so the cross term is 0.
+  if (!(m.dt > 0.0) || !(m.wheelbase > 0.0)) return Cov2{};
+  const double wl = k.k_left * k.k_left * std::fabs(m.d_left);
+  const double wr = k.k_right * k.k_right * std::fabs(m.d_right);
+  const double dt2 = m.dt * m.dt, b = m.wheelbase;
+  if (m.gyro_heading) return Cov2{(wl + wr) / (4.0 * dt2), 0.0, 0.0, m.gyro_var_heading / dt2};
+  const double cross = (wr - wl) / (2.0 * b * dt2);
+  return Cov2{(wl + wr) / (4.0 * dt2), cross, cross, (wl + wr) / (b * b * dt2)};
+}
+
 Cov3 arc_input_covariance(double d_left, double d_right, double b,
                           const ErrorModelParams& k) noexcept {
   Cov3 out{};

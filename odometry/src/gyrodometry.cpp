@@ -4,7 +4,6 @@
 #include <bit>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 // Covariance of a tick whose heading comes from the gyro (propagate_gyro_arc). In the frame of the
 // tick's start pose, with arc parameter u in [0, 1], centre travel D u and heading phi u (as in
@@ -26,49 +25,89 @@ namespace {
 
 constexpr std::uint32_t kResumWraps = 16;
 
-struct Bound {
-  const char* field;
-  double value, lo, hi;
-  bool lo_open;  // lo itself excluded
+// The fusion's limits, in GyroParam order. Open lower limits where zero would divide or stall
+// (speeds, times, the tick); window and bias_tau get their lower limits from the tick and
+// still_time in gyrodometry_range.
+constexpr RangeRow kGyroRows[kGyroParams] = {
+    {"noise_density", 0.0, 0.1, "rad/s/sqrt(Hz)"},
+    {"bias_instability", 0.0, 0.1, "rad/s"},
+    {"scale_tolerance", 0.0, 0.5, ""},
+    {"delay", 0.0, 1.0, "s"},
+    {"delay_tolerance", 0.0, 1.0, "s"},
+    {"window", 0.0, 10.0, "s"},  // lo: two ticks (one per half of the window)
+    {"k_sigma", 1.0, 20.0, ""},
+    {"max_wheel_speed", 0.0, 100.0, "m/s", true},
+    {"max_wheel_accel", 0.0, 1000.0, "m/s^2", true},
+    {"still_time", 0.0, 60.0, "s", true},
+    {"bias_tau", 0.0, 86400.0, "s"},  // lo: still_time (the first average already spans it)
+    {"tick", 0.0, 1.0, "s", true},
+    {"heading_quantum", 0.0, 0.1, "rad"},
+    {"turn_rate_min", 0.0, 100.0, "rad/s", true},
+    {"scale_angle", 0.0, 1e6, "rad", true},
+    {"scale_max_error", 0.0, 0.5, "", true},
 };
-
-Status check_bound(const Bound& b) {
-  const bool above = b.lo_open ? b.value > b.lo : b.value >= b.lo;
-  if (std::isfinite(b.value) && above && b.value <= b.hi) return Ok{};
-  std::ostringstream m;
-  m << "gyrodometry " << b.field << " = " << b.value << " is outside the allowed range "
-    << (b.lo_open ? "(" : "[") << b.lo << ", " << b.hi << "]";
-  return make_error(Errc::kInvalidArgument, m.str());
-}
 
 }  // namespace
 
+RangeRow gyrodometry_range(GyroParam k, double tick, double still_time) noexcept {
+  RangeRow r = kGyroRows[static_cast<std::size_t>(k)];
+  if (k == GyroParam::kWindow) {
+    r.lo = 2.0 * tick;
+    r.hi = std::max(r.hi, r.lo);  // a slow loop still has a window of two ticks
+  }
+  if (k == GyroParam::kBiasTau) r.lo = still_time;
+  return r;
+}
+
+double& gyrodometry_value(GyrodometryParams& p, GyroParam k) noexcept {
+  switch (k) {
+    case GyroParam::kNoiseDensity:
+      return p.noise.rate_noise_density;
+    case GyroParam::kBiasInstability:
+      return p.noise.bias_instability;
+    case GyroParam::kScaleTolerance:
+      return p.noise.scale_tolerance;
+    case GyroParam::kDelay:
+      return p.gyro_delay;
+    case GyroParam::kDelayTolerance:
+      return p.delay_tolerance;
+    case GyroParam::kWindow:
+      return p.window;
+    case GyroParam::kKSigma:
+      return p.k_sigma;
+    case GyroParam::kMaxWheelSpeed:
+      return p.max_wheel_speed;
+    case GyroParam::kMaxWheelAccel:
+      return p.max_wheel_accel;
+    case GyroParam::kStillTime:
+      return p.still_time;
+    case GyroParam::kBiasTau:
+      return p.bias_tau;
+    case GyroParam::kTick:
+      return p.tick;
+    case GyroParam::kHeadingQuantum:
+      return p.heading_quantum;
+    case GyroParam::kTurnRateMin:
+      return p.turn_rate_min;
+    case GyroParam::kScaleAngle:
+      return p.scale_angle;
+    case GyroParam::kScaleMaxError:
+      break;
+  }
+  return p.scale_max_error;
+}
+
 Status check_gyrodometry(const GyrodometryParams& p) {
-  const Bound table[] = {
-      {"rate_noise_density", p.noise.rate_noise_density, 0.0, 0.1, false},
-      {"bias_instability", p.noise.bias_instability, 0.0, 0.1, false},
-      {"scale_tolerance", p.noise.scale_tolerance, 0.0, 0.5, false},
-      {"tick", p.tick, 0.0, 1.0, true},
-      {"window", p.window, 2.0 * p.tick, std::max(10.0, 2.0 * p.tick), false},
-      {"k_sigma", p.k_sigma, 1.0, 20.0, false},
-      {"gyro_delay", p.gyro_delay, 0.0, 1.0, false},
-      {"delay_tolerance", p.delay_tolerance, 0.0, 1.0, false},
-      {"heading_quantum", p.heading_quantum, 0.0, 0.1, false},
-      {"max_wheel_speed", p.max_wheel_speed, 0.0, 100.0, true},
-      {"max_wheel_accel", p.max_wheel_accel, 0.0, 1000.0, true},
-      {"still_time", p.still_time, 0.0, 60.0, true},
-      {"bias_tau", p.bias_tau, p.still_time, 86400.0, false},
-      {"turn_rate_min", p.turn_rate_min, 0.0, 100.0, true},
-      {"scale_angle", p.scale_angle, 0.0, 1e6, true},
-      {"scale_max_error", p.scale_max_error, 0.0, 0.5, true},
-  };
-  for (const Bound& b : table) {
-    if (auto s = check_bound(b); !s) return s;
+  GyrodometryParams q = p;  // gyrodometry_value hands out references into a mutable struct
+  for (std::size_t i = 0; i < kGyroParams; ++i) {
+    const auto k = static_cast<GyroParam>(i);
+    const RangeRow r = gyrodometry_range(k, p.tick, p.still_time);
+    const double v = gyrodometry_value(q, k);
+    if (!r.contains(v)) return range_error(r.range(r.key, v));
   }
   if (p.window / p.tick > 100000.0 || p.gyro_delay / p.tick > 100000.0)
-    return make_error(
-        Errc::kInvalidArgument,
-        "gyrodometry window / tick and gyro_delay / tick must not exceed 100000 ticks");
+    return make_error(Errc::kInvalidArgument,
+                      "window / tick and delay / tick must not exceed 100000 ticks");
   return Ok{};
 }
 
@@ -307,7 +346,8 @@ void Gyrodometry::update_scale(double odo, double raw_gyro, double dt) noexcept 
 inline std::uint32_t Gyrodometry::limit_flags(double abs_left, double abs_right) const noexcept {
   // Speeds per tick: one count of quantisation is m / tick (0.046 m/s for 0.23 mm at 200 Hz),
   // far below any useful limit. The travels are finite (step() checked): max is the || of the two.
-  std::uint32_t f = std::max(abs_left, abs_right) > v_max_tick_ ? kFusionSpeedLimit : 0u;
+  std::uint32_t f =
+      std::max(abs_left, abs_right) > v_max_tick_ ? kFusionSpeedLimit : std::uint32_t{0};
   if (filled_ == size_) {
     // Accelerations from the mean speeds of the two halves of the window: a count per half is
     // 2 m / T_h^2 of acceleration (0.18 m/s^2 for 0.23 mm and T_h = 0.05 s), per tick it would be
@@ -339,7 +379,7 @@ std::uint32_t Gyrodometry::disagree_flag() const noexcept {
   const double abs_err = std::fabs(sums_.err);
   const bool flag =
       sums_.bad == 0 && filled_ == size_ && abs_err > base_threshold_ && abs_err > threshold();
-  return flag ? kFusionDisagree : 0u;
+  return flag ? kFusionDisagree : std::uint32_t{0};
 }
 
 FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
@@ -355,19 +395,8 @@ FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
   out.dtheta = out.dtheta_odo = odo;
   wheelbase_ = in.wheelbase;
   // The flags in a local: out is the caller's memory, each |= would be a load and a store.
-  std::uint32_t flags = 0;
-  const bool rate_ok = in.gyro.flags == kGyroOk && std::isfinite(in.gyro.rate_z);
-  if (!rate_ok) {
-    flags |= kFusionGyroFault;
-    // A gyro still starting (no sample yet, within its timeout) cannot be used but has not
-    // failed: no event, and the state is left as it was (its timeout, if it comes, is the event).
-    if (in.gyro.flags != kGyroStarting) {
-      if (gyro_was_ok_) ++counters_.gyro_faults;
-      gyro_was_ok_ = false;
-    }
-  } else {
-    gyro_was_ok_ = true;
-  }
+  std::uint32_t flags = gyro_health(in.gyro);
+  const bool rate_ok = flags == 0;
   const double abs_left = std::fabs(in.d_left), abs_right = std::fabs(in.d_right);
   if (abs_left + abs_right == 0.0) {  // both travels 0: a sum of magnitudes is 0 only then
     flags |= kFusionStill;
@@ -410,6 +439,20 @@ FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
     continue_interval(odo, fresh.err, dt, out);
   }
   return out;
+}
+
+std::uint32_t Gyrodometry::gyro_health(const GyroSample& g) noexcept {
+  if (g.flags == kGyroOk && std::isfinite(g.rate_z)) {
+    gyro_was_ok_ = true;
+    return 0;
+  }
+  // A gyro still starting (no sample yet, within its timeout) cannot be used but has not
+  // failed: no event, and the state is left as it was (its timeout, if it comes, is the event).
+  if (g.flags != kGyroStarting) {
+    if (gyro_was_ok_) ++counters_.gyro_faults;
+    gyro_was_ok_ = false;
+  }
+  return kFusionGyroFault;
 }
 
 void Gyrodometry::open_interval(std::uint32_t why, double odo, double dt, FusedTick& out) noexcept {

@@ -5,13 +5,6 @@
 
 namespace odo {
 
-double wrap_angle(double a) noexcept {
-  constexpr double kPi = std::numbers::pi;
-  double r = std::remainder(a, 2.0 * kPi);  // in [-pi, pi]
-  if (r <= -kPi) r += 2.0 * kPi;            // -pi maps to +pi
-  return r;
-}
-
 Pose2 arc_step(const Pose2& p, double d_left, double d_right, double b) noexcept {
   // On an arc of chord angle dtheta the centre moves along the chord of length
   // ds * sinc(dtheta/2), pointing at the mean heading theta + dtheta/2.
@@ -57,6 +50,10 @@ void PoseIntegrator::step_arc(double ds, double dth) noexcept {
   integrate(d_l, d_r, 0.5 * (d_l + d_r), (d_r - d_l) / k_.wheelbase(), dt);
 }
 
+[[gnu::flatten]] void Odometry::update_travel(double d_l, double d_r, double dt) noexcept {
+  integrate(d_l, d_r, 0.5 * (d_l + d_r), (d_r - d_l) / k_.wheelbase(), dt);
+}
+
 void Odometry::update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
                             double ds_correction) noexcept {
   const double d_l = static_cast<double>(dn_left) * k_.metres_per_count_left();
@@ -64,10 +61,10 @@ void Odometry::update_fused(std::int64_t dn_left, std::int64_t dn_right, double 
   integrate(d_l, d_r, 0.5 * (d_l + d_r) + ds_correction, dtheta, dt);
 }
 
-void Odometry::advance_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
-                             double ds_correction, bool gyro_heading, double var_heading) noexcept {
+void Odometry::advance_fused(double d_l, double d_r, double dt, double dtheta, double ds_correction,
+                             bool gyro_heading, double var_heading) noexcept {
   const double s0 = sin_theta(), c0 = cos_theta();
-  update_fused(dn_left, dn_right, dt, dtheta, ds_correction);
+  integrate(d_l, d_r, 0.5 * (d_l + d_r) + ds_correction, dtheta, dt);
   if (gyro_heading) {
     cov_.step_gyro_sc(s0, c0, d_left_, d_right_, dtheta, var_heading);
   } else {

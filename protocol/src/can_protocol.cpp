@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "odo/odometry/pose.hpp"
+#include "odo/hal/angle.hpp"
 #include "odo/protocol/signals.hpp"
 
 namespace odo::protocol {

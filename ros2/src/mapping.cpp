@@ -46,19 +46,6 @@ Cov6 twist_covariance_6x6(const Cov2& c) noexcept {
   return out;
 }
 
-Cov2 twist_covariance_from_wheels(double d_left, double d_right, double dt, double b,
-                                  const ErrorModelParams& k) noexcept {
-  // v = (dL + dR) / (2 dt), omega = (dR - dL) / (b dt), with independent wheel variances
-  // wL = kL^2 |dL|, wR = kR^2 |dR|: var v = (wL + wR) / (4 dt^2), var omega = (wL + wR) /
-  // (b^2 dt^2), cov = (wR - wL) / (2 b dt^2).
-  if (!(dt > 0.0) || !(b > 0.0)) return Cov2{};
-  const double wl = k.k_left * k.k_left * std::fabs(d_left);
-  const double wr = k.k_right * k.k_right * std::fabs(d_right);
-  const double dt2 = dt * dt;
-  const double cross = (wr - wl) / (2.0 * b * dt2);
-  return Cov2{(wl + wr) / (4.0 * dt2), cross, cross, (wl + wr) / (b * b * dt2)};
-}
-
 Result<RosTime> to_ros_time(TimeNs monotonic, TimeNs realtime_minus_monotonic) {
   const TimeNs t = monotonic + realtime_minus_monotonic;
   // Floor division: -1.7 s is {sec -2, nanosec 3e8} (builtin_interfaces/Time).

@@ -61,6 +61,34 @@ Scenario square_scenario(const Kinematics& k, const SquareOptions& o) {
   return s;
 }
 
+Scenario squares_scenario(const Kinematics& believed, SquareOptions o, SquareSet set) {
+  Scenario out;
+  auto add = [&](Turn dir) {
+    o.direction = dir;
+    const Scenario sq = square_scenario(believed, o);
+    out.insert(out.end(), sq.begin(), sq.end());
+  };
+  if (set == SquareSet::kCcw || set == SquareSet::kBoth) add(Turn::kCounterClockwise);
+  if (set == SquareSet::kCw || set == SquareSet::kBoth) add(Turn::kClockwise);
+  return out;
+}
+
+RobotGeometry simulated_geometry(bool labmate, const KinematicParams& p) {
+  RobotGeometry g;
+  g.counts_per_rev = p.counts_per_rev;
+  g.gear_ratio = p.gear_ratio;
+  if (labmate) {
+    const RobotGeometry lm = labmate_geometry(p.wheel_diameter);
+    g.wheel_diameter_left = lm.wheel_diameter_left;
+    g.wheel_diameter_right = lm.wheel_diameter_right;
+    g.wheelbase = lm.wheelbase;
+  } else {
+    g.wheel_diameter_left = g.wheel_diameter_right = p.wheel_diameter;
+    g.wheelbase = p.wheelbase_nominal;
+  }
+  return g;
+}
+
 double scenario_duration(const Scenario& s) {
   double d = 0.0;
   for (const Segment& seg : s) d += seg.duration;

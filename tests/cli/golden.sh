@@ -199,13 +199,40 @@ if [ "$mode" = record ]; then
   echo "golden: recorded $(ls "$golden" | wc -l) files into $golden"
   exit 0
 fi
+# The status of each comparison is taken before the message is built: a command substitution in
+# check's first argument would otherwise set the $? that its second argument reads (every
+# comparison then counted as passed, whatever it found: the case until stop 36).
+# close_csv A B: the same CSV up to a relative 1e-12 in each number. Only for a cross build (under
+# its emulator), whose libm rounds some sin/cos/exp results of the Monte Carlo differently in the
+# last bits (armhf: em_ob.csv differed in the 16th digit); natively every byte must be the same.
+close_csv() {
+  python3 - "$1" "$2" <<'PY'
+import sys
+a, b = (open(p).read().splitlines() for p in sys.argv[1:3])
+def same(x, y):
+    if x == y: return True
+    try: u, v = float(x), float(y)
+    except ValueError: return False
+    return abs(u - v) <= 1e-12 * max(abs(u), abs(v))
+ok = len(a) == len(b) and all(len(r.split(",")) == len(q.split(",")) and
+     all(same(x, y) for x, y in zip(r.split(","), q.split(","))) for r, q in zip(a, b))
+sys.exit(0 if ok else 1)
+PY
+}
 for f in "$golden"/*; do
   b=$(basename "$f")
   cmp -s "$f" "$got/$b"
-  check "$b identical$( [ -e "$got/$b" ] && diff "$f" "$got/$b" | head -6 | sed 's/^/\n  /' | tr -d '\r')" $?
+  rc=$?
+  if [ $rc != 0 ] && [ -n "${CROSS_EMULATOR:-}" ] && [[ $b == *.csv ]] && [ -e "$got/$b" ]; then
+    close_csv "$f" "$got/$b" && rc=0
+  fi
+  check "$b identical$( [ -e "$got/$b" ] && diff "$f" "$got/$b" | head -6 | sed 's/^/\n  /' | tr -d '\r')" $rc
 done
 for f in "$got"/*; do
-  [ -e "$golden/$(basename "$f")" ]; check "$(basename "$f") has a golden file" $?
+  b=$(basename "$f")
+  [ -e "$golden/$b" ]
+  rc=$?
+  check "$b has a golden file" $rc
 done
 echo "golden cli: $pass passed, $fail failed"
 [ "$fail" = 0 ]

@@ -34,6 +34,33 @@ grep -q "wheel_diameter" "$tmp/err"; check "replay bad diameter named" $?
 run "$ODOMCTL" replay --bogus >"$tmp/out" 2>"$tmp/err"
 rc=$?; [ $rc = 2 ]; check "odomctl unknown option exit 2 (got $rc)" $?
 
+# replay --config (issue 33): the log is replayed with odometryd's own config, read through the
+# daemon's reader and tables. A gyro without delay on turns that start and stop: the fusion's
+# default delay (2 ms) sees each start and stop as a disagreement (16 on this log), the config's
+# `[gyro] delay = 0` none, and the pose is odometry's own.
+python3 "$dir/spin_gyro_log.py" "$tmp/spin.csv"
+geometry=(--wheel-diameter 0.15 --counts-per-rev 2048 --gear-ratio 16 --wheelbase 0.34)
+run "$ODOMCTL" replay --ticks "$tmp/spin.csv" "${geometry[@]}" --json >"$tmp/def.json" 2>"$tmp/err"
+check "replay spin log, default fusion: exit 0" $?
+printf '[calibration]\nstore = ""\n[gyro]\ndelay = 0\n' >"$tmp/g0.toml"
+run "$ODOMCTL" replay --ticks "$tmp/spin.csv" --config "$tmp/g0.toml" --json >"$tmp/cfg.json" 2>"$tmp/err"
+check "replay spin log, --config: exit 0" $?
+[ "$(jget "$tmp/def.json" gyro.disagreements)" -gt 0 ] && [ "$(jget "$tmp/cfg.json" gyro.disagreements)" = 0 ]
+check "replay --config takes [gyro] delay: $(jget "$tmp/def.json" gyro.disagreements) events with the default, $(jget "$tmp/cfg.json" gyro.disagreements) with the config" $?
+run "$ODOMCTL" replay --ticks "$tmp/spin.csv" "${geometry[@]}" --no-gyro --json >"$tmp/odo.json" 2>/dev/null
+[ "$(jget "$tmp/cfg.json" theta)" = "$(jget "$tmp/odo.json" theta)" ]
+check "replay --config, nothing flagged: the heading is odometry's" $?
+printf '[gyro]\nwindow = 0.015\n' >"$tmp/gbad.toml"
+run "$ODOMCTL" replay --ticks "$tmp/spin.csv" --config "$tmp/gbad.toml" >"$tmp/out" 2>"$tmp/err"
+rc=$?; [ $rc = 2 ] && grep -q "gbad.toml:2: gyro.window = 0.015 is outside the allowed range \[0.02, 10\] s" "$tmp/err"
+check "replay --config: a bad key is the daemon's message with its line (got $rc: $(cat "$tmp/err"))" $?
+run "$ODOMCTL" replay --ticks "$tmp/spin.csv" --config "$tmp/g0.toml" --wheelbase 0.3 >"$tmp/out" 2>"$tmp/err"
+rc=$?; [ $rc = 2 ] && grep -q -- "--config excludes --wheelbase" "$tmp/err"
+check "replay --config with a geometry option: exit 2 (got $rc)" $?
+run "$ODOMCTL" replay --ticks "$tmp/spin.csv" --counts-per-rev 2048 --wheelbase 0.34 >"$tmp/out" 2>"$tmp/err"
+rc=$?; [ $rc = 2 ] && grep -q -- "--wheel-diameter is required (or --config FILE" "$tmp/err"
+check "replay without geometry or --config: exit 2 naming the option (got $rc)" $?
+
 # odometryd in virtual time on the simulated robot: a JSON summary, stops by itself.
 run "$ODOMETRYD" --virtual-time --json >"$tmp/out" 2>"$tmp/err"
 check "odometryd virtual time exit 0" $?

@@ -65,6 +65,15 @@ check "state show without gyro: gyro: none" $?
   'import json,sys; print(json.load(sys.stdin)["gyro_id"])')" = 0 ]
 check "state show --json without gyro: gyro_id 0" $?
 
+# Issue 39: run by hand there is no systemd to make the state file's directory (/run/odometryd):
+# odometryd makes it, mode 0755 (RuntimeDirectory='s) whatever the umask, and persists.
+printf '[resume]\npath = "%s"\n' "$tmp/rundir/state.bin" >"$tmp/rundir.toml"
+(umask 077 && run "$ODOMETRYD" --config "$tmp/rundir.toml" --duration 0.3 >"$tmp/rundir.log" 2>&1)
+check "missing state directory: exit 0" $?
+[ "$(stat -c %a "$tmp/rundir")" = 755 ] && [ -s "$tmp/rundir/state.bin" ] &&
+  ! grep -q "will not survive" "$tmp/rundir.log"
+check "missing state directory: made with mode 0755, the state persisted" $?
+
 # A missing file and a damaged one: exit 1 with the reason.
 run "$ODOMCTL" state show --path "$tmp/none.bin" >/dev/null 2>"$tmp/none.err"
 [ $? = 1 ] && grep -q "none.bin" "$tmp/none.err"

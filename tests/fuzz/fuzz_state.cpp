@@ -17,6 +17,7 @@
 
 #include "fuzz_check.hpp"
 #include "odo/calibration/record.hpp"
+#include "odo/hal/crc.hpp"
 #include "odo/loop/state_record.hpp"
 #include "odo/odometry/count_delta.hpp"
 #include "odo/odometry/gyrodometry.hpp"
@@ -121,7 +122,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   slot[5] = 0;
   slot[6] = static_cast<std::uint8_t>(len);
   slot[7] = 0;
-  const std::uint32_t crc = odo::calib::crc32(std::span<const std::uint8_t>(slot.data(), len - 4));
+  const std::uint32_t crc = odo::crc32(std::span<const std::uint8_t>(slot.data(), len - 4));
   for (int i = 0; i < 4; ++i) slot[len - 4 + i] = static_cast<std::uint8_t>(crc >> (8 * i));
   auto r = loop::decode_state(std::span<const std::uint8_t>(slot.data(), len));
   if (!r) {

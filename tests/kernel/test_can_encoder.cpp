@@ -3,8 +3,12 @@
 // encoder). Checks the exact counts of both protocols, that the kernel filter keeps foreign ids
 // away from user space, stale detection latency of a stopped sender, and a receive flood.
 #include <gtest/gtest.h>
+#include <linux/can.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
 #include <sched.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -101,18 +105,23 @@ TEST(CanEncoderKernel, OdriveCountsFromCansendAndForeignIdsFilteredByTheKernel) 
   ASSERT_EQ(run("cansend vcce0 0AB#1122334455667788 && cansend vcce0 0000000A#0100000000000000"
                 " && cansend vcce0 04A#0100000000000000 && cansend vcce0 00A#R"),
             0);
-  // Counts: left 0x76544210 = 0x76543210 + 0x1000 (+4096); right 0x00000005 = -2 + 7.
-  ASSERT_EQ(run("cansend vcce0 00A#1042547600000000 && cansend vcce0 02A#0500000005000000"), 0);
+  // Counts: left 0x76544210 = 0x76543210 + 0x1000 (+4096); right 0x00000005 = -2 + 7. Both
+  // wheels are reported at one instant (issue 39: the older newest frame, the other wheel
+  // interpolated): the left controller repeats its count after the right's frame, so that the
+  // instant is the right's frame and both counts are exact.
+  ASSERT_EQ(run("cansend vcce0 00A#1042547600000000 && cansend vcce0 02A#0500000005000000"
+                " && cansend vcce0 00A#1042547600000000"),
+            0);
   const EncoderSample s = r.settle(50);
   EXPECT_EQ(s.flags, 0u);
   EXPECT_EQ(s.left, 0x76544210);
   EXPECT_EQ(s.right, 5);
   EXPECT_EQ(wrap_delta(a.left, s.left, 32), 4096);
   EXPECT_EQ(wrap_delta(a.right, s.right, 32), 7);
-  // Exactly our four data frames reached user space: the kernel dropped the other four.
-  EXPECT_EQ(r.bus->counters().received, 4u);
+  // Exactly our five data frames reached user space: the kernel dropped the other four.
+  EXPECT_EQ(r.bus->counters().received, 5u);
   EXPECT_EQ(r.enc->stats().foreign, 0u);
-  EXPECT_EQ(r.enc->stats().decoded, 4u);
+  EXPECT_EQ(r.enc->stats().decoded, 5u);
 }
 
 TEST(CanEncoderKernel, GenericLayoutBothWheelsInOneExtendedBigEndianFrame) {
@@ -144,6 +153,80 @@ TEST(CanEncoderKernel, GenericLayoutBothWheelsInOneExtendedBigEndianFrame) {
   EXPECT_EQ(wrap_delta(a.left, s.left, 32), 48);
   EXPECT_EQ(wrap_delta(a.right, s.right, 32), -8);
   EXPECT_EQ(r.bus->counters().received, 2u);
+}
+
+// RawSender: a raw CAN socket on `ifname` that sends ODrive Get_Encoder_Count frames at once
+// (in-process: the send time is known to within a system call, unlike cansend's process start).
+struct RawSender {
+  int fd = -1;
+  explicit RawSender(const std::string& ifname) {
+    fd = ::socket(PF_CAN, SOCK_RAW, CAN_RAW);
+    sockaddr_can a{};
+    a.can_family = AF_CAN;
+    a.can_ifindex = static_cast<int>(if_nametoindex(ifname.c_str()));
+    if (fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+      ::close(fd);
+      fd = -1;
+    }
+  }
+  ~RawSender() {
+    if (fd >= 0) ::close(fd);
+  }
+  RawSender(const RawSender&) = delete;
+  RawSender& operator=(const RawSender&) = delete;
+  bool send(std::uint32_t node, std::int32_t shadow) const {
+    can_frame f{};
+    f.can_id = node << 5 | 0x00A;
+    f.can_dlc = 8;
+    const auto u = static_cast<std::uint32_t>(shadow);
+    for (int i = 0; i < 4; ++i) f.data[i] = static_cast<std::uint8_t>(u >> (8 * i));
+    return ::write(fd, &f, sizeof f) == static_cast<ssize_t>(sizeof f);
+  }
+};
+
+// Issue 39, "done means": the jump check on the frames' own (kernel) stamps. Frame A of the left
+// wheel arrives and waits 15 ms in the socket (the loop is late); frame B arrives 20 ms after A
+// and is read at once. Limit at max 100 000 counts/s: 100 000 * (20 ms + 5 ms slack) + 1 = 2501
+// counts (more if B was sent later). Measured from the reads (A read 15 ms late) it would be
+// 100 000 * (5 + 5) ms + 1 = 1001: the 2400 counts of the first case, real motion at 96 % of
+// the physical limit, were dropped before. The second case's 3000 counts are over the limit
+// as long as the kernel put B less than 25 ms after A (checked on the stamps; a case the VM
+// made slower is repeated, at most 5 times).
+TEST(CanEncoderKernel, JumpCheckOnTheFramesKernelStampsLateThenEarly) {
+  ODO_REQUIRE_VM();
+  Vcan v("vcce4");
+  ASSERT_TRUE(v.ok);
+  CanEncoderConfig c = odrive_config();
+  c.max_counts_per_s = 100'000;
+  RawSender tx(v.name);
+  ASSERT_GE(tx.fd, 0);
+  for (const std::int32_t step : {2400, 3000}) {
+    bool judged = false;
+    for (int attempt = 0; attempt < 5 && !judged; ++attempt) {
+      Rig r;
+      ASSERT_TRUE(r.open(v.name, c));
+      ASSERT_TRUE(tx.send(0, 0) && tx.send(1, 0));
+      r.settle(20);  // both primed; the next frame is at least 20 ms later
+      ASSERT_TRUE(tx.send(0, 1000) && tx.send(1, 0));  // A: 1000 counts in >= 20 ms, plausible
+      const TimeNs sent_a = r.clock.now();
+      r.clock.sleep_until(sent_a + 15 * kMs);  // the loop is late: A waits in the socket
+      EXPECT_EQ(r.enc->read(r.clock.now()).flags, 0u);
+      const TimeNs stamp_a = r.enc->last_frame(0);
+      r.clock.sleep_until(sent_a + 20 * kMs);
+      ASSERT_TRUE(tx.send(0, 1000 + step) && tx.send(1, 0));  // B, read at once
+      const EncoderSample s = r.enc->read(r.clock.now());
+      const double dt = to_seconds(r.enc->last_frame(0) - stamp_a);
+      const bool over = step > 100'000 * (dt + 0.005) + 1;
+      std::printf("step %d counts, frames %.3f ms apart (kernel stamps): %s, flags %u\n", step,
+                  dt * 1e3, over ? "over the limit" : "within the limit", s.flags);
+      EXPECT_GE(dt, 0.0199);
+      EXPECT_EQ(s.flags, over ? static_cast<std::uint32_t>(kEncoderImplausibleJump) : 0u);
+      EXPECT_EQ(s.left_rejected, over ? step : 0);
+      EXPECT_EQ(r.enc->stats().decoded, 6u);
+      judged = step == 2400 || over;  // the 3000-count case must be judged over the limit
+    }
+    EXPECT_TRUE(judged) << step;
+  }
 }
 
 TEST(CanEncoderKernel, StoppedSenderIsStaleWithinTheTimeoutPlusOnePeriod) {

@@ -29,7 +29,7 @@ inline OdomSample sample_k(std::int64_t k, TimeNs t) {
   s.pose_cov = {1e-4 * g, 1e-6, 2e-6, 1e-6, 3e-4 * g, 4e-6, 2e-6, 4e-6, 5e-5 * g};
   s.v = 0.25;
   s.omega = 0.5 + 0.001 * static_cast<double>(k % 7);
-  s.twist_cov = twist_covariance_from_wheels(0.00024, 0.00026, 0.001, 0.5, ErrorModelParams{});
+  s.twist_cov = twist_covariance(TickMotion{0.00024, 0.00026, 0.001, 0.5}, ErrorModelParams{});
   return s;
 }
 

@@ -63,24 +63,6 @@ TEST(Ros2Mapping, TwistCovarianceLayout) {
   expect_unobserved(m, 4 + 4);
 }
 
-TEST(Ros2Mapping, TwistCovarianceFromWheels) {
-  // kL = 0.001, kR = 0.002, dL = 0.01 m, dR = 0.04 m over dt = 0.1 s, b = 0.5 m:
-  // wL = 1e-6 * 0.01 = 1e-8, wR = 4e-6 * 0.04 = 1.6e-7, wL + wR = 1.7e-7.
-  // var v = 1.7e-7 / (4 * 0.01) = 4.25e-6; var omega = 1.7e-7 / (0.25 * 0.01) = 6.8e-5;
-  // cov = (1.6e-7 - 1e-8) / (2 * 0.5 * 0.01) = 1.5e-5.
-  ErrorModelParams k;
-  k.k_left = 0.001;
-  k.k_right = 0.002;
-  const Cov2 c = twist_covariance_from_wheels(0.01, -0.04, 0.1, 0.5, k);  // |d|: sign irrelevant
-  EXPECT_NEAR(c[0], 4.25e-6, 1e-18);
-  EXPECT_NEAR(c[3], 6.8e-5, 1e-17);
-  EXPECT_NEAR(c[1], 1.5e-5, 1e-18);
-  EXPECT_EQ(c[1], c[2]);
-  const Cov2 zero = twist_covariance_from_wheels(0.0, 0.0, 0.1, 0.5, k);
-  EXPECT_EQ(zero[0], 0.0);
-  EXPECT_EQ(zero[3], 0.0);
-}
-
 TEST(Ros2Mapping, QuaternionFromYaw) {
   // theta = pi/2: q = (0, 0, sin(pi/4), cos(pi/4)) = (0, 0, 0.70710678, 0.70710678).
   Quaternion q = quaternion_from_yaw(M_PI / 2);

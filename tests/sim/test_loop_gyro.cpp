@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "odo/loop/state_record.hpp"
+#include "odo/odometry/error_model.hpp"
 #include "odo/sim/floor.hpp"
 #include "odo/sim/sim_run.hpp"
 
@@ -213,6 +214,69 @@ TEST(LoopGyro, FreshPoseAfterARestartStillGetsTheBias) {
   EXPECT_GE(fresh.events, 8u);
   std::printf("fresh pose after the restart, bias restored: heading error %.3e rad\n",
               fresh.heading_error);
+}
+
+// The tick's motion in the snapshot (issue 33): consumers (the ROS 2 twist covariance, the
+// twist Monte Carlo) take each tick's wheel travels, interval and wheelbase from it instead of
+// inverting (v, w) with a wheelbase captured at start.
+void expect_wheel_twist(const loop::LoopSnapshot& s, double b) {
+  const TickMotion& m = s.motion;
+  ASSERT_GT(m.dt, 0.0);
+  EXPECT_FALSE(m.gyro_heading);
+  EXPECT_EQ(m.wheelbase, b);
+  // Chong-Kleeman per wheel, k^2 |d|; v and omega are the travels' difference quotients.
+  const ErrorModelParams k;
+  const double wl = k.k_left * k.k_left * std::fabs(m.d_left);
+  const double wr = k.k_right * k.k_right * std::fabs(m.d_right);
+  const double dt2 = m.dt * m.dt;
+  const Cov2 c = twist_covariance(m, k);
+  EXPECT_DOUBLE_EQ(c[0], (wl + wr) / (4.0 * dt2));
+  EXPECT_DOUBLE_EQ(c[3], (wl + wr) / (b * b * dt2));
+  EXPECT_DOUBLE_EQ(c[1], (wr - wl) / (2.0 * b * dt2));
+  EXPECT_DOUBLE_EQ(s.v, 0.5 * (m.d_left + m.d_right) / m.dt);
+}
+
+TEST(LoopMotion, SetKinematicsChangesTheTwistCovarianceAtOnce) {
+  // A calibration result (or a SIGHUP reload) arrives mid-run with b = 0.36 m instead of 0.34 m:
+  // from the next tick on the snapshot says so, and the twist covariance follows the new b
+  // (omega's variance by (0.34 / 0.36)^2 for the same travels).
+  Leg leg;
+  auto run = leg.run(nullptr, false);
+  loop::OdometryLoop& loop = run->loop();
+  for (int t = 0; t < 400; ++t) loop.tick();  // 2 s: standing 1 s, then the leg
+  expect_wheel_twist(loop.snapshot(), 0.34);
+  EXPECT_GT(std::fabs(loop.snapshot().motion.d_left), 0.0);
+  KinematicParams p = leg.k.params();
+  p.wheelbase = 0.36;
+  ASSERT_TRUE(loop.post(loop::SetKinematics{*Kinematics::create(p), calib::StoreStatus::kOk}));
+  loop.tick();
+  expect_wheel_twist(loop.snapshot(), 0.36);
+  EXPECT_EQ(loop.snapshot().motion.d_left, loop.odometry().last_d_left());
+  EXPECT_EQ(loop.snapshot().motion.d_right, loop.odometry().last_d_right());
+}
+
+TEST(LoopMotion, GyroFusedTickTakesOmegasVarianceFromTheGyro) {
+  // Ten bumps under the left wheel: the fusion replaces odometry's heading on some ticks. On
+  // each, omega is the gyro's: its variance is the fused increment's over dt^2 and independent
+  // of the wheels (no cross term); on the others it is the wheels'.
+  Leg leg;
+  UmbmarkFloor floor(bumps(10), 1);
+  auto run = leg.run(&floor, true);
+  loop::OdometryLoop& loop = run->loop();
+  int fused = 0;
+  for (int t = 0; t < 200 * 22; ++t) {
+    loop.tick();
+    const loop::LoopSnapshot& s = loop.snapshot();
+    const bool gyro = (s.gyro.fusion_flags & kFusionGyroUsed) != 0;
+    ASSERT_EQ(s.motion.gyro_heading, gyro) << "tick " << t;
+    if (!gyro) continue;
+    ++fused;
+    const Cov2 c = twist_covariance(s.motion, ErrorModelParams{});
+    EXPECT_GT(s.motion.gyro_var_heading, 0.0);
+    EXPECT_DOUBLE_EQ(c[3], s.motion.gyro_var_heading / (s.motion.dt * s.motion.dt));
+    EXPECT_EQ(c[1], 0.0);
+  }
+  EXPECT_GT(fused, 10);
 }
 
 }  // namespace

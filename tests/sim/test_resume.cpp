@@ -227,6 +227,57 @@ TEST(Resume, ChipResetStartsFresh) {
   EXPECT_EQ(b->odometry().pose().x, 0.0);
 }
 
+// Issue 39: a jump the running driver rejected stays rejected after a restart. The right chip's
+// counter leaps by 100 000 counts at 1 s (far over 200 000 counts/s * 10 ms); the driver flags
+// the tick's step and integrates nothing of it (that tick's 200 counts of real motion go with
+// it: the step cannot be split). The record keeps the chip's own counter (the reported count
+// plus the rejected step), so the restarted process, whose driver reports the chip's counter as
+// it is, sees only the gap's motion: the run with a restart 0.5 s after the jump ends where the
+// same run without a restart ends (straight legs: to rounding, as in
+// StraightRunEndsWhereTheUninterruptedRunEnds), heading and all.
+TEST(Resume, RejectedJumpThenRestartResumesWithoutTheJump) {
+  Motion m;
+  m.rates = {{20000, 20000}};
+  auto drive = [&m](bool restart) {
+    World w(m);
+    auto first = drivers::Hctl1100Encoder::create(w.bus, hctl_config()).value();
+    auto a = make_loop(w, first);
+    a->start();
+    tick_until(*a, w.clock, 1.0);
+    w.r.inject_jump(100'000);
+    tick_until(*a, w.clock, 1.5);
+    // One tick's 200 counts of the right wheel lost with the jump: -200 * 1.438e-5 / 0.34 rad.
+    EXPECT_NEAR(a->odometry().pose().theta, -200 * 1.438e-5 / 0.34, 1e-6);
+    if (!restart) {
+      tick_until(*a, w.clock, m.duration());
+      return a->odometry().pose();
+    }
+    loop::StateRecord rec;
+    loop::fill_state_record(*a, rec);
+    rec.sequence = 1;
+    rec.backend = 1;
+    // The record holds the chips' counters, not the re-based readings: both wheels' real motion
+    // (equal, straight) and the right's jump, right = left + 100 000.
+    EXPECT_EQ(wrap_delta(rec.left, rec.right, 24), 100'000);
+    loop::StateBytes bytes{};
+    loop::encode_state(rec, bytes);
+    w.clock.advance(from_seconds(0.3));
+    auto second = drivers::Hctl1100Encoder::create(w.bus, hctl_config()).value();
+    auto b = make_loop(w, second);
+    b->resume_from(loop::decode_state(bytes).value(), context_for(*b));
+    b->start();
+    EXPECT_TRUE(b->resume_decision().resumed())
+        << loop::resume_reason_name(b->resume_decision().reason);
+    EXPECT_EQ(b->resume_decision().dl, b->resume_decision().dr);  // the gap's motion, straight
+    tick_until(*b, w.clock, m.duration());
+    return b->odometry().pose();
+  };
+  const Pose2 through = drive(false), restarted = drive(true);
+  EXPECT_NEAR(restarted.x, through.x, 1e-12);
+  EXPECT_NEAR(restarted.y, through.y, 1e-12);
+  EXPECT_NEAR(restarted.theta, through.theta, 1e-12);
+}
+
 // A motor controller that starts sending only 30 ms after the loop starts: ODrive count frames
 // of both axes every 10 ms, counts from 5000, +10 per frame, put on the port as time passes
 // (each read first publishes what was sent up to then), read by the real CAN driver.

@@ -13,12 +13,17 @@
 #include <new>
 #include <thread>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include "odo/drivers/serial_port.hpp"
 #include "odo/firmware/can_broadcast.hpp"
 #include "odo/firmware/config.hpp"
 #include "odo/firmware/rig.hpp"
 #include "odo/firmware/state_persist.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/protocol/can_protocol.hpp"
+#include "odo/protocol/serial_counts_source.hpp"
 #include "odo/sim/sim_can_bus.hpp"
 #include "odo/sim/truth.hpp"
 
@@ -465,15 +470,9 @@ TEST(ZeroAlloc, CanReceiveFloodWithoutAllocating) {
   EXPECT_NEAR(loop->snapshot().pose.y, 2.0, 1e-9);
 }
 
-TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
-  // [encoder] backend = "can" on the simulated ODrive pair: frames packed, queued on the
-  // simulated port, drained and decoded every tick, and the stale path once the left axis stops
-  // sending at 20 s; none of it may allocate.
-  fw::Config cfg = fw::default_config();
-  cfg.loop.rate_hz = 1000.0;
-  cfg.encoder.backend = fw::EncoderKind::kCan;
-  cfg.can_encoder.bus = fw::CanEncoderBus::kSim;
-  cfg.can_encoder.sim_stop_left_after = 20.0;
+// rig_ticks_without_allocating: the daemon's rig for cfg (virtual time) under the loop for 40 s at
+// 1 kHz, no allocation or deallocation in any tick; `snap` is the last snapshot.
+void rig_ticks_without_allocating(const fw::Config& cfg, loop::LoopSnapshot& snap) {
   auto kin = Kinematics::create(cfg.robot);
   ASSERT_TRUE(kin.ok());
   auto rig = fw::Rig::create(cfg, *kin, /*virtual_time=*/true);
@@ -490,10 +489,95 @@ TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
     EXPECT_EQ(g_allocs.load(), 0u) << "heap allocations during " << kTicks << " ticks";
     EXPECT_EQ(g_frees.load(), 0u) << "heap deallocations during " << kTicks << " ticks";
   }
-  loop::LoopSnapshot snap;
   ASSERT_TRUE(loop->snapshots().latest(snap));
+}
+
+TEST(ZeroAlloc, CanEncoderBackendTicksWithoutAllocating) {
+  // [encoder] backend = "can" on the simulated ODrive pair: frames packed, queued on the
+  // simulated port, drained and decoded every tick, and the stale path once the left axis stops
+  // sending at 20 s; none of it may allocate.
+  fw::Config cfg = fw::default_config();
+  cfg.loop.rate_hz = 1000.0;
+  cfg.encoder.backend = fw::EncoderKind::kCan;
+  cfg.can_encoder.bus = fw::CanEncoderBus::kSim;
+  cfg.can_encoder.sim_stop_left_after = 20.0;
+  loop::LoopSnapshot snap;
+  ASSERT_NO_FATAL_FAILURE(rig_ticks_without_allocating(cfg, snap));
   EXPECT_EQ(snap.encoder_flags, static_cast<std::uint32_t>(kEncoderStaleLeft));
   EXPECT_EQ(snap.encoder_counters.stale_events, 1u);
+}
+
+// serial_backend_without_allocating: [encoder] backend = "serial" with link = "sim": the
+// simulated controller's bytes (diffodom records, or arduino-bridge answers to the polls) go
+// through the real SerialCountsSource every tick; none of it may allocate.
+void serial_backend_without_allocating(fw::SerialProtocol p) {
+  fw::Config cfg = fw::default_config();
+  cfg.loop.rate_hz = 1000.0;
+  cfg.encoder.backend = fw::EncoderKind::kSerial;
+  cfg.serial.link = fw::SerialLink::kSim;
+  cfg.serial.protocol = p;
+  cfg.serial.poll_rate = 200.0;
+  loop::LoopSnapshot snap;
+  ASSERT_NO_FATAL_FAILURE(rig_ticks_without_allocating(cfg, snap));
+  EXPECT_EQ(snap.encoder_flags, 0u);
+  EXPECT_GT(snap.distance, 1.0);  // the robot moved: samples went through
+}
+
+TEST(ZeroAlloc, SerialDiffodomBackendTicksWithoutAllocating) {
+  serial_backend_without_allocating(fw::SerialProtocol::kDiffodom);
+}
+TEST(ZeroAlloc, SerialArduinoBridgeBackendTicksWithoutAllocating) {
+  serial_backend_without_allocating(fw::SerialProtocol::kArduinoBridge);
+}
+
+TEST(ZeroAlloc, SerialPortOnAPtyReadsWithoutAllocating) {
+  // The tty path itself: SerialPort (termios, its reader thread's ring drained by the loop) on a
+  // kernel pseudo-terminal, diffodom records written into the master between reads.
+  const int m = posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK);
+  ASSERT_GE(m, 0);
+  ASSERT_EQ(grantpt(m), 0);
+  ASSERT_EQ(unlockpt(m), 0);
+  auto port = drivers::SerialPort::open(ptsname(m), 115200);
+  ASSERT_TRUE(port.ok()) << port.error().message;
+  protocol::SerialCountsSource src(**port, protocol::SerialSourceConfig{});
+  std::uint64_t allocs = 0;
+  EncoderSample s;
+  for (int i = 0; i < 2000; ++i) {
+    std::array<std::uint8_t, protocol::kSerialCountsFrameMax> f{};
+    const protocol::SerialCounts c{.seq = static_cast<std::uint16_t>(i),
+                                   .time_us = static_cast<std::uint32_t>(i) * 1000u,
+                                   .left = i,
+                                   .right = -i};
+    // The master is non-blocking: on a loaded machine the reader thread may lag and the pty's
+    // buffer fill, so the rest of a frame is written once there is room again.
+    std::size_t done = 0;
+    const std::size_t len = protocol::encode_serial_counts(c, f);
+    for (int tries = 0; done < len && tries < 1000; ++tries) {
+      const ssize_t w = ::write(m, f.data() + done, len - done);
+      if (w > 0) done += static_cast<std::size_t>(w);
+      if (done < len) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    ASSERT_EQ(done, len);
+    // The reader thread takes the bytes: give it the time to (the last one is checked below).
+    if (i == 1999) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    AllocWindow w;
+    s = src.read(static_cast<TimeNs>(i + 1) * 1'000'000);
+    w.disarm();
+    allocs += g_allocs.load() + g_frees.load();
+  }
+  // Whatever the reader thread still holds is drained by the next reads (no heap either).
+  for (int k = 0; k < 100 && s.left != 1999; ++k) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    AllocWindow w;
+    s = src.read(static_cast<TimeNs>(2001 + k) * 1'000'000);
+    w.disarm();
+    allocs += g_allocs.load() + g_frees.load();
+  }
+  EXPECT_EQ(allocs, 0u);
+  EXPECT_EQ(s.left, 1999);
+  // A frame is lost only with a chunk the full ring dropped (counted by the port).
+  EXPECT_EQ(s.counters.link_errors > 0, (*port)->dropped() > 0) << (*port)->dropped();
+  ::close(m);
 }
 
 // gyro_fusion_without_allocating: the fused loop on [gyro] `backend` ticks without the heap.

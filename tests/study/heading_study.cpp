@@ -345,6 +345,11 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--density")) density = std::atof(argv[i + 1]);
     if (!std::strcmp(argv[i], "--check")) check = std::atoi(argv[i + 1]) != 0;
   }
+  if (!choice_value<analysis::UmbmarkGyro>(analysis::kUmbmarkGyros, gyro) ||
+      !choice_value<analysis::UmbmarkNoise>(analysis::kUmbmarkNoises, noise) || gyro == "none") {
+    std::fprintf(stderr, "heading_study: --gyro consumer|industrial, --noise none|paper\n");
+    return 2;
+  }
   sim::GyroModel gm = gyro == "industrial" ? sim::industrial_gyro() : sim::consumer_gyro();
   // --density: the model's rate noise density replaced [rad/s/sqrt(Hz)] in the re-driven squares
   // (the official figures keep the named model: only the "loop" column differs from them).
@@ -357,9 +362,9 @@ int main(int argc, char** argv) {
   for (int s = first; s < first + seeds; ++s) {
     analysis::UmbmarkSimOptions o;
     o.bumps = true;
-    o.noise = noise == "none" ? analysis::UmbmarkNoise::kNone : analysis::UmbmarkNoise::kPaper;
+    o.noise = *choice_value<analysis::UmbmarkNoise>(analysis::kUmbmarkNoises, noise);
     o.seed = static_cast<std::uint64_t>(s);
-    o.gyro = gyro;
+    o.gyro = *choice_value<analysis::UmbmarkGyro>(analysis::kUmbmarkGyros, gyro);
     auto res = analysis::run_umbmark_simulation(o, {});
     if (!res || !res->gyro) {
       std::fprintf(stderr, "simulation failed\n");

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "odo/calibration/record.hpp"
+#include "odo/hal/crc.hpp"
 
 namespace odo::calib {
 namespace {

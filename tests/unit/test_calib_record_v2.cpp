@@ -7,6 +7,7 @@
 
 #include "odo/calibration/record.hpp"
 #include "odo/calibration/store.hpp"
+#include "odo/hal/crc.hpp"
 #include "odo/sim/sim_nv_storage.hpp"
 
 namespace odo::calib {

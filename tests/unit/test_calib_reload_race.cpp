@@ -126,8 +126,7 @@ TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while (!g_reload.exchange(false) && std::chrono::steady_clock::now() < deadline)
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    const fw::AppliedCalibration during =
-        fw::read_and_apply(nominal, path, fw::StoreBackend::kFile);
+    const fw::AppliedCalibration during = fw::read_and_apply(nominal, path, NvBackend::kFile);
     // The writer had written part of the record and had not finished when we read.
     int status = 0;
     const pid_t w = waitpid(pid, &status, WNOHANG);
@@ -156,7 +155,7 @@ TEST(CalibReloadRace, SighupWhileAnotherProcessWritesReadsTheOldRecordWhole) {
     ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "writer status " << status;
     ++seq;
     // A SIGHUP after the save: the new record.
-    check_applied(fw::read_and_apply(nominal, path, fw::StoreBackend::kFile), nominal, seq);
+    check_applied(fw::read_and_apply(nominal, path, NvBackend::kFile), nominal, seq);
     ++rounds;
   }
   sigaction(SIGHUP, &old, nullptr);
@@ -191,7 +190,7 @@ TEST(CalibReloadRace, BothSlotsInFlightIsReadAgainUntilTheSaveSettles) {
   const std::vector<char> settled = file_bytes(path);
   const std::vector<char> in_flight(settled.size(), '\x5a');  // neither valid nor blank
   put_file_bytes(path, in_flight);
-  auto read = [&] { return fw::read_and_apply(nominal, path, fw::StoreBackend::kFile); };
+  auto read = [&] { return fw::read_and_apply(nominal, path, NvBackend::kFile); };
   ASSERT_EQ(read().state, calib::StoreStatus::kCorrupt) << "precondition: both slots unreadable";
 
   int pauses = 0, rereads = -1;
@@ -231,7 +230,7 @@ TEST(CalibReloadRace, BothSlotsInFlightIsReadAgainUntilTheSaveSettles) {
   put_file_bytes(path, in_flight);
   loop::CommandQueue commands;
   std::ostringstream log;
-  fw::CalibrationReloader reloader(commands, nominal, path, fw::StoreBackend::kFile, log);
+  fw::CalibrationReloader reloader(commands, nominal, path, NvBackend::kFile, log);
   std::atomic<bool> request{true};
   reloader.start(request);
   calib::StoreStatus state = calib::StoreStatus::kOk;
@@ -280,7 +279,7 @@ TEST(CalibReloadRace, StopReturnsWhileAReloadWaitsForALoopThatNoLongerTicks) {
     ASSERT_TRUE(commands.post(loop::SetPose{}));
   LineCounter sink;
   std::ostream log(&sink);
-  fw::CalibrationReloader reloader(commands, nominal, path, fw::StoreBackend::kFile, log);
+  fw::CalibrationReloader reloader(commands, nominal, path, NvBackend::kFile, log);
   std::atomic<bool> request{true};
   reloader.start(request);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);

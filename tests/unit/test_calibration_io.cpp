@@ -182,7 +182,7 @@ TEST(CalibrationConfig, SectionKeysAndErrors) {
   auto c = parse_config("[calibration]\nstore = \"/dev/mtd3\"\nbackend = \"mtd\"\n", "t.toml");
   ASSERT_TRUE(c) << c.error().message;
   EXPECT_EQ(c->calibration.store, "/dev/mtd3");
-  EXPECT_EQ(c->calibration.backend, StoreBackend::kMtd);
+  EXPECT_EQ(c->calibration.backend, NvBackend::kMtd);
   EXPECT_EQ(default_config().calibration.store, kDefaultCalibrationStore);
   auto bad = parse_config("[calibration]\nbackend = \"eeprom\"\n", "t.toml");
   ASSERT_FALSE(bad);
@@ -195,7 +195,7 @@ TEST(CalibrationConfig, NoStoreConfiguredMeansNominal) {
   p.wheel_diameter = 0.15;
   p.counts_per_rev = 2048;
   p.wheelbase_nominal = p.wheelbase = 0.34;
-  AppliedCalibration a = read_and_apply(p, "", StoreBackend::kAuto);
+  AppliedCalibration a = read_and_apply(p, "", NvBackend::kAuto);
   EXPECT_EQ(a.state, calib::StoreStatus::kUncalibrated);
   EXPECT_NE(a.report.find("no store configured"), std::string::npos);
 }

@@ -164,7 +164,8 @@ TEST_F(CanEncoder, BeforeTheFirstFrameStaleAndZeroThenTheControllersCounts) {
   EXPECT_EQ(s.flags, 0u);
   EXPECT_EQ(s.left, 1000);  // as sent, no reference subtracted
   EXPECT_EQ(s.right, -5000);
-  EXPECT_EQ(s.stamp, 20 * kMs);
+  // The sample time is the frames' (issue 39: both counts at one instant), not the read's.
+  EXPECT_EQ(s.stamp, 15 * kMs);
   // 10 ms later: +50 and -30 counts (well under 10 000 counts/s * 10 ms = 100).
   port.inject(odrive(0, 1050, 25 * kMs));
   port.inject(odrive(1, -5030, 25 * kMs));
@@ -284,11 +285,76 @@ TEST_F(CanEncoder, ImplausibleJumpIsReportedNotIntegrated) {
   EXPECT_EQ(s.left, 100);   // not integrated: the count before the jump
   EXPECT_EQ(s.right, 240);  // +140
   EXPECT_EQ(s.counters.implausible_jumps, 1u);
-  // Motion after the jump counts from the new base: 600 -> 640 is +40, 100 + 40 = 140.
+  // Motion after the jump counts from the new base: 600 -> 640 is +40, 100 + 40 = 140 (the
+  // right wheel's frame brings the common instant to 30 ms).
   port.inject(odrive(0, 640, 30 * kMs));
+  port.inject(odrive(1, 240, 30 * kMs));
   s = enc.read(30 * kMs);
   EXPECT_EQ(s.flags, 0u);
   EXPECT_EQ(s.left, 140);
+}
+
+// Issue 39: the limit is measured between the frames' own stamps, not between the reads that
+// took them. Frame A of the left wheel arrives at 10 ms but is read late, at 19 ms; frame B
+// arrives 13 ms after A (at 23 ms) and is read at once. Limit: 10 000 * (0.013 + 0.005) + 1 =
+// 181 counts. Between the reads only 4 ms passed, which would allow 10 000 * 0.009 + 1 = 91.
+TEST_F(CanEncoder, JumpLimitUsesTheFramesStampsLateThenEarly) {
+  for (const std::int32_t step : {180, 181, 182}) {
+    sim::SimCanPort fresh{8, 512};
+    auto made = CanEncoderSource::create(fresh, cfg);
+    ASSERT_TRUE(made.ok());
+    CanEncoderSource enc = std::move(made).value();
+    fresh.inject(odrive(0, 0, 1 * kMs));
+    fresh.inject(odrive(1, 0, 1 * kMs));
+    enc.read(1 * kMs);
+    fresh.inject(odrive(0, 100, 10 * kMs));
+    fresh.inject(odrive(1, 0, 10 * kMs));
+    EXPECT_EQ(enc.read(19 * kMs).flags, 0u);  // 100 counts in 9 ms: under 10 000 * 0.014 + 1
+    fresh.inject(odrive(0, 100 + step, 23 * kMs));
+    fresh.inject(odrive(1, 0, 23 * kMs));
+    const EncoderSample s = enc.read(23 * kMs);
+    // 180 and 181 are within the limit (|step| > 181 is the test), 182 is not.
+    EXPECT_EQ(s.flags, step <= 181 ? 0u : static_cast<std::uint32_t>(kEncoderImplausibleJump))
+        << step;
+    EXPECT_EQ(s.left, step <= 181 ? 100 + step : 100) << step;
+    EXPECT_EQ(s.left_rejected, step <= 181 ? 0 : step) << step;
+  }
+}
+
+// Issue 39: one instant for both wheels. The left wheel's frames every 10 ms, the right's late:
+// its frame for 20 ms is missing at the read at 20 ms. The sample time is the right's newest
+// frame (10 ms) and the left count is the one at 10 ms, not the newer one.
+TEST_F(CanEncoder, BothWheelsAtTheOlderNewestFrameInterpolated) {
+  CanEncoderSource enc = make();
+  port.inject(odrive(0, 0, 0 * kMs + 1));
+  port.inject(odrive(1, 0, 0 * kMs + 1));
+  enc.read(1 * kMs);
+  port.inject(odrive(0, 50, 10 * kMs));
+  port.inject(odrive(1, 40, 10 * kMs));
+  port.inject(odrive(0, 100, 20 * kMs));
+  EncoderSample s = enc.read(20 * kMs);
+  EXPECT_EQ(s.stamp, 10 * kMs);
+  EXPECT_EQ(s.left, 50);
+  EXPECT_EQ(s.right, 40);
+  // The right's next frame, stamped 15 ms (out of phase with the left), count 60: the common
+  // instant is 15 ms, the left interpolated halfway between 50 (10 ms) and 100 (20 ms) = 75.
+  port.inject(odrive(1, 60, 15 * kMs));
+  s = enc.read(21 * kMs);
+  EXPECT_EQ(s.stamp, 15 * kMs);
+  EXPECT_EQ(s.left, 75);
+  EXPECT_EQ(s.right, 60);
+  // Three periods late, then all at once: right frames 25, 35, 45 ms; left 30, 40 ms. Instant:
+  // min(40, 45) = 40 ms; left 40 ms exact = 160; right between 35 ms (90) and 45 ms (110): 100.
+  port.inject(odrive(0, 130, 30 * kMs));
+  port.inject(odrive(0, 160, 40 * kMs));
+  port.inject(odrive(1, 70, 25 * kMs));
+  port.inject(odrive(1, 90, 35 * kMs));
+  port.inject(odrive(1, 110, 45 * kMs));
+  s = enc.read(46 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.stamp, 40 * kMs);
+  EXPECT_EQ(s.left, 160);
+  EXPECT_EQ(s.right, 100);
 }
 
 TEST_F(CanEncoder, Int32WrapIsMotionNotAJump) {

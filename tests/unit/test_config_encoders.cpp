@@ -2,7 +2,16 @@
 // values, defaults, and clear errors.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <string>
+
+#include "odo/drivers/can_encoder.hpp"
+#include "odo/drivers/can_gyro.hpp"
+#include "odo/drivers/gpio_quadrature.hpp"
+#include "odo/drivers/hctl1100_encoder.hpp"
 #include "odo/firmware/config.hpp"
+#include "odo/sim/hctl1100_model.hpp"
+#include "odo/sim/sim_can_bus.hpp"
 
 namespace odo::fw {
 namespace {
@@ -301,6 +310,74 @@ TEST(ConfigEncoders, SimulatedGyroOnEverySimulatedRobot) {
     EXPECT_TRUE(simulated_robot(*c));
     EXPECT_TRUE(simulated_gyro(*c));
   }
+}
+
+// The drivers' own limits are the rows the config reader checks against (issue 33: they were
+// written in both places): a value one beyond the row is refused by the reader at its line and by
+// the driver's create() with the same field and range.
+void expect_reader_refuses(const char* section, const RangeRow& r) {
+  for (double bad : {r.lo - 1.0, r.hi + 1.0}) {
+    const std::string text = std::string("[") + section + "]\n" + r.key + " = " +
+                             std::to_string(static_cast<long long>(bad)) + "\n";
+    auto c = parse_config(text, "bad.toml");
+    ASSERT_FALSE(c.ok()) << text;
+    char range[64];
+    std::snprintf(range, sizeof range, "[%g, %g]", r.lo, r.hi);
+    EXPECT_NE(c.error().message.find(std::string("bad.toml:2: ") + section + "." + r.key + " = " +
+                                     std::to_string(static_cast<long long>(bad)) +
+                                     " is outside the allowed range " + range),
+              std::string::npos)
+        << c.error().message;
+  }
+}
+
+void expect_driver_refuses(const Status& s, const std::string& field, const RangeRow& r) {
+  ASSERT_FALSE(s);
+  ASSERT_TRUE(s.error().range.has_value()) << s.error().message;
+  EXPECT_EQ(s.error().range->field, field);
+  EXPECT_EQ(s.error().range->lo, r.lo);
+  EXPECT_EQ(s.error().range->hi, r.hi);
+}
+
+template <class R>
+Status status_of(const R& r) {
+  if (r) return Ok{};
+  return r.error();
+}
+
+TEST(ConfigEncoders, DriverLimitsAreTheRowsTheReaderChecks) {
+  using namespace drivers;
+  expect_reader_refuses("hctl1100", kHctlAgreeWindow);
+  expect_reader_refuses("hctl1100", kHctlMaxAttempts);
+  expect_reader_refuses("gpio", kGpioBatch);
+  expect_reader_refuses("can_encoder", kCanMaxFramesPerRead);
+  expect_reader_refuses("can_gyro", kCanMaxFramesPerRead);
+
+  sim::Hctl1100Model left, right;
+  sim::SimHctlBus bus(&left, &right);
+  Hctl1100Config h;
+  h.agree_window = 65;
+  expect_driver_refuses(status_of(Hctl1100Encoder::create(bus, h)), "hctl1100: agree_window",
+                        kHctlAgreeWindow);
+  h = Hctl1100Config{};
+  h.max_attempts = 1;
+  expect_driver_refuses(status_of(Hctl1100Encoder::create(bus, h)), "hctl1100: max_attempts",
+                        kHctlMaxAttempts);
+  GpioQuadratureConfig g;
+  g.batch = 1025;  // refused before any chip is opened
+  expect_driver_refuses(status_of(GpioQuadratureEncoder::open(g)), "gpio: batch", kGpioBatch);
+  sim::SimCanPort port;
+  CanEncoderConfig ce;
+  ce.left = odrive_count_layout(0);
+  ce.right = odrive_count_layout(1);
+  ce.max_frames_per_read = 0;
+  expect_driver_refuses(status_of(CanEncoderSource::create(port, ce)), "max_frames_per_read",
+                        kCanMaxFramesPerRead);
+  CanGyroConfig cg;
+  cg.scale = 1e-3;  // rad/s per LSB: the rest of the config valid
+  cg.max_frames_per_read = 4097;
+  expect_driver_refuses(status_of(CanGyroSource::create(port, cg)), "CAN gyro: max_frames_per_read",
+                        kCanMaxFramesPerRead);
 }
 
 }  // namespace

@@ -5,11 +5,20 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "odo/firmware/config.hpp"
+#include "odo/hal/field_range.hpp"
+#include "odo/odometry/gyrodometry.hpp"
 
 namespace odo::fw {
 namespace {
@@ -207,6 +216,153 @@ TEST(ConfigErrors, FileMissingOrUnreadable) {
   std::filesystem::remove(dir);
   ASSERT_FALSE(d.ok());
   EXPECT_EQ(d.error().message, dir.string() + ": cannot read config file (Is a directory)");
+}
+
+// shortest: v as the fewest significant digits (at least 6) that read back as v: both the TOML
+// literal a test writes and the number the message prints, so the two are the same text.
+std::string shortest(double v) {
+  char b[32];
+  for (int p = 6; p <= 17; ++p) {
+    std::snprintf(b, sizeof b, "%.*g", p, v);
+    if (std::strtod(b, nullptr) == v) break;
+  }
+  return b;
+}
+
+// A number key of a range table, at its limits: the limit itself is taken (unless the range is
+// open there), a step of 1e-9 (relative) beyond it is refused with file, line, section.key and
+// the range as the table states it.
+void expect_boundaries(const std::string& table, const RangeRow& r) {
+  const auto doc_of = [&](double v) {
+    return "# test\n[" + table + "]\n" + r.key + " = " + shortest(v) + "\n";
+  };
+  const auto step = [](double x) { return 1e-9 * std::max(1.0, std::abs(x)); };
+  const std::string unit = *r.unit != '\0' ? std::string(" ") + r.unit : std::string();
+  const std::string range =
+      std::string(r.lo_open ? "(" : "[") + shortest(r.lo) + ", " + shortest(r.hi) + "]" + unit;
+  const double below = r.lo_open ? r.lo : r.lo - step(r.lo), above = r.hi + step(r.hi);
+  for (double bad : {below, above})
+    expect_error(doc_of(bad), "bad.toml:3: " + table + "." + r.key + " = " + shortest(bad) +
+                                  " is outside the allowed range " + range);
+  for (double good : {r.lo_open ? r.lo + step(r.lo) : r.lo, r.hi}) {
+    auto c = parse_config(doc_of(good), "bad.toml");
+    EXPECT_TRUE(c.ok()) << doc_of(good) << (c.ok() ? "" : c.error().message);
+  }
+}
+
+// [gyro]: the fusion's numbers from its own table (gyrodometry_range at the default loop rate and
+// still_time, as a file that sets only that key sees them), the source's from config.hpp.
+TEST(ConfigErrors, GyroEveryNumberAtBothLimitsFromTheFusionsTable) {
+  const Config def = default_config();
+  for (std::size_t i = 0; i < kGyroConfigParams; ++i)
+    expect_boundaries("gyro", gyrodometry_range(static_cast<GyroParam>(i), 1.0 / def.loop.rate_hz,
+                                                def.gyro.still_time));
+  for (const auto& n : kGyroSourceNumbers) expect_boundaries("gyro", n.row);
+}
+
+// [serial]: every number of its table (config.hpp, kSerialNumbers).
+TEST(ConfigErrors, SerialEveryNumberAtBothLimitsFromItsTable) {
+  for (const auto& n : kSerialNumbers) expect_boundaries("serial", n.row);
+}
+
+// [selfcal]: every number of its table (config.hpp, kSelfCalNumbers / kSelfCalIntegers).
+TEST(ConfigErrors, SelfCalEveryNumberAtBothLimitsFromItsTable) {
+  for (const auto& r : kSelfCalNumbers) expect_boundaries("selfcal", {r.key, r.lo, r.hi, r.unit});
+  for (const auto& r : kSelfCalIntegers) {
+    const auto doc_of = [&](int v) {
+      return std::string("# test\n[selfcal]\n") + r.key + " = " + std::to_string(v) + "\n";
+    };
+    for (int bad : {r.lo - 1, r.hi + 1})
+      expect_error(doc_of(bad), std::string("bad.toml:3: selfcal.") + r.key + " = " +
+                                    std::to_string(bad) + " is outside the allowed range [" +
+                                    std::to_string(r.lo) + ", " + std::to_string(r.hi) + "]");
+  }
+}
+
+// The case a user met (issue 33): at 100 Hz a window of 1.5 ticks passed the reader's own range
+// [0.01, 10] and failed later in the fusion under another name and range. Now one table: the
+// reader refuses it at its line with the fusion's range (two ticks = 0.02 s at 100 Hz), and the
+// fusion, given the same value, reports the same field and range.
+TEST(ConfigErrors, GyroWindowOfOneAndAHalfTicksIsRefusedOnceWithTheFusionsRange) {
+  expect_error("[loop]\nrate_hz = 100\n[gyro]\nbackend = \"sim\"\nwindow = 0.015\n",
+               "bad.toml:5: gyro.window = 0.015 is outside the allowed range [0.02, 10] s");
+  GyrodometryParams p;
+  p.tick = 0.01;
+  p.window = 0.015;
+  const Status s = check_gyrodometry(p);
+  ASSERT_FALSE(s);
+  ASSERT_TRUE(s.error().range.has_value());
+  EXPECT_EQ(s.error().range->field, "window");
+  EXPECT_EQ(s.error().range->lo, 0.02);
+  EXPECT_EQ(s.error().range->hi, 10.0);
+  expect_error("[loop]\nrate_hz = 100\n[gyro]\nwindow = 0.02\nbias_tau = 0.4\n",
+               "bad.toml:5: gyro.bias_tau = 0.4 is outside the allowed range [0.5, 86400] s");
+}
+
+// RangeText: the "lo..hi" of a config comment, "(lo..hi]" when open at lo; lo may be a word
+// ("2 ticks", "still_time"). Empty lo: none found.
+struct RangeText {
+  std::string lo, hi;
+  bool open = false;
+};
+RangeText range_text_of(const std::string& c) {
+  RangeText r;
+  const std::size_t dots = c.find("..");
+  if (dots == std::string::npos) return r;
+  const auto num = [](char ch) {
+    return std::isdigit(static_cast<unsigned char>(ch)) || ch == '.' || ch == 'e' || ch == 'E' ||
+           ch == '+' || ch == '-';
+  };
+  std::size_t b = dots;
+  for (const char* word : {"2 ticks", "still_time"})
+    if (dots >= std::strlen(word) &&
+        c.compare(dots - std::strlen(word), std::strlen(word), word) == 0)
+      b = dots - std::strlen(word);
+  if (b == dots)
+    while (b > 0 && num(c[b - 1])) --b;
+  std::size_t e = dots + 2;
+  while (e < c.size() && num(c[e])) ++e;
+  r.lo = c.substr(b, dots - b);
+  r.hi = c.substr(dots + 2, e - dots - 2);
+  r.open = b > 0 && c[b - 1] == '(' && e < c.size() && c[e] == ']';
+  return r;
+}
+
+// The shipped config's commented [gyro] and [selfcal] keys state each range as its table does:
+// "lo..hi", "(lo..hi]" where lo itself is refused (numbers compared as numbers: 1e-6 = 1e-06);
+// window's lower limit is "2 ticks" and bias_tau's "still_time" (they follow other settings).
+TEST(ConfigErrors, ShippedConfigCommentsStateTheTablesRanges) {
+  std::ifstream f(std::string(ODO_SOURCE_DIR) + "/firmware/config/odometryd.toml");
+  ASSERT_TRUE(f) << "cannot read the shipped config";
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(f, l);) lines.push_back(l);
+  const auto expect_comment = [&](const std::string& key, const std::string& lo, double hi,
+                                  bool lo_open) {
+    const std::string head = "# " + key + " = ";
+    const auto it = std::find_if(lines.begin(), lines.end(),
+                                 [&](const std::string& l) { return l.rfind(head, 0) == 0; });
+    ASSERT_NE(it, lines.end()) << "no commented line for " << key;
+    const std::string comment = it->substr(it->find('#', 1));
+    const RangeText t = range_text_of(comment);
+    ASSERT_FALSE(t.lo.empty()) << *it;
+    EXPECT_EQ(t.open, lo_open) << *it;
+    if (lo == "2 ticks" || lo == "still_time")
+      EXPECT_EQ(t.lo, lo) << *it;
+    else
+      EXPECT_EQ(std::strtod(t.lo.c_str(), nullptr), std::strtod(lo.c_str(), nullptr)) << *it;
+    EXPECT_EQ(std::strtod(t.hi.c_str(), nullptr), hi) << *it;
+  };
+  for (std::size_t i = 0; i < kGyroConfigParams; ++i) {
+    const auto k = static_cast<GyroParam>(i);
+    const RangeRow r = gyrodometry_range(k, 0.01, 0.5);
+    const std::string lo = k == GyroParam::kWindow    ? "2 ticks"
+                           : k == GyroParam::kBiasTau ? "still_time"
+                                                      : shortest(r.lo);
+    expect_comment(r.key, lo, r.hi, r.lo_open);
+  }
+  for (const auto& r : kSelfCalNumbers) expect_comment(r.key, shortest(r.lo), r.hi, false);
+  for (const auto& r : kSelfCalIntegers)
+    expect_comment(r.key, std::to_string(r.lo), static_cast<double>(r.hi), false);
 }
 
 }  // namespace

@@ -378,5 +378,43 @@ TEST(PoseCovariance, ResetZeroes) {
   for (double v : pc.cov()) EXPECT_EQ(v, 0.0);
 }
 
+TEST(ErrorModel, TwistCovarianceOfTheWheelsHandValues) {
+  // kL = 0.001, kR = 0.002, dL = 0.01 m, dR = -0.04 m over dt = 0.1 s, b = 0.5 m:
+  // wL = 1e-6 * 0.01 = 1e-8, wR = 4e-6 * 0.04 = 1.6e-7 (|d|: the sign is irrelevant),
+  // wL + wR = 1.7e-7. var v = 1.7e-7 / (4 * 0.01) = 4.25e-6; var omega = 1.7e-7 / (0.25 * 0.01)
+  // = 6.8e-5; cov = (1.6e-7 - 1e-8) / (2 * 0.5 * 0.01) = 1.5e-5.
+  ErrorModelParams k;
+  k.k_left = 0.001;
+  k.k_right = 0.002;
+  const Cov2 c = twist_covariance(TickMotion{0.01, -0.04, 0.1, 0.5}, k);
+  EXPECT_NEAR(c[0], 4.25e-6, 1e-18);
+  EXPECT_NEAR(c[3], 6.8e-5, 1e-17);
+  EXPECT_NEAR(c[1], 1.5e-5, 1e-18);
+  EXPECT_EQ(c[1], c[2]);
+  const Cov2 zero = twist_covariance(TickMotion{0.0, 0.0, 0.1, 0.5}, k);
+  EXPECT_EQ(zero[0], 0.0);
+  EXPECT_EQ(zero[3], 0.0);
+  // Nothing measured (no interval, no wheelbase): zero, not a division by zero.
+  EXPECT_EQ(twist_covariance(TickMotion{0.01, 0.01, 0.0, 0.5}, k)[0], 0.0);
+  EXPECT_EQ(twist_covariance(TickMotion{0.01, 0.01, 0.1, 0.0}, k)[3], 0.0);
+}
+
+TEST(ErrorModel, TwistCovarianceOfAGyroTickTakesOmegaFromTheGyro) {
+  // The same wheels with the heading from the gyro, var_heading = 4e-8 rad^2 over dt = 0.1 s:
+  // var v is the wheels' 4.25e-6 as before; var omega = 4e-8 / 0.01 = 4e-6; the gyro's noise
+  // is independent of the wheels': cov = 0.
+  ErrorModelParams k;
+  k.k_left = 0.001;
+  k.k_right = 0.002;
+  TickMotion m{0.01, -0.04, 0.1, 0.5};
+  m.gyro_heading = true;
+  m.gyro_var_heading = 4e-8;
+  const Cov2 c = twist_covariance(m, k);
+  EXPECT_NEAR(c[0], 4.25e-6, 1e-18);
+  EXPECT_NEAR(c[3], 4e-6, 1e-19);
+  EXPECT_EQ(c[1], 0.0);
+  EXPECT_EQ(c[2], 0.0);
+}
+
 }  // namespace
 }  // namespace odo

@@ -45,6 +45,22 @@ TEST(SocketCanId, StandardAndExtendedRoundTrip) {
   EXPECT_FALSE(from_socketcan_id(CAN_ERR_FLAG | 0x4, g));    // error frames neither
 }
 
+// Issue 39: the kernel's receive stamp (CLOCK_REALTIME) moved onto CLOCK_MONOTONIC by its age.
+TEST(SocketCanStamp, KernelStampMovesToMonotonicByItsAge) {
+  // Realtime now 1000.5 s, monotonic now 20 s; the frame arrived at 1000.49 s realtime, 10 ms
+  // ago: 20 s - 10 ms = 19.99 s.
+  EXPECT_EQ(kernel_stamp_to_monotonic(1'000'490'000'000, 1'000'500'000'000, 20'000'000'000),
+            19'990'000'000);
+  // The realtime clock stepped back between the frame and now (age < 0): the read time.
+  EXPECT_EQ(kernel_stamp_to_monotonic(1'000'600'000'000, 1'000'500'000'000, 20'000'000'000),
+            20'000'000'000);
+  // Stepped forward by a minute (age 60 s > 10 s): the read time too. Exactly 10 s is kept.
+  EXPECT_EQ(kernel_stamp_to_monotonic(940'500'000'000, 1'000'500'000'000, 20'000'000'000),
+            20'000'000'000);
+  EXPECT_EQ(kernel_stamp_to_monotonic(990'500'000'000, 1'000'500'000'000, 20'000'000'000),
+            10'000'000'000);
+}
+
 TEST(SocketCanOpen, MissingInterfaceNamesItAndTheCall) {
   SocketCanOptions o;
   o.interface = "nocan7";

@@ -51,7 +51,7 @@ TEST(SpscRing, ProducerAndConsumerThreadsLoseAndReorderNothing) {
   constexpr std::uint64_t kValues = 200000;
   SpscRing<std::uint64_t> r(16);
   std::thread producer([&r] {
-    for (std::uint64_t i = 0; i < kValues; ++i) r.push_wait(i);
+    for (std::uint64_t i = 0; i < kValues; ++i) r.push_wait(i, [] { std::this_thread::yield(); });
   });
   std::uint64_t expected = 0, v = 0, out_of_order = 0;
   while (expected < kValues) {

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "odo/calibration/record.hpp"
+#include "odo/hal/crc.hpp"
 #include "odo/loop/state_record.hpp"
 
 namespace odo::loop {
@@ -110,7 +111,7 @@ TEST(StateRecord, VersionOneRecordIsStillRead) {
   // bytes [0, 208) at 208.
   b[4] = 1;
   b[6] = 212;
-  const std::uint32_t crc = calib::crc32(std::span<const std::uint8_t>(b.data(), 208));
+  const std::uint32_t crc = odo::crc32(std::span<const std::uint8_t>(b.data(), 208));
   for (int i = 0; i < 4; ++i) b[208 + i] = static_cast<std::uint8_t>(crc >> (8 * i));
   auto d = decode_state(std::span<const std::uint8_t>(b.data(), kStateRecordBytesV1));
   ASSERT_TRUE(d) << d.error().message;
@@ -264,6 +265,31 @@ TEST(ResumeDecision, ResumesAcrossTheWrapWithTheGapsCounts) {
   EXPECT_EQ(resume_reason_name(d.reason), "resumed");
 }
 
+// Issue 39: the record holds the counters' own values and a backend reports the counts of the
+// jumps it rejected (left/right_rejected); the decision compares counter with counter, so a
+// rejected jump is neither motion during the gap nor a counter jump.
+TEST(ResumeDecision, RejectedJumpsAreNotMotionDuringTheGap) {
+  const StateRecord r = sample_record(9);  // counters 65530 (left) and -12 (right), 16 bits
+  // The restarted backend rejected a jump of +700 counts on the right before its first
+  // reading: it reports 88 - 700 = -612 and right_rejected 700; the counter holds 88, i.e.
+  // +100 since the record (as in ResumesAcrossTheWrapWithTheGapsCounts).
+  EncoderSample s = reading(r, 20, -612, 0.5);
+  s.right_rejected = 700;
+  const auto d = decide_resume(r, matching_context(r), s);
+  EXPECT_EQ(d.reason, ResumeReason::kResumed);
+  EXPECT_EQ(d.dl, 26);
+  EXPECT_EQ(d.dr, 100);
+  // Left rejected -30000 on a 16-bit counter (wrap rule): reported 20 + 30000 = 30020, counter
+  // 30020 - 30000 = 20: still +26 across the wrap.
+  s.left = 30020;
+  s.left_rejected = -30000;
+  EXPECT_EQ(decide_resume(r, matching_context(r), s).dl, 26);
+  // Without the rejected counts (the reading before issue 39) the right wheel would have moved
+  // -612 - (-12) = -600 counts, under the 1501 bound: a resume with motion that never happened.
+  s.right_rejected = 0;
+  EXPECT_EQ(decide_resume(r, matching_context(r), s).dr, -600);
+}
+
 // The gyro's calibration goes only to the gyro it was learnt on (same nonzero id), in the same
 // boot and clock and within max_age; whether the pose resumes is another matter (the bias is
 // the chip's, not the encoders').
@@ -351,9 +377,15 @@ TEST(ResumeDecision, EveryFreshStartReason) {
                 },
                 reading(r, 20, 88, 11.0)),
             ResumeReason::kStale);
+  // A serial controller that says it rebooted (diffodom booted flag): fresh, even though its
+  // counts lie within the gap's bound (they restarted from 0 near the record's counts).
+  EncoderSample rebooted = ok;
+  rebooted.flags = kEncoderControllerReset;
+  EXPECT_EQ(reason(none, rebooted), ResumeReason::kControllerReset);
   EXPECT_EQ(resume_reason_name(ResumeReason::kCounterJump), "counter-jump");
+  EXPECT_EQ(resume_reason_name(ResumeReason::kControllerReset), "controller-reset");
   EXPECT_EQ(std::size(kResumeReasonNames),
-            static_cast<std::size_t>(ResumeReason::kCounterJump) + 1);
+            static_cast<std::size_t>(ResumeReason::kControllerReset) + 1);
 }
 
 }  // namespace

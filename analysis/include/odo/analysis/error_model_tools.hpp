@@ -84,7 +84,7 @@ struct TwistMcResult {
 };
 
 // run_twist_monte_carlo: the twist covariance that the ROS 2 output publishes
-// (ros2::twist_covariance_from_wheels) against a Monte Carlo: the simulated robot (true =
+// (twist_covariance, odometry/error_model.hpp) against a Monte Carlo: the simulated robot (true =
 // believed) drives a circle of 2 m radius at o.speed with wheel noise k^2 |d| on its true travel,
 // and the loop's (v, omega) over the tick after 1 s is compared with the true twist over the
 // same interval, o.runs times. o.path is not used.

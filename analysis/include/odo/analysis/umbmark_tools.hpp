@@ -33,6 +33,11 @@ enum class UmbmarkNoise : std::uint8_t {
   kNone,
   kPaper,  // floor roughness + reference-sensor error
 };
+// UmbmarkGyro: the simulated gyro also fused in a comparison run (--gyro).
+enum class UmbmarkGyro : std::uint8_t { kNone, kConsumer, kIndustrial };
+inline constexpr Choice<UmbmarkGyro> kUmbmarkGyros[] = {{UmbmarkGyro::kNone, "none"},
+                                                        {UmbmarkGyro::kConsumer, "consumer"},
+                                                        {UmbmarkGyro::kIndustrial, "industrial"}};
 inline constexpr Choice<UmbmarkRobot> kUmbmarkRobots[] = {{UmbmarkRobot::kLabmate, "labmate"}};
 inline constexpr Choice<UmbmarkNoise> kUmbmarkNoises[] = {{UmbmarkNoise::kNone, "none"},
                                                           {UmbmarkNoise::kPaper, "paper"}};
@@ -58,7 +63,7 @@ struct UmbmarkSimOptions {
   calib::WheelbaseFormula formula = calib::WheelbaseFormula::kUmbmark629;
   // --gyro: none | consumer | industrial: also drive the comparison with that simulated gyro
   // fused by the loop (UmbmarkGyroComparison).
-  std::string gyro = "none";
+  UmbmarkGyro gyro = UmbmarkGyro::kNone;
 };
 
 // The floor and reference of --noise paper (README "UMBmark calibration" shows the resulting

@@ -13,6 +13,10 @@
 
 #include "odo/hal/result.hpp"
 
+namespace odo {
+struct KinematicParams;  // odometry/kinematics.hpp (apply_record's callers include it)
+}
+
 namespace odo::calib {
 
 // Provenance of a record fitted from absolute fixes (self-calibration, issue 18): format
@@ -68,9 +72,6 @@ inline constexpr std::size_t kRecordV1Bytes = 108;
 inline constexpr std::size_t kRecordV2Bytes = 148;
 inline constexpr std::size_t kMethodBytes = 16;
 
-// crc32: CRC-32/ISO-HDLC (zlib's crc32; "123456789" -> 0xCBF43926).
-std::uint32_t crc32(std::span<const std::uint8_t> data) noexcept;
-
 // encode_record: the bytes of `r`: version 1 (kRecordV1Bytes) without `fit`, version 2
 // (kRecordV2Bytes) with it. Fails when the method text is longer than 15 bytes or a value is
 // not finite.
@@ -93,6 +94,12 @@ struct RecordLimits {
 // validate_record: every value finite and inside RecordLimits; the error names the field and
 // the allowed range.
 Status validate_record(const CalibrationRecord& r);
+
+// apply_record: the kinematics `nominal` corrected by the record (c_L, c_R, and the wheelbase and
+// wheel diameter when it holds them). Errors: the record's values out of range, or the
+// corrected kinematics invalid (odometryd and the microcontroller firmware both run on nominal
+// values then).
+Result<KinematicParams> apply_record(const KinematicParams& nominal, const CalibrationRecord& r);
 
 // utc_text: a record time [s since the Unix epoch] as "YYYY-MM-DDTHH:MM:SSZ".
 std::string utc_text(std::int64_t t);

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "odo/hal/choice.hpp"
 #include "odo/hal/result.hpp"
 
 namespace odo::calib {
@@ -55,6 +56,9 @@ struct TypeAB {
 // b = 337.06 mm and E_max,syst 353.96 -> 4.61 mm (76.8-fold); Eq. 9 gives b = 338.52 mm and
 // 353.96 -> 81.47 mm (4.3-fold), 40.17 mm after a second pass.
 enum class WheelbaseFormula { kUmbmark629, kChongKleeman9 };
+// Their spellings (odomctl umbmark simulate --eb-form).
+inline constexpr Choice<WheelbaseFormula> kWheelbaseFormulas[] = {
+    {WheelbaseFormula::kUmbmark629, "umbmark"}, {WheelbaseFormula::kChongKleeman9, "chong"}};
 
 // Calibration factors of a robot: c_L, c_R (Eq. 6.35) and the wheelbase b [m] it uses.
 struct Factors {

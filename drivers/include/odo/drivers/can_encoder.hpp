@@ -11,19 +11,32 @@
 //
 // read(now):
 // - takes at most max_frames_per_read frames from the bus without blocking; frames beyond stay
-//   queued (in the kernel socket buffer) for the next read, and since the counts are cumulative
-//   only the newest frame of each wheel matters: a backlog delays, never loses, motion;
+//   queued (in the kernel socket buffer) for the next read; a backlog delays, never loses,
+//   motion (the counts are cumulative);
 // - counts are the controller's own counter (after `reverse`, sign-extended from the field's
 //   width: the loop's wrap rule applies), so they are continuous across restarts of odometryd
 //   while the controller keeps counting (issue 17); before the first frame a wheel reads 0 and
 //   is stale (the loop takes a wheel's first fresh count as its reference, so that 0 is never
 //   a jump to the first count);
+// - every frame is judged on its own receive stamp (the kernel's, SocketCanBus): a step between
+//   two frames of a wheel beyond max_counts_per_s * (stamp difference + kLatencySlack) + 1 count
+//   is flagged kEncoderImplausibleJump, counted and not integrated (re-based); the sample's
+//   left_rejected/right_rejected carry what was left out, so the state record keeps the
+//   controller's own counter (issue 39);
+// - both wheels are reported at one instant (issue 39): the sample time is the older of the two
+//   wheels' newest frame stamps, and the other wheel's count is interpolated linearly between
+//   its two frames around that instant (kept: the last kHistory frames of each wheel). Why
+//   interpolation rather than "the newest pair whose stamps agree": per-wheel controllers (ODrive
+//   axes) send out of phase, so their stamps never agree closer than their phase offset, and a
+//   late frame of one wheel would hold both back by whole periods; interpolating keeps the error
+//   at the count curve's bend between two frames (a * P^2 / 8 counts at acceleration a, frame
+//   period P), independent of the phase. A wheel that falls silent holds the instant back until
+//   it is stale (`timeout`); while a wheel is stale the sample time is `now` and each wheel
+//   reports its newest count, as before;
 // - a wheel whose newest frame is older than `timeout` is flagged kEncoderStaleLeft/Right and
 //   keeps its last count; stale_events counts each fresh -> stale transition (the start-up
 //   state before the first frame is not an event). On recovery the count difference since the
 //   last frame is real motion (the counts are cumulative) unless it is implausible;
-// - a step between two frames of a wheel beyond max_counts_per_s * (time between the frames)
-//   + 1 count is flagged kEncoderImplausibleJump, counted and not integrated (re-based);
 // - optionally sends a remote request (RTR) for each wheel's id at request_period, for
 //   controllers that answer only on request; a dropped request is counted, never waited for.
 #pragma once
@@ -67,6 +80,10 @@ CanDecode decode_count(const CanFrame& f, const CanCountLayout& layout, std::int
 // check_layout: configure-time validation of a layout; the message names the field.
 Status check_layout(const CanCountLayout& layout);
 
+// The range of max_frames_per_read of the CAN sources (encoder counts, gyro), checked by their
+// create() and by the config reader ([can_encoder], [can_gyro]).
+inline constexpr RangeRow kCanMaxFramesPerRead{"max_frames_per_read", 1, 4096, "frames"};
+
 struct CanEncoderConfig {
   CanCountLayout left;
   CanCountLayout right;
@@ -109,16 +126,30 @@ class CanEncoderSource final : public EncoderSource {
 
  private:
   CanEncoderSource(CanBus& bus, const CanEncoderConfig& cfg) : bus_(&bus), cfg_(cfg) {}
-  void accept(int wheel, std::int64_t raw, TimeNs stamp, std::uint32_t& flags) noexcept;
-  void send_requests(TimeNs now) noexcept;
-
+  // Frames of one wheel kept for interpolation: a wheel may lag the other by up to
+  // kHistory - 1 of its frames before its count at the common instant is clamped to the oldest.
+  static constexpr std::size_t kHistory = 8;
+  struct Stamped {
+    TimeNs stamp = 0;        // receive time [ns]
+    std::int64_t count = 0;  // reported count (offset applied)
+  };
   struct Wheel {
     std::int64_t offset = 0;    // subtracted from the sender's count (re-basing after jumps)
     std::int64_t last_raw = 0;  // last accepted count (after reverse)
     TimeNs last_stamp = 0;      // receive time of the newest frame [ns]
     bool primed = false;        // a frame has arrived
     bool stale = true;          // flagged stale at the last read
+    std::array<Stamped, kHistory> history{};  // ring; newest at `newest`
+    std::size_t newest = 0;
+    std::size_t kept = 0;  // valid entries, 0..kHistory
   };
+
+  void accept(int wheel, std::int64_t raw, TimeNs stamp, std::uint32_t& flags) noexcept;
+  void send_requests(TimeNs now) noexcept;
+  int drain(TimeNs now, std::uint32_t& flags) noexcept;
+  // count_at: wheel `w`'s reported count at `t` [ns]: interpolated between the frames around t,
+  // the newest count after the newest frame, the oldest kept before the oldest.
+  std::int64_t count_at(const Wheel& w, TimeNs t) const noexcept;
 
   CanBus* bus_;
   CanEncoderConfig cfg_;
@@ -126,6 +157,7 @@ class CanEncoderSource final : public EncoderSource {
   EncoderCounters counters_;
   CanEncoderStats stats_;
   TimeNs next_request_ = 0;
+  TimeNs last_sample_ = 0;  // sample time of the last read [ns]: never goes back
 };
 
 }  // namespace odo::drivers

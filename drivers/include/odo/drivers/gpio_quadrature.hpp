@@ -24,6 +24,9 @@ struct GpioWheelLines {
   bool reverse = false;  // negate the count (mirrored motor mounting)
 };
 
+// The range of `batch`, checked by open() and by the config reader ([gpio]).
+inline constexpr RangeRow kGpioBatch{"batch", 1, 1024, "events"};
+
 struct GpioQuadratureConfig {
   std::string chip;  // /dev/gpiochipN, gpiochipN, a chip label or a number
   GpioWheelLines left;

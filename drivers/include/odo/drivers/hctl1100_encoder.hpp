@@ -19,6 +19,10 @@
 
 namespace odo::drivers {
 
+// The ranges of the read-back settings, checked by create() and by the config reader ([hctl1100]).
+inline constexpr RangeRow kHctlAgreeWindow{"agree_window", 0, 64, "counts"};
+inline constexpr RangeRow kHctlMaxAttempts{"max_attempts", 2, 16, ""};
+
 struct Hctl1100Config {
   int unit_left = 0;          // chip-select index of the left wheel's chip
   int unit_right = 1;         // and of the right wheel's

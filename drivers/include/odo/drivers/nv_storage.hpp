@@ -12,10 +12,10 @@
 
 namespace odo::drivers {
 
-enum class NvBackend : std::uint8_t { kAuto, kFile, kNvmem, kMtd };
-
-// nv_backend_name: "auto", "file", "nvmem", "mtd".
-const char* nv_backend_name(NvBackend b) noexcept;
+// nv_backend_name: "auto", "file", "nvmem", "mtd" (hal's kNvBackends).
+inline std::string_view nv_backend_name(NvBackend b) noexcept {
+  return choice_name(kNvBackends, b);
+}
 // detect_nv_backend: /dev/mtd* -> mtd, a file named "nvmem" or under /sys/ -> nvmem, else file.
 NvBackend detect_nv_backend(std::string_view path) noexcept;
 

@@ -48,6 +48,13 @@ std::uint32_t to_socketcan_id(const CanFrame& f) noexcept;
 // and error frames, which the firmware does not use.
 bool from_socketcan_id(std::uint32_t can_id, CanFrame& f) noexcept;
 
+// kernel_stamp_to_monotonic: a kernel receive stamp `kernel_rt` on CLOCK_REALTIME [ns] moved
+// onto CLOCK_MONOTONIC, given both clocks read together just after (`rt_now`, `mono_now`): the
+// frame's age on the realtime clock is subtracted from the monotonic now. An age below 0 (the
+// realtime clock stepped back meanwhile) counts as 0, one above 10 s (stepped forward) too:
+// then the read time is the best stamp there is. Pure; unit-tested.
+TimeNs kernel_stamp_to_monotonic(TimeNs kernel_rt, TimeNs rt_now, TimeNs mono_now) noexcept;
+
 // SocketCanCounters: cumulative since open; read from the thread that sends/receives.
 struct SocketCanCounters {
   std::uint64_t sent = 0;
@@ -65,7 +72,8 @@ class SocketCanBus final : public CanBus {
   static Result<std::unique_ptr<SocketCanBus>> open(const SocketCanOptions& o);
 
   CanTx send(const CanFrame& f) noexcept override;
-  // receive: the stamp is CLOCK_MONOTONIC at the time of the read [ns].
+  // receive: the stamp is the kernel's receive time of the frame (SO_TIMESTAMPNS), moved onto
+  // CLOCK_MONOTONIC [ns]; the read time when the kernel gave none.
   bool receive(CanFrame& out) noexcept override;
 
   const SocketCanCounters& counters() const noexcept { return counters_; }

@@ -33,7 +33,7 @@ class CalibrationReloader {
  public:
   // commands: the loop's inbound queue (OdometryLoop::commands()).
   CalibrationReloader(loop::CommandQueue& commands, const KinematicParams& nominal,
-                      std::string path, StoreBackend backend, std::ostream& log)
+                      std::string path, NvBackend backend, std::ostream& log)
       : commands_(commands),
         nominal_(nominal),
         path_(std::move(path)),
@@ -61,7 +61,7 @@ class CalibrationReloader {
   loop::CommandQueue& commands_;
   KinematicParams nominal_;
   std::string path_;
-  StoreBackend backend_;
+  NvBackend backend_;
   std::ostream& log_;
   std::thread thread_;
   std::mutex m_;

@@ -28,7 +28,7 @@ struct OpenStore {
 
 // open_calibration_store: the medium `backend` (kAuto: /dev/mtd* is MTD, a path under /sys/ or
 // named nvmem is nvmem, anything else a regular file).
-Result<OpenStore> open_calibration_store(const std::string& path, StoreBackend backend);
+Result<OpenStore> open_calibration_store(const std::string& path, NvBackend backend);
 
 // AppliedCalibration: what odometryd runs on after reading the store.
 struct AppliedCalibration {
@@ -48,6 +48,6 @@ AppliedCalibration apply_calibration(const KinematicParams& nominal,
 
 // read_and_apply: opens `path` (empty: no store configured), loads and applies.
 AppliedCalibration read_and_apply(const KinematicParams& nominal, const std::string& path,
-                                  StoreBackend backend);
+                                  NvBackend backend);
 
 }  // namespace odo::fw

@@ -127,7 +127,7 @@ class CanBroadcaster final : public loop::TickObserver {
   void send_timing(const loop::LoopSnapshot& s) noexcept;
   void log_frame(const CanFrame& f) noexcept {
     if (o_.lossless_log)
-      log_->push_wait(f);
+      log_->push_wait(f, [] { std::this_thread::yield(); });
     else
       log_->push(f);
   }

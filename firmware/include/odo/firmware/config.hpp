@@ -13,8 +13,11 @@
 
 #include "odo/hal/angle.hpp"
 #include "odo/hal/choice.hpp"
+#include "odo/hal/field_range.hpp"
+#include "odo/hal/nv_storage.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/error_model.hpp"
+#include "odo/odometry/gyrodometry.hpp"
 #include "odo/odometry/kinematics.hpp"
 
 namespace odo::ros2 {
@@ -28,7 +31,10 @@ namespace odo::fw {
 template <class E>
 using Choice = odo::Choice<E>;  // hal/choice.hpp; the name as written in the file
 
-enum class EncoderKind : std::uint8_t { kSim, kHctl1100, kGpio, kCan };
+enum class EncoderKind : std::uint8_t { kSim, kHctl1100, kGpio, kCan, kSerial };
+// [serial] protocol (the backend maps it onto protocol::SerialProtocol, same order).
+enum class SerialProtocol : std::uint8_t { kDiffodom, kArduinoBridge };
+enum class SerialLink : std::uint8_t { kTty, kSim };
 enum class SimRobotKind : std::uint8_t { kLabmate, kNominal };
 enum class SimScenario : std::uint8_t { kSquareCcw, kSquareCw, kSquares, kIdle };
 enum class HctlBus : std::uint8_t { kGpio, kSim };
@@ -36,7 +42,6 @@ enum class HctlLatch : std::uint8_t { kNone, kLsb };
 enum class CanEncoderBus : std::uint8_t { kSocketCan, kSim };
 enum class CanEncoderProtocol : std::uint8_t { kOdrive, kGeneric };
 enum class ByteOrder : std::uint8_t { kLittle, kBig };
-enum class StoreBackend : std::uint8_t { kAuto, kFile, kNvmem, kMtd };
 enum class CanBusKind : std::uint8_t { kSim, kSocketCan, kNone };
 enum class GyroBackend : std::uint8_t { kNone, kSim, kIio, kCan };
 enum class GyroAxis : std::uint8_t { kX, kY, kZ };
@@ -46,7 +51,8 @@ enum class GyroModelKind : std::uint8_t { kConsumer, kIndustrial };
 inline constexpr Choice<EncoderKind> kEncoderKinds[] = {{EncoderKind::kSim, "sim"},
                                                         {EncoderKind::kHctl1100, "hctl1100"},
                                                         {EncoderKind::kGpio, "gpio"},
-                                                        {EncoderKind::kCan, "can"}};
+                                                        {EncoderKind::kCan, "can"},
+                                                        {EncoderKind::kSerial, "serial"}};
 inline constexpr Choice<SimRobotKind> kSimRobotKinds[] = {{SimRobotKind::kLabmate, "labmate"},
                                                           {SimRobotKind::kNominal, "nominal"}};
 inline constexpr Choice<SimScenario> kSimScenarios[] = {{SimScenario::kSquareCcw, "square-ccw"},
@@ -60,12 +66,12 @@ inline constexpr Choice<CanEncoderBus> kCanEncoderBuses[] = {
     {CanEncoderBus::kSocketCan, "socketcan"}, {CanEncoderBus::kSim, "sim"}};
 inline constexpr Choice<CanEncoderProtocol> kCanEncoderProtocols[] = {
     {CanEncoderProtocol::kOdrive, "odrive"}, {CanEncoderProtocol::kGeneric, "generic"}};
+inline constexpr Choice<SerialProtocol> kSerialProtocols[] = {
+    {SerialProtocol::kDiffodom, "diffodom"}, {SerialProtocol::kArduinoBridge, "arduino-bridge"}};
+inline constexpr Choice<SerialLink> kSerialLinks[] = {{SerialLink::kTty, "tty"},
+                                                      {SerialLink::kSim, "sim"}};
 inline constexpr Choice<ByteOrder> kByteOrders[] = {{ByteOrder::kLittle, "little"},
                                                     {ByteOrder::kBig, "big"}};
-inline constexpr Choice<StoreBackend> kStoreBackends[] = {{StoreBackend::kAuto, "auto"},
-                                                          {StoreBackend::kFile, "file"},
-                                                          {StoreBackend::kNvmem, "nvmem"},
-                                                          {StoreBackend::kMtd, "mtd"}};
 inline constexpr Choice<CanBusKind> kCanBusKinds[] = {
     {CanBusKind::kSim, "sim"}, {CanBusKind::kSocketCan, "socketcan"}, {CanBusKind::kNone, "none"}};
 inline constexpr Choice<GyroBackend> kGyroBackends[] = {{GyroBackend::kNone, "none"},
@@ -88,8 +94,10 @@ inline constexpr std::tuple kChoiceTables{
     std::span<const Choice<HctlLatch>>(kHctlLatches),
     std::span<const Choice<CanEncoderBus>>(kCanEncoderBuses),
     std::span<const Choice<CanEncoderProtocol>>(kCanEncoderProtocols),
+    std::span<const Choice<SerialProtocol>>(kSerialProtocols),
+    std::span<const Choice<SerialLink>>(kSerialLinks),
     std::span<const Choice<ByteOrder>>(kByteOrders),
-    std::span<const Choice<StoreBackend>>(kStoreBackends),
+    std::span<const Choice<NvBackend>>(kNvBackends),
     std::span<const Choice<CanBusKind>>(kCanBusKinds),
     std::span<const Choice<GyroBackend>>(kGyroBackends),
     std::span<const Choice<GyroAxis>>(kGyroAxes),
@@ -213,6 +221,48 @@ struct CanEncoderSection {
   double sim_stop_right_after = -1.0;
 };
 
+// [serial]: counts from a microcontroller on a serial line (README "Serial counts"; issue 37).
+// link = "tty": the device; link = "sim": the simulated robot behind a simulated peer speaking
+// the protocol (in-process bytes, through the same source).
+struct SerialSection {
+  SerialLink link = SerialLink::kTty;
+  std::string device = "/dev/ttyACM0";  // a tty; /dev/serial/by-id/... links are followed
+  std::string device_where;             // "file:line: serial.device", for errors at open
+  int baud = 115200;                    // one of drivers::kSerialBaudRates
+  SerialProtocol protocol = SerialProtocol::kDiffodom;
+  int bits_left = 32;  // [bits] 8..32: the controller's counter width per wheel
+  int bits_right = 32;
+  bool reverse_left = false;  // negate the wheel's count
+  bool reverse_right = false;
+  double timeout = 0.1;        // [s] no valid sample for this long: stale
+  double reopen_period = 0.5;  // [s] between attempts to reopen a vanished device
+  double poll_rate = 100.0;    // [Hz] arduino-bridge: "e" requests per second
+  double max_speed = 3.0;      // [m/s] physical maximum wheel surface speed (jump check)
+  double clock_window = 1.0;   // [s] diffodom: window of the clock mapping's minimum
+  double start_wait = 2.5;     // [s] the first sample may take this long (an Arduino reboots)
+  // link = "sim" only
+  double sim_period = 0.01;  // [s] sample period of the simulated controller
+};
+
+// SectionNumber: one number key of a section: its range row (key, limits, unit) and the field it
+// sets. A section's table of these is the only place its ranges are written: the reader and the
+// config error tests take them from there.
+template <class S>
+struct SectionNumber {
+  RangeRow row;
+  double S::*member;
+};
+
+// [serial]'s numbers.
+inline constexpr SectionNumber<SerialSection> kSerialNumbers[] = {
+    {{"timeout", 0.005, 10.0, "s"}, &SerialSection::timeout},
+    {{"reopen_period", 0.01, 60.0, "s"}, &SerialSection::reopen_period},
+    {{"poll_rate", 1.0, 1000.0, "Hz"}, &SerialSection::poll_rate},
+    {{"max_speed", 0.01, 100.0, "m/s"}, &SerialSection::max_speed},
+    {{"clock_window", 0.05, 60.0, "s"}, &SerialSection::clock_window},
+    {{"start_wait", 0.0, 30.0, "s"}, &SerialSection::start_wait},
+    {{"sim_period", 0.001, 1.0, "s"}, &SerialSection::sim_period}};
+
 struct EncoderSection {
   EncoderKind backend = EncoderKind::kSim;
 };
@@ -230,7 +280,7 @@ struct RealtimeSection {
 // Where the calibration record lives ([calibration]); see calibration_io.hpp.
 struct CalibrationSection {
   std::string store = "/var/lib/odometryd/calibration.bin";  // "" = no store: nominal values
-  StoreBackend backend = StoreBackend::kAuto;
+  NvBackend backend = NvBackend::kAuto;
 };
 
 // [can]: the CAN pose broadcast (README "CAN protocol"). Rates must divide the loop rate.
@@ -322,6 +372,13 @@ struct GyroSection {
   static constexpr double kNotSet = -1.0;
 };
 
+// [gyro]'s numbers that belong to the gyro source (the fusion's own are its table,
+// gyrodometry_range).
+inline constexpr SectionNumber<GyroSection> kGyroSourceNumbers[] = {
+    {{"rate", 0.0, 100000.0, "Hz"}, &GyroSection::rate},
+    {{"stale_timeout", 0.001, 10.0, "s"}, &GyroSection::stale_timeout},
+};
+
 // [can_gyro]: the yaw rate of a CAN IMU ([gyro] backend = "can"; drivers/can_gyro.hpp).
 struct CanGyroSection {
   CanEncoderBus bus = CanEncoderBus::kSocketCan;  // socketcan | sim (a simulated CAN IMU)
@@ -351,6 +408,7 @@ struct Config {
   Hctl1100Section hctl1100;
   GpioSection gpio;
   CanEncoderSection can_encoder;
+  SerialSection serial;
   ErrorModelParams error_model;  // [error_model]: Chong-Kleeman k_L, k_R [m^(1/2)]
   CanSection can;
   // [ros2]: the ROS 2 output over DDS (README "ROS 2"), off unless enabled = true; null when
@@ -367,6 +425,10 @@ Config default_config();
 
 // parse_config: parses TOML text; `source` names it in messages. Unknown keys are errors.
 Result<Config> parse_config(std::string_view text, std::string_view source);
+
+// gyrodometry_params: the fusion's parameters from [gyro]; keys left unset take the simulated
+// model's figures (simulated_gyro) or the consumer-class defaults (GyroNoiseModel).
+GyrodometryParams gyrodometry_params(const Config& cfg);
 
 // load_config: reads and parses a file.
 Result<Config> load_config(const std::string& path);

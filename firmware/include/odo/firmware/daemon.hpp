@@ -62,7 +62,7 @@ class Daemon {
   std::unique_ptr<loop::OdometryLoop> loop_;
   std::unique_ptr<CanLink> can_;
   std::unique_ptr<CalibrationReloader> reloader_;
-  std::unique_ptr<Ros2Output> ros2_;  // [ros2] enabled; null otherwise
+  std::unique_ptr<Ros2Output> ros2_;      // [ros2] enabled; null otherwise
   std::unique_ptr<ResumeWiring> resume_;  // issue 17: persisted state (null in virtual time)
   std::unique_ptr<SelfCalLink> selfcal_;  // [selfcal] enabled
 };

@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "odo/firmware/config.hpp"
+#include "odo/hal/field_range.hpp"
 
 namespace odo::fw {
 
@@ -23,8 +24,15 @@ class TableReader {
 
   // number: a float or integer in [lo, hi]; `unit` is printed in messages.
   double number(std::string_view key, double def, double lo, double hi, std::string_view unit);
+  // number: the value of row.key, checked against the row's range (a range table's row).
+  double number(double def, const RangeRow& row);
   // integer: an integer in [lo, hi].
   std::int64_t integer(std::string_view key, std::int64_t def, std::int64_t lo, std::int64_t hi);
+  // integer: the whole number at row.key, within the row's (whole) limits.
+  std::int64_t integer(std::int64_t def, const RangeRow& row) {
+    return integer(row.key, def, static_cast<std::int64_t>(row.lo),
+                   static_cast<std::int64_t>(row.hi));
+  }
   bool boolean(std::string_view key, bool def);
   std::string string(std::string_view key, std::string def);
   // strings: an array of strings (may be empty).
@@ -39,6 +47,9 @@ class TableReader {
   }
   // reject: reports a problem found across settings at the line of `key` (or of the table).
   void reject(std::string_view key, const std::string& what);
+  // location: "file:line: path.key" of `key` (the table's line when the key is absent), for
+  // errors found later, when the value is used (a serial device that is not there).
+  std::string location(std::string_view key) const;
   // sub: a nested table (may be absent).
   TableReader sub(std::string_view key);
   // finish: reports the first key of this table that no getter asked for.

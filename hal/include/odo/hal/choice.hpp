@@ -7,6 +7,8 @@
 #include <string>
 #include <string_view>
 
+#include "odo/hal/result.hpp"
+
 namespace odo {
 
 template <class E>
@@ -40,6 +42,15 @@ std::string choice_join(const Table& table, std::string_view sep) {
     s += c.name;
   }
   return s;
+}
+
+// parse_choice_of: the value spelt `text` in `table`; otherwise an error naming the field (a
+// config key or a command-line option) and the spellings: "--gyro = 'x' must be a or b".
+template <class E, class Table>
+Result<E> parse_choice_of(const Table& table, std::string_view field, std::string_view text) {
+  if (auto v = choice_value<E>(table, text)) return *v;
+  return make_error(Errc::kInvalidArgument, std::string(field) + " = '" + std::string(text) +
+                                                "' must be " + choice_join(table, " or "));
 }
 
 }  // namespace odo

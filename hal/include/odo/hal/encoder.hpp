@@ -15,6 +15,9 @@ enum EncoderFlag : std::uint32_t {
   kEncoderInvalidTransition = 1u << 2,  // quadrature decoder saw an illegal A/B transition
   kEncoderImplausibleJump = 1u << 3,    // a count step beyond the wheel's physical maximum
   kEncoderReadError = 1u << 4,          // the backend could not read the hardware this tick
+  kEncoderLinkError = 1u << 5,          // serial: a corrupt frame/line or a sequence gap this tick
+  kEncoderControllerReset = 1u << 6,    // serial: the controller restarted (counts re-based)
+  kEncoderNoValidData = 1u << 7,        // serial: bytes arrive, none valid (wrong baud/protocol?)
 };
 
 // Cumulative event counters of a backend since start; they only grow.
@@ -23,6 +26,11 @@ struct EncoderCounters {
   std::uint64_t implausible_jumps = 0;
   std::uint64_t stale_events = 0;
   std::uint64_t read_errors = 0;
+  // Serial links (drivers/serial_encoder.hpp); 0 for the other backends.
+  std::uint64_t link_errors = 0;        // corrupt frames / lines (CRC, framing, garbage)
+  std::uint64_t sequence_gaps = 0;      // records missing from the controller's sequence
+  std::uint64_t controller_resets = 0;  // controller restarts seen (counters from zero)
+  std::uint64_t reconnects = 0;         // the device vanished and was opened again
 };
 
 // One reading of both wheels. left/right are raw counter readings exactly as the counter holds
@@ -34,6 +42,11 @@ struct EncoderSample {
   TimeNs stamp = 0;         // when the counts were latched [ns, clock of the loop]
   std::uint32_t flags = 0;  // EncoderFlag bits for this sample
   EncoderCounters counters;
+  // Counts of implausible jumps this backend rejected since it started (wrap rule): the counter
+  // itself holds left + left_rejected. The loop integrates left/right; the state record keeps
+  // the counter's own value, so a restart sees only the motion made while nobody listened.
+  std::int64_t left_rejected = 0;
+  std::int64_t right_rejected = 0;
 };
 
 class EncoderSource {

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <string>
 #include <utility>
@@ -60,15 +61,41 @@ inline FieldRange positive_range(std::string field, double v, std::string unit) 
   return r;
 }
 
+// RangeRow: one number's key, allowed range and unit: the one shape of a row of a range table
+// (written once beside the code that owns the value; readers and checkers derive from it).
+struct RangeRow {
+  const char* key = "";   // the user-facing name, e.g. "window" (a config key under its section)
+  double lo = 0.0;        // lower limit
+  double hi = 0.0;        // upper limit
+  const char* unit = "";  // "" when dimensionless
+  bool lo_open = false;   // lo itself is outside ("(lo, hi]")
+  // contains: v finite and within the range (NaN and +-inf are outside).
+  constexpr bool contains(double v) const noexcept {
+    return (lo_open ? v > lo : v >= lo) && v <= hi && v - v == 0.0;
+  }
+  // range: the FieldRange that says `v` is outside this row, under the field name `field`.
+  FieldRange range(std::string field, double v) const {
+    FieldRange r{std::move(field), v, lo, hi, unit};
+    r.lo_open = lo_open;
+    return r;
+  }
+};
+
 // range_text: "= <value>[ unit] is outside the allowed range [<lo>, <hi>][ unit][ note]"
-// (numbers as an ostream prints them by default: %g).
+// (numbers as %g prints them, with the digits needed to give the value back).
 inline std::string range_text(const FieldRange& r) {
   auto num = [&](double v, std::int64_t i) {
     char b[32];
-    if (r.integer)
+    if (r.integer) {
       std::snprintf(b, sizeof b, "%lld", static_cast<long long>(i));
-    else
-      std::snprintf(b, sizeof b, "%g", v);
+    } else {
+      // %g, with more digits where 6 would not give the value back: 10.00001 must not read as
+      // the limit 10 it lies beyond.
+      for (int p = 6; p <= 17; ++p) {
+        std::snprintf(b, sizeof b, "%.*g", p, v);
+        if (std::strtod(b, nullptr) == v || !(v == v)) break;
+      }
+    }
     return std::string(b);
   };
   const std::string u = r.unit.empty() ? std::string() : " " + r.unit;

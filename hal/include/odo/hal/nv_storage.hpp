@@ -6,9 +6,18 @@
 #include <cstdint>
 #include <span>
 
+#include "odo/hal/choice.hpp"
 #include "odo/hal/result.hpp"
 
 namespace odo {
+
+// NvBackend: the kind of medium behind a storage path (drivers/ opens each; the config's
+// calibration.backend names them through kNvBackends). kAuto: detected from the path.
+enum class NvBackend : std::uint8_t { kAuto, kFile, kNvmem, kMtd };
+inline constexpr Choice<NvBackend> kNvBackends[] = {{NvBackend::kAuto, "auto"},
+                                                    {NvBackend::kFile, "file"},
+                                                    {NvBackend::kNvmem, "nvmem"},
+                                                    {NvBackend::kMtd, "mtd"}};
 
 // Shape of a medium. Offsets and sizes in bytes.
 struct NvGeometry {

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <variant>
 
@@ -67,6 +68,14 @@ inline Error make_error(Errc code, std::string message) {
 inline Error range_error(FieldRange r) {
   std::string m = range_message(r);
   return Error{Errc::kInvalidArgument, std::move(m), std::move(r)};
+}
+
+// check_row: Ok when `row` contains v; otherwise its range error under the field name
+// prefix + key, e.g. "hctl1100: agree_window" (a driver checking the value the config reader
+// checked against the same row).
+inline Status check_row(const RangeRow& row, std::string_view prefix, double v) {
+  if (row.contains(v)) return Ok{};
+  return range_error(row.range(std::string(prefix) + row.key, v));
 }
 
 }  // namespace odo

@@ -21,6 +21,7 @@
 #include "odo/loop/latency_histogram.hpp"
 #include "odo/loop/state_record.hpp"
 #include "odo/loop/triple_buffer.hpp"
+#include "odo/odometry/count_delta.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/gyrodometry.hpp"
 #include "odo/odometry/kinematics.hpp"
@@ -58,11 +59,14 @@ struct LoopGyroStatus {
 // What one tick produced; observers and the status thread see this.
 struct LoopSnapshot {
   std::uint64_t tick = 0;
-  TimeNs stamp = 0;                 // sample time of the encoder reading [ns]
-  TimeNs loop_time = 0;             // time since the loop started [ns]
-  Pose2 pose;                       // cumulative heading
-  double v = 0.0;                   // [m/s]
-  double w = 0.0;                   // [rad/s]
+  TimeNs stamp = 0;      // sample time of the encoder reading [ns]
+  TimeNs loop_time = 0;  // time since the loop started [ns]
+  Pose2 pose;            // cumulative heading
+  double v = 0.0;        // [m/s]
+  double w = 0.0;        // [rad/s]
+  // What this tick measured (wheel travels, their interval, the wheelbase in use, the gyro's
+  // heading variance on a fused tick): consumers derive from it, never invert (v, w).
+  TickMotion motion;
   double distance = 0.0;            // path length of the centre point [m]
   std::uint32_t encoder_flags = 0;  // EncoderFlag bits of the last sample
   EncoderCounters encoder_counters;
@@ -132,6 +136,14 @@ class OdometryLoop {
   std::int64_t last_left() const noexcept { return prev_left_; }
   std::int64_t last_right() const noexcept { return prev_right_; }
   TimeNs last_stamp() const noexcept { return prev_stamp_; }
+  // The counters' own values at the last integrated sample (last_left/right plus the counts of
+  // the jumps the backend rejected, wrap rule): what a restarted process will read.
+  std::int64_t last_counter_left() const noexcept {
+    return counter_value(prev_left_, prev_rejected_left_, bits_);
+  }
+  std::int64_t last_counter_right() const noexcept {
+    return counter_value(prev_right_, prev_rejected_right_, bits_);
+  }
   int counter_bits() const noexcept { return bits_; }
   calib::StoreStatus calibration() const noexcept { return calibration_; }
   // tick: runs one period of the loop (sleeps until the deadline first).
@@ -183,8 +195,9 @@ class OdometryLoop {
   void record_wakeup(TimeNs latency) noexcept;
   // fill_snapshot: this tick's snapshot in the back slot (every field that changes).
   LoopSnapshot& fill_snapshot(const EncoderSample& s, TimeNs woke) noexcept;
-  // fill_gyro_status: the gyro and fusion part of the snapshot.
-  void fill_gyro_status(LoopGyroStatus& g) const noexcept;
+  // fill_gyro_status: the gyro and fusion part of the snapshot (its status, the motion's gyro
+  // fields).
+  void fill_gyro_status(LoopSnapshot& snap) const noexcept;
   // record_compute: the tick's compute time from `woke` to `done` [ns] into the statistics.
   void record_compute(LoopSnapshot& snap, TimeNs latency, TimeNs woke, TimeNs done) noexcept;
   // schedule_next: the next deadline; after an overrun the missed periods are skipped.
@@ -208,6 +221,8 @@ class OdometryLoop {
   // read into it directly (a 64-byte GyroSample copied once a tick, not twice).
   FusionInput fused_in_;
   std::uint32_t last_fusion_flags_ = 0;
+  double last_dt_ = 0.0;           // [s] interval of the last integrated tick (TickMotion::dt)
+  double last_var_heading_ = 0.0;  // [rad^2] its fused heading increment's variance
   std::array<TickObserver*, kMaxObservers> observers_{};
   std::size_t n_observers_ = 0;
 
@@ -215,6 +230,8 @@ class OdometryLoop {
   TimeNs deadline_ = 0;
   std::int64_t prev_left_ = 0;
   std::int64_t prev_right_ = 0;
+  std::int64_t prev_rejected_left_ = 0;  // the last integrated sample's left/right_rejected
+  std::int64_t prev_rejected_right_ = 0;
   // Stale flags of wheels that have not had a fresh reading since start(): their reference
   // count is taken from their first fresh reading, not integrated from the stale one.
   std::uint32_t unreferenced_ = 0;

@@ -7,7 +7,6 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -39,11 +38,13 @@ class SpscRing {
     head_.store(h + 1, std::memory_order_release);
     return true;
   }
-  // push_wait: producer thread in virtual time only (no deadlines to keep): waits for space, so
-  // a run faster than real time loses no value.
-  void push_wait(const T& v) noexcept {
+  // push_wait: producer thread in virtual time only (no deadlines to keep): calls wait() until
+  // there is space, so a run faster than real time loses no value. The caller says how to wait
+  // (a thread's yield on Linux): the ring itself knows no threads.
+  template <class Wait>
+  void push_wait(const T& v, Wait&& wait) noexcept {
     while (head_.load(std::memory_order_relaxed) - tail_.load(std::memory_order_acquire) > mask_)
-      std::this_thread::yield();
+      wait();
     push(v);
   }
   // pop: consumer thread; false when empty.

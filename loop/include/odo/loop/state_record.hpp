@@ -92,13 +92,14 @@ enum class ResumeReason : std::uint8_t {
   kNotContinuous,     // this backend's counts are lost while nobody listens (GPIO)
   kEncoderNotReady,   // the first reading is stale or failed
   kCounterJump,       // a counter went backwards (or forwards) beyond the wrap rule
+  kControllerReset,   // the counting controller says it rebooted since (serial: booted flag)
 };
 
 inline constexpr std::string_view kResumeReasonNames[] = {
-    "resumed",           "disabled",      "no-record",      "corrupt",
-    "other-boot",        "other-clock",   "stale",          "other-kinematics",
-    "other-calibration", "other-backend", "not-continuous", "encoder-not-ready",
-    "counter-jump"};
+    "resumed",           "disabled",        "no-record",      "corrupt",
+    "other-boot",        "other-clock",     "stale",          "other-kinematics",
+    "other-calibration", "other-backend",   "not-continuous", "encoder-not-ready",
+    "counter-jump",      "controller-reset"};
 
 // resume_reason_name: how logs, --json and odomctl spell `r`.
 std::string_view resume_reason_name(ResumeReason r) noexcept;
@@ -126,6 +127,10 @@ struct ResumeDecision {
   TimeNs gap = 0;       // sample time of `current` minus the record's [ns]
   std::int64_t dl = 0;  // counts of each wheel during the gap (wrap rule)
   std::int64_t dr = 0;
+  // The most counts each wheel could make in the gap (set from the plausibility check on;
+  // with dl/dr they say which wheel jumped and how far on kCounterJump) [counts].
+  double max_dl = 0.0;
+  double max_dr = 0.0;
   Pose2 pose;  // on kResumed: the pose the loop starts from (the record's plus the gap's step)
   // The record's gyro calibration belongs to this loop's gyro (same nonzero id, same boot and
   // clock, within max_age): set whether or not the pose resumes (the bias is the chip's, not

@@ -18,6 +18,15 @@ constexpr std::int64_t wrap_delta(std::int64_t prev, std::int64_t cur, int bits)
   return static_cast<std::int64_t>(diff << shift) >> shift;
 }
 
+// counter_value: reported + rejected modulo 2^bits, sign-extended: the counter's own value when a
+// backend reports `reported` after leaving out `rejected` counts of implausible jumps [counts].
+constexpr std::int64_t counter_value(std::int64_t reported, std::int64_t rejected,
+                                     int bits) noexcept {
+  const std::uint64_t sum =
+      static_cast<std::uint64_t>(reported) + static_cast<std::uint64_t>(rejected);
+  return wrap_delta(0, static_cast<std::int64_t>(sum), bits);
+}
+
 // kCounterBitsMin, kCounterBitsMax: the counter widths the loop handles (the config reader
 // checks against the same numbers).
 inline constexpr int kCounterBitsMin = 16;

@@ -31,6 +31,28 @@ std::optional<FieldRange> error_model_range(const ErrorModelParams& k);
 // check_error_model: the same as an error (message from range_message).
 Status check_error_model(const ErrorModelParams& k);
 
+// Covariance of the twist (v, omega) of one interval, row-major 2x2 [m^2/s^2, m rad/s^2;
+// rad^2/s^2].
+using Cov2 = std::array<double, 4>;
+
+// TickMotion: what one loop tick measured, as the loop integrated it: each wheel's calibrated
+// travel, the interval the travels cover and the wheelbase in use then; a tick whose heading
+// increment was the gyro's (gyrodometry) carries the variance that increment has.
+struct TickMotion {
+  double d_left = 0.0;            // left wheel travel [m] (c_L applied)
+  double d_right = 0.0;           // right wheel travel [m]
+  double dt = 0.0;                // interval between the tick's sample and the previous [s]
+  double wheelbase = 0.0;         // b in use for this tick [m]
+  bool gyro_heading = false;      // the heading increment (so omega) is the gyro's
+  double gyro_var_heading = 0.0;  // its variance [rad^2] when gyro_heading
+};
+
+// twist_covariance: the covariance of (v, omega) = ((d_L + d_R) / (2 dt), dtheta / dt) of one
+// tick, from the wheels' variances k^2 |d| (Chong & Kleeman Eq. 4); on a gyro tick omega's
+// variance is the gyro's increment's over dt^2, independent of the wheels. Zero for dt <= 0 or
+// b <= 0 (nothing measured).
+Cov2 twist_covariance(const TickMotion& m, const ErrorModelParams& k) noexcept;
+
 // ArcTerms: the shape integrals of one arc of heading change phi = (d_R - d_L) / b, each
 // int_0^1 ... du along the arc parameter u (see error_model.cpp for the definitions).
 struct ArcTerms {

@@ -98,9 +98,11 @@
 // alarm in about 50 h from noise alone, before the quantisation margin q.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
+#include "odo/hal/field_range.hpp"
 #include "odo/hal/gyro.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/error_model.hpp"
@@ -134,7 +136,40 @@ struct GyrodometryParams {
   double scale_max_error = 0.05;           // scale estimates beyond 1 +- this are rejected
 };
 
-// check_gyrodometry: every field finite and in range; the error names the field and the range.
+// GyroParam: every number of GyrodometryParams the fusion checks. The first kGyroConfigParams are
+// set by the user (odometryd's [gyro] keys, by the names of gyrodometry_range); the rest come
+// from the loop (tick), the encoders (heading_quantum) or stay at the fusion's defaults.
+enum class GyroParam : std::uint8_t {
+  kNoiseDensity,
+  kBiasInstability,
+  kScaleTolerance,
+  kDelay,
+  kDelayTolerance,
+  kWindow,
+  kKSigma,
+  kMaxWheelSpeed,
+  kMaxWheelAccel,
+  kStillTime,
+  kBiasTau,
+  kTick,
+  kHeadingQuantum,
+  kTurnRateMin,
+  kScaleAngle,
+  kScaleMaxError,
+};
+inline constexpr std::size_t kGyroConfigParams = 11;  // kNoiseDensity .. kBiasTau
+inline constexpr std::size_t kGyroParams = 16;
+
+// gyrodometry_range: the key, allowed range and unit of `k`: the one table of the fusion's
+// limits. window's range depends on the loop tick [s] (at least two ticks), bias_tau's on
+// still_time [s] (at least that long).
+RangeRow gyrodometry_range(GyroParam k, double tick, double still_time) noexcept;
+
+// gyrodometry_value: the field of `p` that `k` names.
+double& gyrodometry_value(GyrodometryParams& p, GyroParam k) noexcept;
+
+// check_gyrodometry: every field finite and in its gyrodometry_range; the error is a range error
+// (Error::range) under the field's key.
 Status check_gyrodometry(const GyrodometryParams& p);
 
 // What happened on one tick (several bits may be set).
@@ -275,6 +310,9 @@ class Gyrodometry {
   // limit_flags: kFusionSpeedLimit, kFusionAccelLimit for the newest tick's |d_L|, |d_R| [m].
   std::uint32_t limit_flags(double abs_left, double abs_right) const noexcept;
   double begin_interval() noexcept;
+  // gyro_health: kFusionGyroFault when the sample cannot be used (a fault counted on the
+  // transition from healthy, none while the gyro is still starting), 0 when it can.
+  std::uint32_t gyro_health(const GyroSample& g) noexcept;
   // open_interval: the first flagged tick: the window's odometry increments are replaced by the
   // gyro's (out.dtheta, out.var_heading [rad^2]); why: the kFusion* reasons.
   void open_interval(std::uint32_t why, double odo, double dt, FusedTick& out) noexcept;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "odo/hal/angle.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
 
@@ -15,9 +16,6 @@ struct Pose2 {
   double y = 0.0;      // [m]
   double theta = 0.0;  // [rad], cumulative: two full CCW turns give 4*pi
 };
-
-// wrap_angle: maps any angle [rad] into (-pi, pi].
-double wrap_angle(double a) noexcept;
 
 // Below this half-angle [rad] half_angle() uses Taylor series, exact to double precision: the
 // first dropped terms are h^9/9! < 6e-18 (sin) and h^10/10! < 3e-20 (cos) for |h| <= 0.05.
@@ -161,11 +159,23 @@ class Odometry {
   // odometry's own increment and ds_correction is 0.
   void update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
                     double ds_correction) noexcept;
-  // advance_fused: update_fused() and the covariance step of the same tick: the wheels' arc
-  // when gyro_heading is false (dtheta is then odometry's own), otherwise the gyro's heading
-  // noise var_heading [rad^2] instead of the wheels' differential noise (propagate_gyro_arc).
-  void advance_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
-                     double ds_correction, bool gyro_heading, double var_heading) noexcept;
+  // advance_travel: advance() from the tick's wheel travels d_l, d_r [m] that the caller has
+  // already converted from counts (count x metres_per_count, Eq. 6.35: the same bits as
+  // advance computes), so that a fused tick converts its counts once.
+  void advance_travel(double d_l, double d_r, double dt) noexcept {
+    const double s0 = sin_theta(), c0 = cos_theta();
+    update_travel(d_l, d_r, dt);
+    cov_.step_sc(s0, c0, d_left_, d_right_, k_.wheelbase());
+  }
+  // update_travel: update() from wheel travels d_l, d_r [m] (the pose only).
+  void update_travel(double d_l, double d_r, double dt) noexcept;
+  // advance_fused: from the wheel travels d_l, d_r [m] (as advance_travel), the heading changing
+  // by dtheta [rad] and the centre travel by ds_correction [m] more than the wheels' mean (the
+  // fusion's FusedTick), with the covariance step of the same tick: the wheels' arc when
+  // gyro_heading is false (dtheta is then odometry's own), otherwise the gyro's heading noise
+  // var_heading [rad^2] instead of the wheels' differential noise (propagate_gyro_arc).
+  void advance_fused(double d_l, double d_r, double dt, double dtheta, double ds_correction,
+                     bool gyro_heading, double var_heading) noexcept;
   // set_kinematics: swap in new calibration (e.g. after SIGHUP); the pose is kept.
   void set_kinematics(const Kinematics& k) noexcept { k_ = k; }
 

@@ -13,7 +13,6 @@
 namespace odo::ros2 {
 
 using Cov6 = std::array<double, 36>;  // row-major 6x6, as in geometry_msgs
-using Cov2 = std::array<double, 4>;   // row-major 2x2 over (v, omega)
 
 // One published state of the loop, as the DDS thread reads it from a snapshot.
 struct OdomSample {
@@ -81,12 +80,6 @@ Cov6 pose_covariance_6x6(const Cov3& c) noexcept;
 // twist_covariance_6x6: our 2x2 over (v, omega) placed at (0, 5); vy gets kLateralSpeedVariance,
 // vz, roll and pitch rates kUnobservedVariance.
 Cov6 twist_covariance_6x6(const Cov2& c) noexcept;
-
-// twist_covariance_from_wheels: 2x2 covariance of (v, omega) measured over one interval of dt [s]
-// in which the wheels travelled d_left, d_right [m], from the error model's wheel variances
-// k^2 |d| (Chong & Kleeman Eq. 4) on a wheel base b [m]; zero when the wheels did not move.
-Cov2 twist_covariance_from_wheels(double d_left, double d_right, double dt, double b,
-                                  const ErrorModelParams& k) noexcept;
 
 // to_ros_time: monotonic sample time [ns] plus realtime_minus_monotonic [ns] (CLOCK_REALTIME -
 // CLOCK_MONOTONIC read near the publish) as builtin_interfaces/Time; seconds floor toward minus

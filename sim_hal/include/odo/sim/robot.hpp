@@ -65,6 +65,18 @@ struct SquareOptions {
 // sees the nominal path.
 Scenario square_scenario(const Kinematics& believed, const SquareOptions& o);
 
+// SquareSet: the squares a simulated run drives one after the other (odometryd's [sim] scenario,
+// also the microcontroller firmware's run in QEMU: both compose their robot with these).
+enum class SquareSet : std::uint8_t { kNone, kCcw, kCw, kBoth };
+
+// squares_scenario: the squares of `set` (counter-clockwise first), each with square_scenario's
+// options `o` (its direction ignored); kNone: an empty scenario (the robot stands still).
+Scenario squares_scenario(const Kinematics& believed, SquareOptions o, SquareSet set);
+
+// simulated_geometry: the true geometry of a simulated robot with the belief `p`: the LabMate's
+// errors (labmate_geometry with p's diameter) or, labmate false, exactly the belief.
+RobotGeometry simulated_geometry(bool labmate, const KinematicParams& p);
+
 // scenario_duration: total duration of a scenario [s].
 double scenario_duration(const Scenario& s);
 

@@ -1,0 +1,1 @@
+// The image's own translation unit: everything is in the board library (main included).

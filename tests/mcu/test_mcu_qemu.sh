@@ -1,0 +1,133 @@
+#!/usr/bin/env bash
+# The microcontroller firmware (board/, issue 36) in QEMU's netduinoplus2 (STM32F405) on the host:
+# virtual time (-icount shift=0,sleep=off: one instruction a nanosecond, idle time skipped).
+#  1. The default square: every pose frame the firmware sends over SLCAN (USART1) equals, byte
+#     for byte, odometryd --virtual-time's for the same scenario (its --can-log), the final
+#     pose included; no missed deadline, no dropped frame; odomctl decode reads the firmware's
+#     frames (converted to candump -L).
+#  2. Set-pose over SLCAN: decoded with protocol/, posted to the loop; the next pose frames start
+#     from it and the status frame acknowledges it.
+#     USART2 carries the serial counts stream (issue 37) at 100 Hz, checked record by record.
+#  3. A bus fault: the fault handler reports the registers on USART1 and QEMU exits with 3.
+#  4. Calibrated from a flash image (-device loader at sector 10): equal to odometryd with the
+#     same store file; without the image the firmware runs uncalibrated.
+# usage: test_mcu_qemu.sh SOURCE_DIR MCU_ELF   (env ODOMETRYD, ODOMCTL)
+set -u
+src=$1
+elf=$2
+. "$src/tests/cli/lib.sh"  # check, $tmp
+tool="$src/tests/mcu/slcan_tool.py"
+qemu() {  # qemu OUT ARGS...: the firmware with USART1 into OUT; its exit code
+  local out=$1
+  shift
+  local args=arg=odo
+  for a in "$@"; do args="$args,arg=$a"; done
+  timeout 300 qemu-system-arm -M netduinoplus2 -display none -monitor none \
+    -serial "file:$out" -serial "file:$out.usart2" -kernel "$elf" -icount shift=0,sleep=off \
+    -semihosting-config "enable=on,target=native,$args"
+}
+
+# 1. The default square against odometryd.
+qemu "$tmp/usart1.txt"
+check "firmware exits 0 after the square" $?
+tr '\r' '\n' <"$tmp/usart1.txt" | grep '^# end' >"$tmp/end"
+check "firmware's final report" $?
+grep -q ' missed=0 ' "$tmp/end" && grep -q ' dropped=0 ' "$tmp/end"
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "no missed deadline, no dropped frame: $(cat "$tmp/end")" $rc
+"$ODOMETRYD" --virtual-time --can-log "$tmp/host.log" >/dev/null 2>"$tmp/host.err"
+check "odometryd --virtual-time exit 0" $?
+python3 "$tool" candump "$tmp/usart1.txt" "$tmp/mcu.log"
+pose() { grep -E ' (410|411)#' "$1" | sed 's/.* //'; }
+pose "$tmp/host.log" >"$tmp/host.pose"
+pose "$tmp/mcu.log" >"$tmp/mcu.pose"
+[ -s "$tmp/host.pose" ] && cmp -s "$tmp/host.pose" "$tmp/mcu.pose"
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "all $(wc -l <"$tmp/host.pose") pose frames bit-identical to odometryd's" $rc
+[ "$(tail -2 "$tmp/host.pose")" = "$(tail -2 "$tmp/mcu.pose")" ]
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "final broadcast pose identical: $(tail -2 "$tmp/mcu.pose" | tr '\n' ' ')" $rc
+"$ODOMCTL" decode "$tmp/mcu.log" >"$tmp/decoded" 2>&1 && grep -q ' PoseYTheta .*theta=' "$tmp/decoded"
+check "odomctl decode reads the firmware's frames" $?
+# The stopping status (last frame): its stopping flag set, as odometryd's.
+[ "$(tail -1 "$tmp/mcu.log" | sed 's/.* //')" = "$(tail -1 "$tmp/host.log" | sed 's/.* //')" ] ||
+  "$ODOMCTL" decode --csv "$tmp/mcu.log" | grep -q 'Status,stopping,1'
+check "stopping status frame" $?
+
+# USART2: the serial counts stream (issue 37's format, decoded from its spec by slcan_tool.py):
+# one record a tick at the default 100 Hz, the first flagged 'booted', seq +1 and time +10 ms.
+read -r n f0 fmax seq_ok dts ver _ <<<"$(python3 "$tool" serial "$tmp/usart1.txt.usart2")"
+ticks=$(sed -E 's/.* ticks=([0-9]+) .*/\1/' "$tmp/end")
+[ "$n" = "$ticks" ] && [ "$f0" = 4 ] && [ "$fmax" = 0 ] && [ "$seq_ok" = 1 ] && [ "$dts" = "[10000]" ] && [ "$ver" = 1 ]
+check "serial counts on USART2: $n records of $ticks ticks, CRC and COBS valid, seq and 10 ms steps" $?
+
+# 2. Set-pose (10 m, 20 m, 1 rad) after 100 pose frames.
+python3 "$tool" setpose "$elf" 10 20 1 >"$tmp/after.log" 2>"$tmp/after.err"
+check "firmware with set-pose exits 0" $?
+"$ODOMCTL" decode --csv "$tmp/after.log" >"$tmp/after.csv"
+python3 - "$tmp/after.csv" <<'PY'
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+groups, x = [], None  # (x, y) of each pose group: a PoseX, then its PoseYTheta
+for r in rows:
+    if r[4] == "PoseX" and r[5] == "x":
+        x = float(r[6])
+    elif r[4] == "PoseYTheta" and r[5] == "y" and x is not None:
+        groups.append((x, float(r[6])))
+ack = [float(r[6]) for r in rows if r[4] == "Status" and r[5] == "set_pose_ack"]
+gx, gy = next(g for g in groups if g[0] > 5)  # the first pose group after the command
+# The robot moves at most 0.2 m/s: within 2 ticks (20 ms) of the set pose, 4 mm.
+assert abs(gx - 10) < 0.005 and abs(gy - 20) < 0.005, (gx, gy)
+assert ack and ack[-1] == 1, ack
+PY
+check "set-pose over SLCAN: next pose frames start at (10, 20), status acknowledges" $?
+grep -q ' set_pose=1 ' "$tmp/after.err"
+check "firmware counted one set-pose" $?
+
+# 4. Calibrated from flash: a store written by odomctl calib set, its slot A placed at flash
+# sector 10 (0x080C0000, -device loader; the rest of sectors 10-11 erased, 0xFF): the firmware
+# reports the record and its pose frames equal odometryd's with the same store file.
+"$ODOMCTL" calib set --store "$tmp/cal.bin" --cl 0.998 --cr 1.002 --wheelbase 0.337 >/dev/null
+check "odomctl calib set" $?
+python3 - "$tmp/cal.bin" "$tmp/calimg.bin" <<'PY'
+import sys
+d = open(sys.argv[1], "rb").read()
+n = int.from_bytes(d[6:8], "little")  # the record's length field (slot A starts the file)
+img = bytearray(b"\xff" * (2 * 128 * 1024))
+img[:n] = d[:n]
+open(sys.argv[2], "wb").write(img)
+PY
+sed "s|^store = .*|store = \"$tmp/cal.bin\"|" "$src/firmware/config/odometryd.toml" >"$tmp/cal.toml"
+"$ODOMETRYD" --config "$tmp/cal.toml" --virtual-time --can-log "$tmp/hostcal.log" >"$tmp/hostcal.err" 2>&1
+check "odometryd with the store exit 0" $?
+grep -q 'calibration.*ok, sequence 1' "$tmp/hostcal.err"
+check "odometryd runs calibrated" $?
+timeout 300 qemu-system-arm -M netduinoplus2 -display none -monitor none \
+  -serial "file:$tmp/cal.txt" -serial null -kernel "$elf" -icount shift=0,sleep=off \
+  -device "loader,file=$tmp/calimg.bin,addr=0x080C0000" \
+  -semihosting-config enable=on,target=native,arg=odo
+check "calibrated firmware exits 0" $?
+tr '\r' '\n' <"$tmp/cal.txt" | grep -q '^# calibration (flash sectors 10-11): ok, sequence 1'
+check "firmware loads the record from flash" $?
+python3 "$tool" candump "$tmp/cal.txt" "$tmp/mcucal.log"
+pose "$tmp/hostcal.log" >"$tmp/hostcal.pose"
+pose "$tmp/mcucal.log" >"$tmp/mcucal.pose"
+[ -s "$tmp/hostcal.pose" ] && cmp -s "$tmp/hostcal.pose" "$tmp/mcucal.pose" &&
+  ! cmp -s "$tmp/hostcal.pose" "$tmp/host.pose"
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "calibrated: $(wc -l <"$tmp/mcucal.pose") pose frames equal odometryd's, unlike the uncalibrated run" $rc
+"$ODOMCTL" decode --csv "$tmp/mcucal.log" | grep 'Status,calibration_state,' | tail -1 | grep -q ',1$'
+check "Status says calibrated" $?
+tr '\r' '\n' <"$tmp/usart1.txt" | grep -q '^# calibration (flash sectors 10-11): uncalibrated'
+check "without the image: uncalibrated" $?
+
+# 3. Fault report.
+qemu "$tmp/fault.txt" --fault
+[ $? = 3 ]
+check "bus fault: exit code 3" $?
+tr '\r' '\n' <"$tmp/fault.txt" | grep -E '^# FAULT exc=0x00000003 .* pc=0x0800[0-9A-F]{4} .*cfsr=0x0000..00 hfsr=0x40000000' >/dev/null
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "fault handler prints the registers ($(tr '\r' '\n' <"$tmp/fault.txt" | grep FAULT | cut -c1-60)...)" $rc
+
+echo "test_mcu_qemu: $pass passed, $fail failed"
+[ "$fail" = 0 ]

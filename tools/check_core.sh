@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# check_core.sh - the house rules that a compiler or configure step does not check by itself
+# (README "Layout", issue 33). Exit 1 with the offending lines when a rule is broken.
+#   portable   the core rooms (hal, odometry, calibration, loop, protocol) include no Linux or
+#              POSIX header, start no thread, use no iostream, and compile with -fno-exceptions
+#              -fno-rtti (preset core-portable: those libraries only); the microcontroller
+#              build stands on this
+#   functions  no function of the project's own code (tests excepted) is longer than 60 lines
+#              (clang-tidy's readability-function-size over build/default's compile database)
+# The layer table needs no check here: configure (odo_check_layers) fails on a wrong link.
+# Usage: tools/check_core.sh [portable] [functions]   (default: both)
+set -euo pipefail
+ODO_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$ODO_ROOT"
+core_rooms=(hal odometry calibration loop protocol)
+max_lines=60
+rc=0
+
+check_portable() {
+  local bad
+  # Headers of an operating system, of threads and of stream I/O: none in the core.
+  bad=$(grep -rnE '#include <(unistd\.h|fcntl\.h|poll\.h|termios\.h|pthread\.h|sys/[a-z_/]+\.h|linux/[a-z_/]+\.h|iostream|fstream|thread|mutex|condition_variable|future|filesystem)>' \
+    "${core_rooms[@]}" || true)
+  bad+=$(grep -rnE 'std::(thread|jthread|async)\b|pthread_create' "${core_rooms[@]}" || true)
+  if [[ -n $bad ]]; then
+    echo "check_core: portable: the core rooms must not use these (Linux, POSIX, threads, streams):"
+    echo "$bad"
+    rc=1
+  fi
+  cmake --preset core-portable >/dev/null
+  if ! cmake --build --preset core-portable -j"${ODO_JOBS:-$(nproc)}"; then
+    echo "check_core: portable: the core rooms do not build with -fno-exceptions -fno-rtti"
+    rc=1
+  else
+    echo "check_core: portable: ${core_rooms[*]}: no OS header, thread or stream; built with -fno-exceptions -fno-rtti"
+  fi
+}
+
+check_functions() {
+  local db=build/default/compile_commands.json files out
+  [[ -f $db ]] || cmake --preset default >/dev/null
+  # The project's own sources, tests and generated code excepted.
+  mapfile -t files < <(git ls-files '*.cpp' | grep -vE '^(tests|build)/')
+  out=$(printf '%s\n' "${files[@]}" | xargs -P"${ODO_JOBS:-$(nproc)}" -n 8 clang-tidy-14 -p build/default \
+    --quiet --checks='-*,readability-function-size' \
+    --config="{CheckOptions: [{key: readability-function-size.LineThreshold, value: '$max_lines'}]}" \
+    2>/dev/null | grep -E 'warning: function .* exceeds recommended size' || true)
+  if [[ -n $out ]]; then
+    echo "check_core: functions: longer than $max_lines lines (split them):"
+    echo "$out"
+    rc=1
+  else
+    echo "check_core: functions: ${#files[@]} files, no function over $max_lines lines"
+  fi
+}
+
+checks=("$@")
+((${#checks[@]})) || checks=(portable functions)
+for c in "${checks[@]}"; do
+  case $c in
+    portable) check_portable ;;
+    functions) check_functions ;;
+    *) echo "check_core: unknown check $c" >&2; exit 2 ;;
+  esac
+done
+exit $rc
