@@ -86,7 +86,8 @@ void print_result(const calib::SelfCalResult& r, bool as_json) {
                      {"sigma_c_l", r.sigma[0]},
                      {"sigma_c_r", r.sigma[1]},
                      {"sigma_wheelbase", r.sigma[2]},
-                     {"scale_held", r.scale_held},
+                     {"sigma_given_scale", r.sigma_given_scale},
+                     {"scale_learnt", r.scale_learnt},
                      {"fixes_used", r.fixes_used},
                      {"fixes_rejected", r.fixes_rejected},
                      {"rejected", rejected},
@@ -103,10 +104,8 @@ void print_result(const calib::SelfCalResult& r, bool as_json) {
   std::cout << "c_l         " << r.estimate.c_l << " (sigma " << r.sigma[0] << ")\n"
             << "c_r         " << r.estimate.c_r << " (sigma " << r.sigma[1] << ")\n"
             << "wheelbase   " << r.estimate.wheelbase << " m (sigma " << r.sigma[2] << " m)\n"
-            << "scale       "
-            << (r.scale_held ? "held at the value in use (the fixes do not determine it)"
-                             : "from the fixes")
-            << "\n"
+            << "scale       " << std::lround(100.0 * r.scale_learnt)
+            << " % of its information from the fixes (0 %: the prior's, the values in use)\n"
             << "fixes       " << r.fixes_used << " used, " << r.fixes_rejected << " rejected";
   for (std::size_t i = 0; i < rejected.size(); ++i)
     std::cout << (i == 0 ? " (fix " : ", ") << rejected[i] << (i + 1 == rejected.size() ? ")" : "");
