@@ -11,6 +11,7 @@
 
 #include "odo/calibration/count_recorder.hpp"
 #include "odo/calibration/selfcal.hpp"
+#include "odo/hal/choice.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
@@ -19,13 +20,19 @@
 
 namespace odo::analysis {
 
+// The time span of a count log: its first and last row [ns].
+struct LogSpan {
+  TimeNs first = 0, last = 0;
+};
+
 // read_count_segments: the replay log `t,left,right` (optionally `gyro_z`, not used yet; t [s]
 // non-decreasing, raw `bits`-wide readings) passed reading by reading through
-// loop::RecordingEncoder, as the daemon records them; recorder limits from `k`. Errors name
-// `source`, the line and the field.
+// loop::RecordingEncoder, as the daemon records them; recorder limits from `k`; the log's time
+// span into `span` when given. Errors name `source`, the line and the field.
 Result<std::vector<calib::CountSegment>> read_count_segments(std::istream& in,
                                                              const std::string& source,
-                                                             const Kinematics& k, int bits);
+                                                             const Kinematics& k, int bits,
+                                                             LogSpan* span = nullptr);
 
 // Standard deviations for fixes whose sigma fields are empty.
 struct FixDefaults {
@@ -34,8 +41,9 @@ struct FixDefaults {
 };
 
 // read_fixes: CSV `t,x,y,theta,sigma_xy,sigma_theta` (t [s] on the log's clock, strictly
-// increasing; theta [rad] empty = heading unknown; sigma_xy in (0, 10] m and sigma_theta in
-// (0, 3.15] rad, empty = `d`). Errors name `source`, the line, the field and its range.
+// increasing; theta [rad] in [-2 pi, 2 pi] (beyond: refused as degrees), empty = heading unknown;
+// sigma_xy in (0, 10] m and sigma_theta in (0, 3.15] rad, empty = `d`). Errors name `source`, the
+// line, the field and its range.
 Result<std::vector<calib::PoseFix>> read_fixes(std::istream& in, const std::string& source,
                                                const FixDefaults& d = {});
 
@@ -77,6 +85,12 @@ std::string selfcal_svg(const std::vector<SelfCalFitPoint>& fits, const calib::F
                         const std::vector<std::string>& notes, const std::string& title);
 
 // ---- Fixes taken anywhere (issue 34): a robot of random geometry, Chong-Kleeman wheel noise ----
+
+// SelfCalScenario: `odomctl selfcal simulate --scenario`: the LabMate's dock excursions through
+// the daemon (issue 18) or open excursions of a random robot with a fix where each ends.
+enum class SelfCalScenario : std::uint8_t { kDock, kOpen };
+inline constexpr Choice<SelfCalScenario> kSelfCalScenarios[] = {{SelfCalScenario::kDock, "dock"},
+                                                                {SelfCalScenario::kOpen, "open"}};
 
 // FixDriveOptions: a drive of excursions, each ending with the robot still for 0.5 s and a fix
 // of its true pose at the middle of the stop.
