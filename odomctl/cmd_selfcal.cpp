@@ -33,6 +33,22 @@ struct FitFixesOpts {
   bool json = false;
 };
 
+// fixes_in_span: every fix lies within the count log's time span (a fix outside it has no
+// counts to be predicted from: a clock offset or the wrong log). The message names the fix by
+// its data row.
+Status fixes_in_span(const std::vector<calib::PoseFix>& fixes, const analysis::LogSpan& span,
+                     const FitFixesOpts& o) {
+  for (std::size_t i = 0; i < fixes.size(); ++i) {
+    if (fixes[i].t >= span.first && fixes[i].t <= span.last) continue;
+    std::ostringstream m;
+    m << o.fixes << ": fix " << i + 1 << " at t = " << to_seconds(fixes[i].t)
+      << " s is outside the time span of " << o.ticks << " [" << to_seconds(span.first) << ", "
+      << to_seconds(span.last) << "] s (are both on the same clock?)";
+    return make_error(Errc::kInvalidArgument, m.str());
+  }
+  return Ok{};
+}
+
 // fit_input: kinematics, segments and fixes; false (message printed) on bad input.
 bool fit_input(const FitFixesOpts& o, calib::FixTrack& track, calib::SelfCalConfig& c) {
   const char* cmd = "odomctl calib fit-fixes: ";
@@ -48,7 +64,8 @@ bool fit_input(const FitFixesOpts& o, calib::FixTrack& track, calib::SelfCalConf
       return false;
     }
   }
-  auto segs = analysis::read_count_segments(ticks, o.ticks, *k, o.kin.bits);
+  analysis::LogSpan span;
+  auto segs = analysis::read_count_segments(ticks, o.ticks, *k, o.kin.bits, &span);
   if (!segs) {
     std::cerr << cmd << segs.error().message << "\n";
     return false;
@@ -56,6 +73,10 @@ bool fit_input(const FitFixesOpts& o, calib::FixTrack& track, calib::SelfCalConf
   auto fx = analysis::read_fixes(fixes, o.fixes);
   if (!fx) {
     std::cerr << cmd << fx.error().message << "\n";
+    return false;
+  }
+  if (auto s = fixes_in_span(*fx, span, o); !s) {
+    std::cerr << cmd << s.error().message << "\n";
     return false;
   }
   auto t = calib::build_track(*segs, *fx);
@@ -76,7 +97,20 @@ bool fit_input(const FitFixesOpts& o, calib::FixTrack& track, calib::SelfCalConf
   return true;
 }
 
-void print_result(const calib::SelfCalResult& r, bool as_json) {
+// failed_bound: for a too-uncertain verdict, which standard deviation (given the scale) was
+// above which bound, e.g. "sigma(b | scale) = 0.00031 m > max_sigma_wheelbase = 0.0002 m".
+std::string failed_bound(const calib::SelfCalResult& r, const calib::SelfCalConfig& c) {
+  const auto i = static_cast<std::size_t>(r.too_uncertain);
+  const char* names[] = {"c_l", "c_r", "b"};
+  const bool b = i == 2;
+  std::ostringstream m;
+  m << "sigma(" << names[i] << " | scale) = " << r.sigma_given_scale[i] << (b ? " m" : "") << " > "
+    << (b ? "max_sigma_wheelbase = " : "max_sigma_factor = ")
+    << (b ? c.max_sigma_wheelbase : c.max_sigma_factor) << (b ? " m" : "");
+  return m.str();
+}
+
+void print_result(const calib::SelfCalResult& r, const calib::SelfCalConfig& c, bool as_json) {
   std::vector<int> rejected;  // fix numbers, 1 = the first data row of FIXES.csv
   for (int i : r.rejected) rejected.push_back(i + 1);
   if (as_json) {
@@ -86,7 +120,8 @@ void print_result(const calib::SelfCalResult& r, bool as_json) {
                      {"sigma_c_l", r.sigma[0]},
                      {"sigma_c_r", r.sigma[1]},
                      {"sigma_wheelbase", r.sigma[2]},
-                     {"scale_held", r.scale_held},
+                     {"sigma_given_scale", r.sigma_given_scale},
+                     {"scale_learnt", r.scale_learnt},
                      {"fixes_used", r.fixes_used},
                      {"fixes_rejected", r.fixes_rejected},
                      {"rejected", rejected},
@@ -97,16 +132,18 @@ void print_result(const calib::SelfCalResult& r, bool as_json) {
                      {"held_out_candidate", r.score_candidate},
                      {"held_out_in_use", r.score_in_use},
                      {"verdict", calib::verdict_name(r.verdict)}};
+    if (r.too_uncertain >= 0) j["failed_bound"] = failed_bound(r, c);
     std::cout << j.dump() << "\n";
     return;
   }
   std::cout << "c_l         " << r.estimate.c_l << " (sigma " << r.sigma[0] << ")\n"
             << "c_r         " << r.estimate.c_r << " (sigma " << r.sigma[1] << ")\n"
             << "wheelbase   " << r.estimate.wheelbase << " m (sigma " << r.sigma[2] << " m)\n"
-            << "scale       "
-            << (r.scale_held ? "held at the value in use (the fixes do not determine it)"
-                             : "from the fixes")
-            << "\n"
+            << "given scale sigma c_l " << r.sigma_given_scale[0] << ", c_r "
+            << r.sigma_given_scale[1] << ", b " << r.sigma_given_scale[2]
+            << " m (what the acceptance bounds test)\n"
+            << "scale       " << std::lround(100.0 * r.scale_learnt)
+            << " % of its information from the fixes (0 %: the prior's, the values in use)\n"
             << "fixes       " << r.fixes_used << " used, " << r.fixes_rejected << " rejected";
   for (std::size_t i = 0; i < rejected.size(); ++i)
     std::cout << (i == 0 ? " (fix " : ", ") << rejected[i] << (i + 1 == rejected.size() ? ")" : "");
@@ -114,7 +151,9 @@ void print_result(const calib::SelfCalResult& r, bool as_json) {
             << " held out, " << r.excursions_skipped << " skipped\n"
             << "residual    chi2/dof " << r.chi2_per_dof << " (fit); held out " << r.score_candidate
             << " against " << r.score_in_use << " with the values in use\n"
-            << "verdict     " << calib::verdict_name(r.verdict) << "\n";
+            << "verdict     " << calib::verdict_name(r.verdict);
+  if (r.too_uncertain >= 0) std::cout << ": " << failed_bound(r, c);
+  std::cout << "\n";
 }
 
 void run_fit_fixes(const FitFixesOpts& o, int& exit_code) {
@@ -130,7 +169,7 @@ void run_fit_fixes(const FitFixesOpts& o, int& exit_code) {
     exit_code = kExitFailed;
     return;
   }
-  print_result(*r, o.json);
+  print_result(*r, c, o.json);
   exit_code = kExitOk;
 }
 
@@ -146,7 +185,11 @@ struct SelfcalOpts {
   int score_runs = 200;  // squares a direction of the systematic E_max,syst
   std::uint64_t seed = 1;
   bool json = false;
-  std::string plot;  // SVG of the convergence, empty: none
+  std::string plot;                    // SVG of the convergence, empty: none
+  std::string scenario_text = "dock";  // as typed; parsed into `scenario`
+  analysis::SelfCalScenario scenario = analysis::SelfCalScenario::kDock;
+  bool direct_drive = false;         // open: encoders on the wheels (else geared)
+  std::string ticks_out, fixes_out;  // open: the count log and fixes fit-fixes reads
 };
 
 // SimDrive: the random excursions as one scenario and the fix moments (ticks in the final
@@ -330,8 +373,94 @@ bool write_plot(const SelfcalOpts& o, const SimOutcome& r, const Scores& sc) {
   return write_output_file(o.plot, svg, "selfcal simulate");
 }
 
+// fit_fixes_command: the `calib fit-fixes` line that fits the files of an open drive.
+std::string fit_fixes_command(const SelfcalOpts& o, const analysis::FixDrive& d,
+                              const calib::SelfCalConfig& c) {
+  std::ostringstream m;
+  m << "odomctl calib fit-fixes --ticks " << o.ticks_out << " --fixes " << o.fixes_out
+    << " --wheel-diameter " << analysis::kSelfCalDn << " --counts-per-rev "
+    << d.geometry.counts_per_rev << " --gear-ratio " << d.geometry.gear_ratio << " --wheelbase "
+    << analysis::kSelfCalBn << " --k-left " << c.odometry_noise.k_left << " --k-right "
+    << c.odometry_noise.k_right;
+  return m.str();
+}
+
+// run_open: --scenario open: a random robot (c_L, c_R up to 0.6 % off, b 1.5 %) drives open
+// excursions with a fix where each ends; the fixes are fit as `calib fit-fixes` would, and
+// --ticks-out / --fixes-out write the files it reads.
+void run_open(const SelfcalOpts& o, int& exit_code) {
+  analysis::FixDriveOptions fo;
+  fo.excursions = o.excursions;
+  fo.sigma_xy = o.sigma_xy;
+  fo.sigma_theta = o.sigma_theta * kRadPerDeg;
+  fo.outliers = o.outliers;
+  fo.direct_drive = o.direct_drive;
+  fo.seed = o.seed;
+  const analysis::FixDrive d = analysis::simulate_fix_drive(fo);
+  const calib::SelfCalConfig c = analysis::fix_drive_config(d, fo);
+  const char* cmd = "selfcal simulate";
+  if ((!o.ticks_out.empty() &&
+       !write_output_file(o.ticks_out, analysis::count_log_csv(d.ticks), cmd)) ||
+      (!o.fixes_out.empty() &&
+       !write_output_file(o.fixes_out, analysis::fixes_csv(d.fixes), cmd))) {
+    exit_code = kExitFailed;
+    return;
+  }
+  auto t = calib::build_track(d.segments, d.fixes);
+  auto r = t ? calib::fit_fixes(*t, c) : Result<calib::SelfCalResult>(t.error());
+  if (!r) {
+    std::cerr << "odomctl selfcal simulate: " << r.error().message << "\n";
+    exit_code = kExitFailed;
+    return;
+  }
+  const int corrupted = static_cast<int>(std::count(d.corrupted.begin(), d.corrupted.end(), true));
+  if (o.json) {
+    nlohmann::json j{{"scenario", "open"},
+                     {"excursions", o.excursions},
+                     {"fixes", d.fixes.size()},
+                     {"corrupted", corrupted},
+                     {"rejected", r->rejected},
+                     {"c_l", r->estimate.c_l},
+                     {"c_r", r->estimate.c_r},
+                     {"wheelbase", r->estimate.wheelbase},
+                     {"sigma", r->sigma},
+                     {"scale_learnt", r->scale_learnt},
+                     {"truth_c_l", d.truth.c_l},
+                     {"truth_c_r", d.truth.c_r},
+                     {"truth_wheelbase", d.truth.wheelbase},
+                     {"verdict", calib::verdict_name(r->verdict)}};
+    std::cout << j.dump() << "\n";
+  } else {
+    std::cout << "excursions  " << o.excursions << " open, fixes " << d.fixes.size() << " ("
+              << corrupted << " corrupted, " << r->fixes_rejected << " rejected)\n"
+              << "c_l         " << r->estimate.c_l << " (sigma " << r->sigma[0] << ", truth "
+              << d.truth.c_l << ")\n"
+              << "c_r         " << r->estimate.c_r << " (sigma " << r->sigma[1] << ", truth "
+              << d.truth.c_r << ")\n"
+              << "wheelbase   " << r->estimate.wheelbase << " m (sigma " << r->sigma[2]
+              << " m, truth " << d.truth.wheelbase << " m)\n"
+              << "scale       " << std::lround(100.0 * r->scale_learnt)
+              << " % of its information from the fixes\n"
+              << "verdict     " << calib::verdict_name(r->verdict)
+              << (r->too_uncertain >= 0 ? ": " + failed_bound(*r, c) : std::string()) << "\n";
+    if (!o.ticks_out.empty() && !o.fixes_out.empty())
+      std::cout << "fit them    " << fit_fixes_command(o, d, c) << "\n";
+  }
+  exit_code = kExitOk;
+}
+
 void run_simulate(const SelfcalOpts& o, int& exit_code) {
-  if (!output_paths_ok({o.plot}, "selfcal simulate")) {
+  if (!output_paths_ok({o.plot, o.ticks_out, o.fixes_out}, "selfcal simulate")) {
+    exit_code = kExitBadInput;
+    return;
+  }
+  if (o.scenario == analysis::SelfCalScenario::kOpen) {
+    run_open(o, exit_code);
+    return;
+  }
+  if (!o.ticks_out.empty() || !o.fixes_out.empty() || o.direct_drive) {
+    std::cerr << "odomctl selfcal simulate: --ticks-out, --fixes-out and --direct-drive need "
+                 "--scenario open (the dock scenario runs the daemon's loop on the LabMate)\n";
     exit_code = kExitBadInput;
     return;
   }
@@ -422,7 +551,19 @@ void add_selfcal(CLI::App& app, int& exit_code) {
   c->add_option("--seed", o->seed, "random seed")->capture_default_str();
   c->add_flag("--json", o->json, "print one JSON object");
   c->add_option("--plot", o->plot, "write an SVG of the estimate's convergence over the fits");
-  c->callback([o, &exit_code] { run_simulate(*o, exit_code); });
+  c->add_option("--scenario", o->scenario_text,
+                "dock: the LabMate from a dock through the daemon; open: a random robot, a fix "
+                "where each excursion ends")
+      ->capture_default_str();
+  c->add_flag("--direct-drive", o->direct_drive, "open: 4096-count encoders on the wheels");
+  c->add_option("--ticks-out", o->ticks_out, "open: write the count log (calib fit-fixes --ticks)");
+  c->add_option("--fixes-out", o->fixes_out, "open: write the fixes (calib fit-fixes --fixes)");
+  c->callback([o, &exit_code] {
+    if (take_choice(parse_choice_of<analysis::SelfCalScenario>(analysis::kSelfCalScenarios,
+                                                               "--scenario", o->scenario_text),
+                    o->scenario, "selfcal simulate", exit_code))
+      run_simulate(*o, exit_code);
+  });
 }
 
 void add_calib_fit_fixes(CLI::App& calib, int& exit_code) {
@@ -444,6 +585,13 @@ void add_calib_fit_fixes(CLI::App& calib, int& exit_code) {
       ->capture_default_str();
   c->add_option("--max-sigma-wheelbase", o->fit.max_sigma_wheelbase,
                 "acceptance bound on sigma(b) [m]")
+      ->capture_default_str();
+  c->add_option("--prior-sigma-factor", o->fit.prior_sigma_factor,
+                "prior standard deviation of c_L, c_R around the values in use (the scale's "
+                "tolerance)")
+      ->capture_default_str();
+  c->add_option("--prior-sigma-wheelbase", o->fit.prior_sigma_wheelbase,
+                "prior standard deviation of b around the value in use [m]")
       ->capture_default_str();
   fw::say_range(c->add_option("--min-improvement", o->fit.min_improvement,
                               "held-out score below (1 - this) x the values in use"),

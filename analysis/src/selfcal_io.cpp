@@ -1,4 +1,5 @@
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 #include "odo/analysis/csv.hpp"
@@ -8,6 +9,8 @@
 
 namespace odo::analysis {
 namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 // RowSource: the current CSV row as an encoder reading.
 class RowSource final : public EncoderSource {
@@ -40,7 +43,8 @@ Result<double> ranged(const CsvReader& csv, const std::string& text, std::string
 
 Result<std::vector<calib::CountSegment>> read_count_segments(std::istream& in,
                                                              const std::string& source,
-                                                             const Kinematics& k, int bits) {
+                                                             const Kinematics& k, int bits,
+                                                             LogSpan* span) {
   if (auto s = check_counter_bits(bits); !s) return std::move(s).error();
   auto limits = calib::recorder_limits(k);
   if (!limits) return std::move(limits).error();
@@ -65,6 +69,10 @@ Result<std::vector<calib::CountSegment>> read_count_segments(std::istream& in,
       std::ostringstream m;
       m << "field 't' = " << *t << " s goes backwards (previous row: " << prev_t << " s)";
       return csv.error(m.str());
+    }
+    if (span != nullptr) {
+      if (prev_t == -HUGE_VAL) span->first = from_seconds(*t);
+      span->last = from_seconds(*t);
     }
     prev_t = *t;
     auto raw_l = csv.parse_int64(f[cl], "left");
@@ -120,6 +128,13 @@ Result<std::vector<calib::PoseFix>> read_fixes(std::istream& in, const std::stri
     if (!field(3).empty()) {
       auto th = csv.parse_double(field(3), "theta");
       if (!th) return std::move(th).error();
+      // A heading beyond a whole turn is not a wrapped angle in radians: most likely degrees.
+      if (std::fabs(*th) > kTwoPi) {
+        std::ostringstream m;
+        m << "field 'theta' = " << *th << " is outside the allowed range [-" << kTwoPi << ", "
+          << kTwoPi << "] rad (headings are in radians; this looks like degrees)";
+        return csv.error(m.str());
+      }
       p.theta = *th;
     }
     auto sxy = ranged(csv, field(4), "sigma_xy", d.sigma_xy, 0.0, 10.0, "m");

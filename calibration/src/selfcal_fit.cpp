@@ -177,20 +177,22 @@ void summarise(const FixTrack& t, const SelfCalConfig& c, const std::vector<int>
   r.chi2_per_dof = dof > 0 ? chi / dof : 0.0;
 }
 
-// hold_scale: when the distance scale m = (c_L + c_R) / 2 is not determined to
-// max_sigma_factor (excursions that return to where they started cannot see it: scaling c_L,
-// c_R and b together scales the whole closed path about its start), the candidate is
-// conditioned on m = m_in_use (Gaussian conditioning: p += K (m_use - m), Sigma -= K a^T Sigma,
-// K = Sigma a / (a^T Sigma a)), which keeps what the data do determine. True when it did.
-bool hold_scale(const SelfCalConfig& c, FitOut& f) {
-  const Vec3 a(0.5, 0.5, 0.0);
-  const Vec3 sa = f.cov * a;
-  const double var = a.dot(sa);
-  if (std::sqrt(var) <= c.max_sigma_factor) return false;
-  const Vec3 k = sa / var;
-  f.p += k * (0.5 * (c.in_use.c_l + c.in_use.c_r) - a.dot(f.p));
-  f.cov -= k * sa.transpose();
-  return true;
+// The distance scale m = (c_L + c_R) / 2 as a direction in p.
+const Vec3 kScale(0.5, 0.5, 0.0);
+
+// given_scale: the covariance conditioned on m (Gaussian conditioning, Sigma - Sigma a a^T
+// Sigma / (a^T Sigma a)): the uncertainty of what is left when the scale is known, which the
+// acceptance bounds test (the scale's own is the prior's at most).
+Mat3 given_scale(const Mat3& cov) {
+  const Vec3 sa = cov * kScale;
+  return cov - sa * sa.transpose() / kScale.dot(sa);
+}
+
+// scale_learnt: 1 - var(m) / prior var(m): the share of the scale's information that came from
+// the fixes (0: a dock drive, the prior's scale kept; towards 1: open drives).
+double scale_learnt(const SelfCalConfig& c, const Mat3& cov) {
+  const double prior = 0.5 * c.prior_sigma_factor * c.prior_sigma_factor;
+  return std::clamp(1.0 - kScale.dot(cov * kScale) / prior, 0.0, 1.0);
 }
 
 // The acceptance folds: which excursions were predicted held out, the summed scores and the
@@ -216,19 +218,24 @@ Status score_folds(const FixTrack& t, const SelfCalConfig& c, const std::vector<
     }
     FitOut ff = detail::fit_once(t, acc, c, train);
     if (!ff.ok) return make_error(Errc::kInvalidArgument, "the fit diverged on the training set");
-    FitOut scored = ff;
-    hold_scale(c, scored);  // predicts with what would be applied
-    held_out_scores(t, c, acc, scored.p, train, out.scores);
+    held_out_scores(t, c, acc, ff.p, train, out.scores);
     if (!cv) out.candidate = ff;
   }
   return Ok{};
 }
 
+// first_too_uncertain: the first of c_L, c_R, b (0..2) whose standard deviation given the
+// scale is above its bound; -1: none.
+int first_too_uncertain(const SelfCalConfig& c, const SelfCalResult& r) {
+  const double bound[3] = {c.max_sigma_factor, c.max_sigma_factor, c.max_sigma_wheelbase};
+  for (int i = 0; i < 3; ++i)
+    if (r.sigma_given_scale[static_cast<std::size_t>(i)] > bound[i]) return i;
+  return -1;
+}
+
 Verdict decide(const SelfCalConfig& c, const SelfCalResult& r) {
   if (r.excursions_held_out == 0) return Verdict::kNoHeldOut;
-  if (r.sigma[0] > c.max_sigma_factor || r.sigma[1] > c.max_sigma_factor ||
-      r.sigma[2] > c.max_sigma_wheelbase)
-    return Verdict::kTooUncertain;
+  if (r.too_uncertain >= 0) return Verdict::kTooUncertain;
   return r.score_candidate < (1.0 - c.min_improvement) * r.score_in_use ? Verdict::kAccepted
                                                                         : Verdict::kNotBetter;
 }
@@ -252,14 +259,16 @@ Result<SelfCalResult> fit_fixes(const FixTrack& t, const SelfCalConfig& c) {
   if (auto s = score_folds(t, c, acc, folds); !s) return std::move(s).error();
   FitOut& f = folds.candidate;
   SelfCalResult r;
-  r.free_scale = detail::to_factors(f.p);
-  r.scale_held = hold_scale(c, f);
   r.initial = detail::to_factors(f.initial);
   r.estimate = detail::to_factors(f.p);
+  const Mat3 cond = given_scale(f.cov);
   for (int i = 0; i < 9; ++i) r.covariance[static_cast<std::size_t>(i)] = f.cov(i / 3, i % 3);
-  // max(0, .): the conditioned variance along the held direction is zero up to rounding.
-  for (int i = 0; i < 3; ++i)
-    r.sigma[static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, f.cov(i, i)));
+  // max(0, .): the conditioned variance of a direction the scale fixes is zero up to rounding.
+  for (int i = 0; i < 3; ++i) {
+    r.sigma[static_cast<std::size_t>(i)] = std::sqrt(f.cov(i, i));
+    r.sigma_given_scale[static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, cond(i, i)));
+  }
+  r.scale_learnt = scale_learnt(c, f.cov);
   r.iterations = f.iterations;
   r.fixes_used = static_cast<int>(acc.size());
   r.fixes_rejected = static_cast<int>(rejected.size());
@@ -273,6 +282,7 @@ Result<SelfCalResult> fit_fixes(const FixTrack& t, const SelfCalConfig& c) {
     r.score_candidate = folds.scores.cand / folds.scores.dof;
     r.score_in_use = folds.scores.use / folds.scores.dof;
   }
+  r.too_uncertain = first_too_uncertain(c, r);
   r.verdict = decide(c, r);
   return r;
 }

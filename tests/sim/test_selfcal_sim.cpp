@@ -147,11 +147,6 @@ TEST(SELFCAL_SUITE, NoiseFreeFixesWithinFiveHundredthsOfAPercent) {
       EXPECT_LT(rel_err(r->estimate.wheelbase, tr.wheelbase), 5e-4);
       EXPECT_EQ(r->fixes_rejected, 0);
       EXPECT_EQ(r->verdict, calib::Verdict::kAccepted);
-      // The data alone (before the scale is held at the in-use 1, which is the LabMate's true
-      // mean) are within 0.05 % too.
-      EXPECT_LT(rel_err(r->free_scale.c_l, tr.c_l), 5e-4);
-      EXPECT_LT(rel_err(r->free_scale.c_r, tr.c_r), 5e-4);
-      EXPECT_LT(rel_err(r->free_scale.wheelbase, tr.wheelbase), 5e-4);
     }
   }
 }
@@ -191,11 +186,14 @@ std::pair<double, double> noisy_seed(std::uint64_t seed, bool table) {
         r->score_candidate, r->score_in_use, calib::verdict_name(r->verdict), 1e3 * m.wheelbase,
         1e3 * e_manual);
     if (n != 21U) continue;
-    // The rough floor shortens the true travel by about 0.3 % and the dock cannot see the
-    // scale, which stays at 1: the effective b is about 0.337 / 0.997 = 338.0 mm (the manual
-    // pass finds 338.2 mm). So b is not compared with the geometric 337 mm here.
+    // The rough floor shortens the true travel by about 0.3 % and the dock barely sees the
+    // scale, which stays near the prior's 1: the effective b is about 0.337 / 0.997 = 338.0 mm
+    // (the manual pass finds 338.2 mm). So b is not compared with the geometric 337 mm here.
     EXPECT_EQ(r->fixes_rejected, 0);
-    EXPECT_TRUE(r->scale_held);
+    // A dock drive: the excursions end near the dock, not at it (planned from the noise-free
+    // pose, driven on the rough floor), so the fixes see the scale a little (seeds 1-4: 9-33 %
+    // of its information); the rest is the prior's.
+    EXPECT_LT(r->scale_learnt, 0.5);
     EXPECT_EQ(r->verdict, calib::Verdict::kAccepted);
     EXPECT_LT(r->score_candidate, r->score_in_use);
   }

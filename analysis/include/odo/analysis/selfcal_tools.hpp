@@ -11,20 +11,28 @@
 
 #include "odo/calibration/count_recorder.hpp"
 #include "odo/calibration/selfcal.hpp"
+#include "odo/hal/choice.hpp"
 #include "odo/hal/result.hpp"
+#include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
 #include "odo/odometry/pose.hpp"
 #include "odo/sim/robot.hpp"
 
 namespace odo::analysis {
 
+// The time span of a count log: its first and last row [ns].
+struct LogSpan {
+  TimeNs first = 0, last = 0;
+};
+
 // read_count_segments: the replay log `t,left,right` (optionally `gyro_z`, not used yet; t [s]
 // non-decreasing, raw `bits`-wide readings) passed reading by reading through
-// loop::RecordingEncoder, as the daemon records them; recorder limits from `k`. Errors name
-// `source`, the line and the field.
+// loop::RecordingEncoder, as the daemon records them; recorder limits from `k`; the log's time
+// span into `span` when given. Errors name `source`, the line and the field.
 Result<std::vector<calib::CountSegment>> read_count_segments(std::istream& in,
                                                              const std::string& source,
-                                                             const Kinematics& k, int bits);
+                                                             const Kinematics& k, int bits,
+                                                             LogSpan* span = nullptr);
 
 // Standard deviations for fixes whose sigma fields are empty.
 struct FixDefaults {
@@ -33,8 +41,9 @@ struct FixDefaults {
 };
 
 // read_fixes: CSV `t,x,y,theta,sigma_xy,sigma_theta` (t [s] on the log's clock, strictly
-// increasing; theta [rad] empty = heading unknown; sigma_xy in (0, 10] m and sigma_theta in
-// (0, 3.15] rad, empty = `d`). Errors name `source`, the line, the field and its range.
+// increasing; theta [rad] in [-2 pi, 2 pi] (beyond: refused as degrees), empty = heading unknown;
+// sigma_xy in (0, 10] m and sigma_theta in (0, 3.15] rad, empty = `d`). Errors name `source`, the
+// line, the field and its range.
 Result<std::vector<calib::PoseFix>> read_fixes(std::istream& in, const std::string& source,
                                                const FixDefaults& d = {});
 
@@ -74,5 +83,79 @@ struct SelfCalFitPoint {
 // rest; `notes` (e.g. E_max,syst before and after) as text lines under the plot.
 std::string selfcal_svg(const std::vector<SelfCalFitPoint>& fits, const calib::Factors& truth,
                         const std::vector<std::string>& notes, const std::string& title);
+
+// ---- Fixes taken anywhere (issue 34): a robot of random geometry, Chong-Kleeman wheel noise ----
+
+// SelfCalScenario: `odomctl selfcal simulate --scenario`: the LabMate's dock excursions through
+// the daemon (issue 18) or open excursions of a random robot with a fix where each ends.
+enum class SelfCalScenario : std::uint8_t { kDock, kOpen };
+inline constexpr Choice<SelfCalScenario> kSelfCalScenarios[] = {{SelfCalScenario::kDock, "dock"},
+                                                                {SelfCalScenario::kOpen, "open"}};
+
+// FixDriveOptions: a drive of excursions, each ending with the robot still for 0.5 s and a fix
+// of its true pose at the middle of the stop.
+struct FixDriveOptions {
+  int excursions = 20;
+  bool dock = false;                   // true: excursions return to the dock (random_excursion);
+                                       // false: open, 4-9 pieces (straights, arcs, spins)
+  double sigma_xy = 0.005;             // fix noise [m]
+  double sigma_theta = 0.0087266;      // [rad] (0.5 deg)
+  double outliers = 0.0;               // fraction of fixes (not the first) moved 0.5-5 m
+  double max_factor_error = 0.006;     // c_L, c_R uniform in 1 +- this ...
+  double max_wheelbase_error = 0.015;  // ... and b in b_n (1 +- this), independently
+  // > 0: c_L, c_R ~ N(1, prior_sigma_factor^2), b ~ N(b_n, prior_sigma_wheelbase^2) instead (the
+  // truth drawn from the estimator's prior: what a coverage test of a dock drive needs, since
+  // there the scale's uncertainty is the prior's).
+  double prior_sigma_factor = 0.0;
+  double prior_sigma_wheelbase = 0.0;  // [m]
+  bool direct_drive = false;           // encoder on the wheel: 4096 counts/rev, no gear (else
+                                       // 2048 counts/rev through a 16:1 gear)
+  ErrorModelParams wheel_noise{};      // the true robot's k_L, k_R [m^(1/2)]
+  std::uint64_t seed = 1;
+};
+
+// A count log row at 100 Hz: `t,left,right` as `odomctl replay` / `calib fit-fixes` read it.
+struct CountRow {
+  double t = 0.0;  // [s]
+  std::int64_t left = 0, right = 0;
+};
+
+struct FixDrive {
+  sim::RobotGeometry geometry;  // the true robot
+  calib::Factors truth;         // its c_L = D_L / Dn, c_R = D_R / Dn, b [m]
+  KinematicParams nominal;      // what the robot believes (factors 1, b_n)
+  std::vector<CountRow> ticks;
+  std::vector<calib::CountSegment> segments;  // the ticks through the loop's recorder
+  std::vector<calib::PoseFix> fixes;
+  std::vector<Pose2> true_poses;  // at every fix
+  std::vector<bool> corrupted;    // per fix
+};
+
+// simulate_fix_drive: the drive of `o` (repeatable for a seed).
+FixDrive simulate_fix_drive(const FixDriveOptions& o);
+
+// fix_drive_config: the estimator's configuration for a drive: nominal values in use, the
+// drive's wheel noise, prior and bounds of `base`.
+calib::SelfCalConfig fix_drive_config(const FixDrive& d, const FixDriveOptions& o,
+                                      calib::SelfCalConfig base = {});
+
+// write_count_log / write_fixes: the CSV files `calib fit-fixes` reads (full precision).
+std::string count_log_csv(const std::vector<CountRow>& rows);
+std::string fixes_csv(const std::vector<calib::PoseFix>& fixes);
+
+// ReferenceFit: the exact-model Gauss-Newton of issue 34 (maximum likelihood, no prior): the
+// unknowns are p = (c_L, c_R, b) and the true pose at every fix; the residuals are every fix
+// against its pose (its sigmas) and every excursion's end pose against the exact arcs from its
+// start pose (Chong-Kleeman covariance), Jacobians by central differences. Written apart from
+// calib::fit_fixes (no shared code but arc_step and the error model) as its yardstick.
+struct ReferenceFit {
+  calib::Factors estimate;
+  calib::ParamCov covariance{};
+  int iterations = 0;
+  double last_step = 0.0;  // largest |step| of p in the last iteration
+};
+// reference_fit: over the fixes `use` marks (all when empty); excursions between used fixes.
+ReferenceFit reference_fit(const calib::FixTrack& t, const calib::SelfCalConfig& c,
+                           const std::vector<bool>& use = {});
 
 }  // namespace odo::analysis

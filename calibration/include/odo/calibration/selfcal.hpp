@@ -6,19 +6,25 @@
 // Model: a segment with counts (n_L, n_R) moves the wheels d_L = c_L c_m n_L, d_R = c_R c_m n_R
 // (UMBmark Eq. 6.35, c_m the nominal metres per count) and is one exact arc (odo::arc_step).
 // Pipeline (fit_fixes):
-//  1. Initial value, Antonelli, Chiaverini & Fusco 2005: the heading change of an excursion
-//     between two heading fixes is linear in (u_R, u_L) = (c_R/b, c_L/b); with those the
-//     position change is linear in (c_L, c_R); b = LS fit of (c_L, c_R) = b (u_L, u_R).
+//  1. Start value: the calibration in use (the prior's mean). The linear estimate of Antonelli,
+//     Chiaverini & Fusco 2005 (heading change between heading fixes linear in (u_R, u_L) =
+//     (c_R/b, c_L/b); with those the position change linear in (c_L, c_R); b = LS fit of
+//     (c_L, c_R) = b (u_L, u_R)) is reported as `initial`: as a start it was 3-12 % off on open
+//     drives and Gauss-Newton stalled at the box's edge from there (issue 34).
 //  2. Gauss-Newton on the exact model with analytic Jacobians, residual = fix - prediction.
 //     An excursion's residual covariance is S = Sigma_end + G Sigma_start G^T + Sigma_odo: the
 //     end fix's covariance, the start fix's propagated through the excursion (G = d end /
 //     d start) and the Chong-Kleeman wheel noise along the excursion. Consecutive excursions
 //     share a fix, so their residuals correlate: Cov(r_k, r_k+1) = -Sigma_fix G_k+1^T. The fit
-//     is weighted by that joint (block-tridiagonal) covariance, frozen at the start value (with
-//     per-excursion weights the reported sigma was 19 % too small against a Monte Carlo), plus a
-//     prior N(calibration in use, sigma_prior) that keeps unobservable directions (spins only,
-//     straights only) finite. A step that would leave the plausible box (factors 0.5 .. 1.5,
-//     b within 0.5 .. 2 times the in-use b) is halved until it does not.
+//     is weighted by that joint (block-tridiagonal) covariance (with per-excursion weights the
+//     reported sigma was 19 % too small against a Monte Carlo), evaluated at the estimate of
+//     the pass before (three passes; frozen at the start it left open drives 4-6 sigma off),
+//     plus the prior N(calibration in use, diag(prior_sigma_factor^2 (c_L, c_R),
+//     prior_sigma_wheelbase^2)): the user's tolerance of the values in use (e.g. of the wheel
+//     diameter), which also keeps unobservable directions (spins only, straights only, the
+//     scale of dock drives) finite. The covariance is that posterior's. A step that would
+//     leave the plausible box (factors 0.5 .. 1.5, b within 0.5 .. 2 times the in-use b) is
+//     halved until it does not.
 //  3. Outliers: a fix's score is the mean over the (at most two) excursions touching it of
 //     chi2 / gate(dof), chi2 = r^T S^-1 r of the fitted estimate, gate = chi-square 99.9 %
 //     quantile (13.82 for x, y; 16.27 for x, y, theta). While the largest score exceeds 1, that
@@ -30,23 +36,27 @@
 //     rejected): the rejection starts again, removing each time the fix whose removal leaves
 //     the smallest chi2 per dof (leave-one-out).
 //  4. Scale: excursions that end where they started (a dock) cannot see the distance scale:
-//     multiplying c_L, c_R and b by one factor scales the closed path about its start. When the
-//     standard deviation of m = (c_L + c_R)/2 exceeds max_sigma_factor, the estimate and its
-//     covariance are conditioned on m = m_in_use (scale_held): what the data determine (the
-//     ratio c_R/c_L and the turn rates c/b) is kept, the scale stays as it was.
+//     multiplying c_L, c_R and b by one factor scales the closed path about its start. Fixes
+//     away from the start (a map, a surveyed point, GNSS) see it. The prior decides in between:
+//     a dock drive keeps the prior's scale (the values in use, prior_sigma_factor), an open drive
+//     learns it, and the posterior covariance says how much (scale_learnt); nothing switches.
 //  5. Acceptance: excursion k (in time order, after rejection) belongs to fold
 //     k % hold_out_every. The score of a parameter set is the mean chi2 per degree of freedom
 //     of its predictions of held-out excursions (S of the calibration in use for both).
 //     kHoldOut: only the last fold is held out; the candidate is the fit on the other
 //     excursions and is scored on that fold. kCrossValidated (default): every fold is held out
-//     in turn, each excursion predicted by the fit of the other folds (scale held as in 4); the
+//     in turn, each excursion predicted by the fit of the other folds; the
 //     candidate is the fit on all excursions, which has hold_out_every / (hold_out_every - 1)
 //     times the training data (issue 18's LabMate: E_max,syst 11.6 -> 8.2 mm, BENCHMARKS.md).
 //     The cross-validated score judges the estimator on excursions it did not see; the
 //     candidate itself saw them all. The candidate is accepted only when every standard
-//     deviation is below its bound AND the score is lower than (1 - min_improvement) times the
-//     calibration in use's (a margin: near the truth two calibrations score alike, and without
-//     it a 24 h soak wrote 45 records, 19 of them worse than the one before by E_max,syst).
+//     deviation given the scale (sigma_given_scale: c_L, c_R below max_sigma_factor, b below
+//     max_sigma_wheelbase) is within its bound AND the score is lower than (1 - min_improvement)
+//     times the calibration in use's (a margin: near the truth two calibrations score alike,
+//     and without it a 24 h soak wrote 45 records, 19 of them worse than the one before by
+//     E_max,syst). The bounds do not apply to the scale: its posterior is never wider than the
+//     prior, so a dock drive writes the ratio and the turn rates with the prior's scale, and an
+//     open drive writes the scale as far as its fixes determined it.
 // Fix headings are used where present. A fix without heading contributes x, y only; the next
 // excursion then starts with the heading predicted by the previous one (its derivative carried
 // along, its variance taken as that of the last heading fix: that heading's correlation with
@@ -110,7 +120,7 @@ using ParamCov = std::array<double, 9>;
 struct SelfCalConfig {
   double metres_per_count = 0.0;     // c_m, nominal [m/count] (Kinematics::metres_per_count)
   Factors in_use{1.0, 1.0, 0.0};     // calibration in use: prior mean and the acceptance baseline
-  double prior_sigma_factor = 0.05;  // prior standard deviation of c_L, c_R
+  double prior_sigma_factor = 0.01;  // prior standard deviation of c_L, c_R
   double prior_sigma_wheelbase = 0.02;  // [m]
   ErrorModelParams odometry_noise{};    // wheel noise k_L, k_R [m^(1/2)] in S
   int max_iterations = 20;              // Gauss-Newton
@@ -138,15 +148,16 @@ enum class Verdict : std::uint8_t {
 const char* verdict_name(Verdict v) noexcept;
 
 struct SelfCalResult {
-  Factors initial;                // Antonelli et al. linear estimate (in_use where not observable)
-  Factors estimate;               // Gauss-Newton on the training excursions (scale: below)
-  Factors free_scale;             // the same before the scale was held
-  bool scale_held = false;        // sigma((c_L + c_R)/2) was above max_sigma_factor: estimate
-                                  // and covariance are conditioned on the in-use value
-  ParamCov covariance{};          // of estimate
+  Factors initial;                // Antonelli et al. linear estimate (reported, not the start)
+  Factors estimate;               // Gauss-Newton on the training excursions, with the prior
+  ParamCov covariance{};          // of estimate (posterior: prior and fixes)
   std::array<double, 3> sigma{};  // sqrt of the diagonal: c_L, c_R, b [-, -, m]
-  int iterations = 0;             // Gauss-Newton iterations of the last fit
-  int fixes_used = 0;             // accepted fixes
+  std::array<double, 3> sigma_given_scale{};  // the same with m = (c_L + c_R)/2 known: what the
+                                              // acceptance bounds test
+  double scale_learnt = 0.0;  // 1 - var(m) / prior var(m): 0 the prior's scale, 1 the fixes'
+  int too_uncertain = -1;     // kTooUncertain: c_L, c_R, b (0..2) the first over its bound
+  int iterations = 0;         // Gauss-Newton iterations of the last fit (all passes)
+  int fixes_used = 0;         // accepted fixes
   int fixes_rejected = 0;
   std::vector<int> rejected;     // indices into FixTrack::fixes
   int excursions_fit = 0;        // in the candidate's fit

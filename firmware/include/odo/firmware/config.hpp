@@ -317,7 +317,7 @@ struct SelfCalSection {
   double max_sigma_factor = 2e-4;       // acceptance bound on sigma(c_L), sigma(c_R)
   double max_sigma_wheelbase = 2e-4;    // [m] acceptance bound on sigma(b)
   double min_improvement = 0.1;         // held-out score below (1 - this) x the one in use
-  double prior_sigma_factor = 0.05;     // prior around the calibration in use
+  double prior_sigma_factor = 0.01;     // prior around the calibration in use
   double prior_sigma_wheelbase = 0.02;  // [m]
 };
 
