@@ -449,33 +449,13 @@ void run_open(const SelfcalOpts& o, int& exit_code) {
   exit_code = kExitOk;
 }
 
-void run_simulate(const SelfcalOpts& o, int& exit_code) {
-  if (!output_paths_ok({o.plot, o.ticks_out, o.fixes_out}, "selfcal simulate")) {
-    exit_code = kExitBadInput;
-    return;
-  }
-  if (o.scenario == analysis::SelfCalScenario::kOpen) {
-    run_open(o, exit_code);
-    return;
-  }
-  if (!o.ticks_out.empty() || !o.fixes_out.empty() || o.direct_drive) {
-    std::cerr << "odomctl selfcal simulate: --ticks-out, --fixes-out and --direct-drive need "
-                 "--scenario open (the dock scenario runs the daemon's loop on the LabMate)\n";
-    exit_code = kExitBadInput;
-    return;
-  }
-  std::mt19937_64 rng(o.seed);
-  const SimDrive d = plan_drive(o, rng);
-  const SimOutcome r = simulate_drive(o, d, rng);
+// print_dock: the dock scenario's outcome (--json or text): counters, the factors against the
+// simulation's truth, E_max,syst [m] nominal, self-calibrated and after a manual pass.
+void print_dock(const SelfcalOpts& o, const SimOutcome& r, const calib::Factors& fin,
+                const Scores& sc) {
   const calib::Factors truth = analysis::selfcal_truth();
-  const calib::Factors fin{r.final.c_l, r.final.c_r, r.final.wheelbase};
-  const Scores sc = score(o, fin);
   const double *e5 = sc.e5, *e_sys = sc.e_sys;
   const double before = e5[0], after = e5[1], e_manual = e5[2];
-  if (!o.plot.empty() && !write_plot(o, r, sc)) {
-    exit_code = kExitFailed;
-    return;
-  }
   const fw::SelfCalCounters& c = r.counters;
   if (o.json) {
     nlohmann::json j{{"excursions", o.excursions},
@@ -513,6 +493,33 @@ void run_simulate(const SelfcalOpts& o, int& exit_code) {
               << " mm self-calibrated, " << e_sys[2] * 1e3 << " mm after one manual UMBmark pass ("
               << o.score_runs << " + " << o.score_runs << " squares)\n";
   }
+}
+
+void run_simulate(const SelfcalOpts& o, int& exit_code) {
+  if (!output_paths_ok({o.plot, o.ticks_out, o.fixes_out}, "selfcal simulate")) {
+    exit_code = kExitBadInput;
+    return;
+  }
+  if (o.scenario == analysis::SelfCalScenario::kOpen) {
+    run_open(o, exit_code);
+    return;
+  }
+  if (!o.ticks_out.empty() || !o.fixes_out.empty() || o.direct_drive) {
+    std::cerr << "odomctl selfcal simulate: --ticks-out, --fixes-out and --direct-drive need "
+                 "--scenario open (the dock scenario runs the daemon's loop on the LabMate)\n";
+    exit_code = kExitBadInput;
+    return;
+  }
+  std::mt19937_64 rng(o.seed);
+  const SimDrive d = plan_drive(o, rng);
+  const SimOutcome r = simulate_drive(o, d, rng);
+  const calib::Factors fin{r.final.c_l, r.final.c_r, r.final.wheelbase};
+  const Scores sc = score(o, fin);
+  if (!o.plot.empty() && !write_plot(o, r, sc)) {
+    exit_code = kExitFailed;
+    return;
+  }
+  print_dock(o, r, fin, sc);
   exit_code = kExitOk;
 }
 
