@@ -172,7 +172,7 @@ stage_config() {  # build one configuration and run its ctest tiers
     # (measured on cross-aarch64). They run natively in default and debug-asan; the same
     # functions' hand-derived unit tests (ErrorModel.*, SelfCal.*, ...) run here too.
     if [[ $c == cross-* ]]; then
-      exclude=(--exclude-regex '^(ErrorMonteCarlo|ErrorModelFit|SelfCalSim|SelfCalSoak)\.')
+      exclude=(--exclude-regex '^(ErrorMonteCarlo|ErrorModelFit|SelfCalSim|SelfCalSoak|SelfCalOpen)\.')
     fi
     if gated "$c" "build/$c/ctest-tiers.log" ctest --preset "$c" -j"$jobs" --label-regex "$labels" \
       "${exclude[@]}"
