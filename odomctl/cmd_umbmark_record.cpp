@@ -27,6 +27,7 @@
 #include "odo/analysis/calibration_json.hpp"
 #include "odo/analysis/umbmark_tools.hpp"
 #include "odo/calibration/umbmark_tape.hpp"
+#include "odo/firmware/calibration_store.hpp"
 #include "odo/firmware/can_listen.hpp"
 #include "odo/firmware/config.hpp"
 #include "odo/hal/field_range.hpp"
@@ -586,11 +587,39 @@ std::optional<calib::Factors> factor_sigmas(const calib::UmbmarkInput& ui,
   return calib::Factors{std::sqrt(s.c_l), std::sqrt(s.c_r), std::sqrt(s.wheelbase)};
 }
 
-// print_import: what an import would change: the factors the robot used during the runs
-// against the new ones, with the new ones' sigmas.
+// StoreNow: what --store holds before an import: its factors when it holds a calibration, and
+// the words for the preview's heading either way.
+struct StoreNow {
+  std::optional<calib::Factors> factors;
+  std::string what;
+};
+
+// store_now: reads --store without changing it (a missing file is not created here); a record
+// without a wheelbase leaves the daemon's configured one, `wheelbase` [m].
+StoreNow store_now(const std::string& path, double wheelbase) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return {std::nullopt, path + " does not exist yet"};
+  auto s = fw::open_calibration_store(path, NvBackend::kAuto);
+  if (!s) return {std::nullopt, s.error().message};
+  auto l = s->store->load();
+  if (!l) return {std::nullopt, l.error().message};
+  if (l->status != calib::StoreStatus::kOk || !l->record || l->record->cleared)
+    return {std::nullopt, path + ": " + l->describe()};
+  const calib::CalibrationRecord& r = *l->record;
+  return {calib::Factors{r.c_l, r.c_r, r.wheelbase.value_or(wheelbase)},
+          "in " + path + " now, sequence " + std::to_string(r.sequence)};
+}
+
+// print_import: what an import would change: the factors in the store now (or, for a store
+// without a calibration, those the robot used during the runs) against the new ones, with the
+// new ones' sigmas; and a note when the store holds other factors than the runs were driven
+// with (--current-*, --wheelbase: UMBmark composes the new factors from those).
 void print_import(const RecordOpts& o, const calib::UmbmarkInput& ui,
                   const calib::UmbmarkResult& r) {
   const std::optional<calib::Factors> sd = factor_sigmas(ui, r);
+  const StoreNow now = store_now(o.store, o.wheelbase);
+  const calib::Factors used{o.cl, o.cr, o.wheelbase};
+  const calib::Factors old = now.factors.value_or(used);
   auto row = [&](const char* name, double old_v, double new_v, std::optional<double> sigma,
                  double unit, const char* unit_name, int digits) {
     std::cout << "  " << std::left << std::setw(10) << name << std::right << std::fixed
@@ -599,12 +628,25 @@ void print_import(const RecordOpts& o, const calib::UmbmarkInput& ui,
     if (sigma) std::cout << "  (sigma " << *sigma * unit << unit_name << ")";
     std::cout << "\n";
   };
-  std::cout << "the import would store (used during the runs -> new):\n";
-  row("c_l", o.cl, r.composed.c_l, sd ? std::optional(sd->c_l) : std::nullopt, 1.0, "", 6);
-  row("c_r", o.cr, r.composed.c_r, sd ? std::optional(sd->c_r) : std::nullopt, 1.0, "", 6);
-  row("wheelbase", o.wheelbase, r.composed.wheelbase,
+  if (now.factors)
+    std::cout << "the import would store (" << now.what << " -> new):\n";
+  else
+    std::cout << "the import would store (used during the runs -> new; " << now.what << "):\n";
+  row("c_l", old.c_l, r.composed.c_l, sd ? std::optional(sd->c_l) : std::nullopt, 1.0, "", 6);
+  row("c_r", old.c_r, r.composed.c_r, sd ? std::optional(sd->c_r) : std::nullopt, 1.0, "", 6);
+  row("wheelbase", old.wheelbase, r.composed.wheelbase,
       sd ? std::optional(sd->wheelbase) : std::nullopt, 1e3, " mm", 1);
   if (!sd) std::cout << "  (sigmas unknown: fewer than 3 runs a direction)\n";
+  // 1e-6: what `calib show` prints (6 decimals) and a person types back counts as the same.
+  const bool differ = now.factors && (std::fabs(old.c_l - used.c_l) > 1e-6 ||
+                                      std::fabs(old.c_r - used.c_r) > 1e-6 ||
+                                      std::fabs(old.wheelbase - used.wheelbase) > 1e-6);
+  if (differ)
+    std::cout << std::setprecision(6) << "  note: the new factors are composed from those the runs "
+              << "were driven with (--current-cl " << used.c_l << " --current-cr " << used.c_r
+              << " --wheelbase " << used.wheelbase << "), not from the store's: if odometryd ran "
+              << "with the store's, answer N and record again with --current-cl " << old.c_l
+              << " --current-cr " << old.c_r << " --wheelbase " << old.wheelbase << "\n";
 }
 
 // finish: the computation over all runs, --out, and the offer to import into --store.

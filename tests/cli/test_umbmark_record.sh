@@ -140,9 +140,9 @@ for la, lb in zip(a[1:], b[1:]):
     assert abs(float(fa[3]) - float(fb[3])) <= 1.6e-4, (la, lb)
 PY
 check "live record CSV = simulate --csv (same seed) within the CAN resolution" $?
-# The import shows the factors used during the runs against the new ones with their sigmas,
-# then stores what it showed.
-grep -q "the import would store (used during the runs -> new):" "$tmp/session" &&
+# The import shows the factors used during the runs against the new ones with their sigmas (the
+# store does not exist yet: nothing else to show), then stores what it showed.
+grep -q "the import would store (used during the runs -> new; .*rec.bin does not exist yet):" "$tmp/session" &&
   grep -Eq "^  c_l +1.000000 -> [0-9.]+  \(sigma [0-9.]+\)$" "$tmp/session" &&
   grep -Eq "^  wheelbase +340.0 mm -> [0-9.]+ mm  \(sigma [0-9.]+ mm\)$" "$tmp/session"
 check "record: the import shows old -> new and sigmas: $(grep -A3 "import would" "$tmp/session" | tr '\n' '|')" $?
@@ -156,6 +156,39 @@ assert s["status"] == "ok" and abs(s["c_l"] - float(shown)) <= 5e-7, (s, shown)
 assert abs(s["c_l"] - r["c_l"]) < 1e-9 and abs(s["wheelbase"] - r["b_new"]) < 1e-9, (s, r)
 PY
 check "record's import into the store = what it showed and --out" $?
+
+# The same command again: every run is in the CSV, so the session goes straight to the import,
+# now over a store that holds the factors just imported. The preview's "old" values are the
+# store's (issue 35), and the runs were driven with --current-cl 1 while the store holds others:
+# a note says so and how to record again. With the store's values given, no note. Answer N.
+printf 'n\n' >"$tmp/no"
+resume() {
+  run "$ODOMCTL" umbmark record --csv "$tmp/rec.csv" --can-log "$tmp/pose.log" --side 0.5 \
+    --runs 2 --answers "$tmp/no" --store "$tmp/rec.bin" "$@" >"$tmp/resume" 2>&1
+}
+resume --wheelbase 0.34
+check "record resumed with every run saved: exit 0: $(tail -2 "$tmp/resume" | tr '\n' '|')" $?
+python3 - "$tmp/rs.json" "$tmp/resume" <<'PY'
+import json, re, sys
+s = json.load(open(sys.argv[1]))
+t = open(sys.argv[2]).read()
+assert re.search(r"^the import would store \(in .*rec\.bin now, sequence %d -> new\):$" % s["sequence"], t, re.M), t
+old = float(re.search(r"^  c_l +([0-9.]+) -> ", t, re.M).group(1))
+assert abs(old - s["c_l"]) <= 5e-7, (old, s)
+b = float(re.search(r"^  wheelbase +([0-9.]+) mm -> ", t, re.M).group(1))
+assert abs(b - 1e3 * s["wheelbase"]) <= 0.05, (b, s)
+assert "note: the new factors are composed from those the runs were driven with (--current-cl 1.000000" in t, t
+assert "not imported." in t, t
+PY
+check "record resumed: the preview's old values are the store's, with the --current-* note" $?
+args=$(python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); print("--current-cl %.9f --current-cr %.9f --wheelbase %.9f" % (s["c_l"], s["c_r"], s["wheelbase"]))' "$tmp/rs.json")
+# shellcheck disable=SC2086
+resume $args
+[ $? = 0 ] && grep -q "^the import would store (in .*rec.bin now" "$tmp/resume" && ! grep -q "note:" "$tmp/resume"
+check "record resumed with the store's values as --current-*: no note" $?
+run "$ODOMCTL" calib show --store "$tmp/rec.bin" --json >"$tmp/rs2.json" 2>/dev/null
+cmp -s "$tmp/rs.json" "$tmp/rs2.json"
+check "answering N leaves the store as it was" $?
 
 # --- the recorder's logic on a log being written: live_log.py writes the log of a running
 # daemon (fresh stamps) from a virtual-time square's frames; each "drive" line in its control
