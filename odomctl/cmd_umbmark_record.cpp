@@ -562,31 +562,6 @@ bool load_runs(const RecordOpts& o, std::vector<UmbmarkRun>& runs) {
   return true;
 }
 
-// factor_sigmas: the standard deviations of the composed c_l, c_r, b_new [m] from the spread
-// of the runs: each direction's centre of gravity is uncertain by its SEM (sigma / sqrt(n)) in
-// x and y, independently; each of these four is moved by its SEM (every plain run of the
-// direction shifted) and the changes of the factors are added in quadrature (first order).
-// nullopt without a spread (fewer than 3 runs) or when a moved set does not compute.
-std::optional<calib::Factors> factor_sigmas(const calib::UmbmarkInput& ui,
-                                            const calib::UmbmarkResult& r) {
-  if (!r.spread.sigma) return std::nullopt;
-  calib::Factors s{0.0, 0.0, 0.0};
-  for (const auto& [d, n] :
-       {std::pair{Direction::kCw, r.cw.n}, std::pair{Direction::kCcw, r.ccw.n}})
-    for (const bool in_x : {true, false}) {
-      const double sem = *r.spread.sigma / std::sqrt(static_cast<double>(n));
-      calib::UmbmarkInput moved = ui;
-      for (UmbmarkRun& run : moved.runs)
-        if (run.direction == d && !run.bumps) (in_x ? run.ex : run.ey) += sem;
-      auto m = calib::umbmark_compute(moved);
-      if (!m) return std::nullopt;
-      s.c_l += std::pow(m->composed.c_l - r.composed.c_l, 2);
-      s.c_r += std::pow(m->composed.c_r - r.composed.c_r, 2);
-      s.wheelbase += std::pow(m->composed.wheelbase - r.composed.wheelbase, 2);
-    }
-  return calib::Factors{std::sqrt(s.c_l), std::sqrt(s.c_r), std::sqrt(s.wheelbase)};
-}
-
 // StoreNow: what --store holds before an import: its factors when it holds a calibration, and
 // the words for the preview's heading either way.
 struct StoreNow {
@@ -616,7 +591,7 @@ StoreNow store_now(const std::string& path, double wheelbase) {
 // with (--current-*, --wheelbase: UMBmark composes the new factors from those).
 void print_import(const RecordOpts& o, const calib::UmbmarkInput& ui,
                   const calib::UmbmarkResult& r) {
-  const std::optional<calib::Factors> sd = factor_sigmas(ui, r);
+  const std::optional<calib::Factors> sd = calib::factor_sigmas(ui, r);
   const StoreNow now = store_now(o.store, o.wheelbase);
   const calib::Factors used{o.cl, o.cr, o.wheelbase};
   const calib::Factors old = now.factors.value_or(used);

@@ -202,4 +202,26 @@ Result<UmbmarkResult> umbmark_compute(const UmbmarkInput& in) {
   return out;
 }
 
+std::optional<Factors> factor_sigmas(const UmbmarkInput& in, const UmbmarkResult& r) {
+  if (!r.spread.sigma) return std::nullopt;
+  double v_l = 0.0, v_r = 0.0, v_b = 0.0;  // variances
+  UmbmarkInput moved = in;                 // allocates: a report's computation, not the loop's
+  for (const auto& [d, n] :
+       {std::pair{Direction::kCw, r.cw.n}, std::pair{Direction::kCcw, r.ccw.n}})
+    for (const bool in_x : {true, false}) {
+      const double sem = *r.spread.sigma / std::sqrt(static_cast<double>(n));
+      moved.runs = in.runs;
+      // Bump runs are not part of the centre of gravity (centre_of_gravity): not moved.
+      for (UmbmarkRun& run : moved.runs)
+        if (run.direction == d && !run.bumps) (in_x ? run.ex : run.ey) += sem;
+      auto m = umbmark_compute(moved);
+      if (!m) return std::nullopt;
+      v_l += (m->composed.c_l - r.composed.c_l) * (m->composed.c_l - r.composed.c_l);
+      v_r += (m->composed.c_r - r.composed.c_r) * (m->composed.c_r - r.composed.c_r);
+      v_b += (m->composed.wheelbase - r.composed.wheelbase) *
+             (m->composed.wheelbase - r.composed.wheelbase);
+    }
+  return Factors{std::sqrt(v_l), std::sqrt(v_r), std::sqrt(v_b)};
+}
+
 }  // namespace odo::calib

@@ -238,6 +238,55 @@ TEST(Umbmark, ComputeEndToEnd) {
   EXPECT_NEAR(r2->composed.c_r, 0.998 * 1.000085000, 1e-9);
 }
 
+// factor_sigmas, derived by hand. Three runs a direction on a square of L = 4 m, b = 0.34 m,
+// current factors 1: (d, 0), (-d, 0), (0, 0) each, d = 10 mm. Both centres of gravity are
+// (0, 0), so alpha = beta = 0: b_new = b, c_l = c_r = 1 (R undefined: E_d = 1).
+// Spread: sum |e - cg|^2 = 4 d^2 over n_cw + n_ccw - 2 = 4 dof, sigma = d; each direction's
+// SEM s = d / sqrt(3). With k = -4L = -16 and alpha = (alpha_x + alpha_y) / 2, beta likewise:
+//   cw.x += s:  alpha_x = s/k, beta_x = s/k    -> alpha = s/2k, beta = s/2k
+//   cw.y += s:  alpha_y = s/k, beta_y = s/k    -> alpha = s/2k, beta = s/2k
+//   ccw.x += s: alpha_x = s/k, beta_x = -s/k   -> alpha = s/2k, beta = -s/2k
+//   ccw.y += s: alpha_y = -s/k, beta_y = s/k   -> alpha = -s/2k, beta = s/2k
+// With a = s/32 (= |s/2k|): alpha = -a three times and +a once.
+// b_new = b q/(q - alpha) (Eq. 6.29, q = pi/2): its change is b alpha/(q - alpha), so
+//   sigma_b^2 = 3 (b a/(q + a))^2 + (b a/(q - a))^2.
+// c_l = 2/(E_d + 1) with E_d = (R + b/2)/(R - b/2) and R = (L/2)/sin(beta/2) is exactly
+// 1 - b sin(beta/2)/L, c_r = 1 + b sin(beta/2)/L; |beta| = a in all four moves:
+//   sigma_cl = sigma_cr = sqrt(4 (b sin(a/2)/L)^2) = 2 b sin(a/2)/L.
+// The moves are finite, so these are exact, not first-order: only rounding separates them.
+TEST(Umbmark, FactorSigmasFromTheSemOfEachCentreOfGravity) {
+  const double d = 0.010, L = 4.0, b = 0.34;
+  UmbmarkInput in;
+  in.side = L;
+  in.current = {1.0, 1.0, b};
+  in.runs = {cw(d, 0), cw(-d, 0), cw(0, 0), ccw(d, 0), ccw(-d, 0), ccw(0, 0)};
+  auto r = umbmark_compute(in);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_TRUE(r->spread.sigma.has_value());
+  EXPECT_NEAR(*r->spread.sigma, d, 1e-15);
+  const auto sd = factor_sigmas(in, *r);
+  ASSERT_TRUE(sd.has_value());
+  const double s = d / std::sqrt(3.0), a = s / 32.0, q = kPi / 2.0;
+  const double sigma_b = b * std::sqrt(3.0 * std::pow(a / (q + a), 2) + std::pow(a / (q - a), 2));
+  const double sigma_c = 2.0 * b * std::sin(a / 2.0) / L;
+  EXPECT_NEAR(sd->wheelbase, sigma_b, 1e-12 * sigma_b);
+  EXPECT_NEAR(sd->c_l, sigma_c, 1e-9 * sigma_c);
+  EXPECT_NEAR(sd->c_r, sigma_c, 1e-9 * sigma_c);
+  // Bump runs are not in a centre of gravity: adding one (with its heading) changes nothing.
+  in.runs.push_back({Direction::kCw, 0.5, 0.5, 0.01, true});
+  in.runs.front().etheta = 0.0;
+  auto rb = umbmark_compute(in);
+  ASSERT_TRUE(rb.ok()) << rb.error().message;
+  const auto sdb = factor_sigmas(in, *rb);
+  ASSERT_TRUE(sdb.has_value());
+  EXPECT_NEAR(sdb->wheelbase, sigma_b, 1e-12 * sigma_b);
+  // Fewer than 3 runs in all: no spread, no sigmas.
+  in.runs = {cw(d, 0), ccw(d, 0)};
+  auto r2 = umbmark_compute(in);
+  ASSERT_TRUE(r2.ok());
+  EXPECT_FALSE(factor_sigmas(in, *r2).has_value());
+}
+
 TEST(Umbmark, ComputeRejectsBadInputNamingTheField) {
   auto message = [](UmbmarkInput in) {
     auto r = umbmark_compute(in);

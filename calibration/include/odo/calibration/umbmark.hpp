@@ -164,6 +164,14 @@ struct UmbmarkResult {
   std::vector<std::string> warnings;       // e.g. fewer than 5 runs a direction
 };
 
+// factor_sigmas: the standard deviations of `r.composed` (c_l, c_r, b_new [m]) from the spread
+// of the runs of `in` it was computed from: each direction's centre of gravity is uncertain by
+// its SEM (sigma / sqrt(n)) in x and in y, independently; each of these four is moved by its SEM
+// (every plain run of the direction shifted), the set computed again, and the changes of the
+// factors added in quadrature (first order). nullopt without a spread (fewer than 3 runs) or
+// when a moved set does not compute.
+std::optional<Factors> factor_sigmas(const UmbmarkInput& in, const UmbmarkResult& r);
+
 // umbmark_compute: the whole UMBmark calculation. Errors (Errc::kInvalidArgument, message names
 // the field and the allowed range): side or wheelbase not positive and finite, a current factor
 // outside [0.9, 1.1], a non-finite run value, no plain run in a direction, |alpha| or |beta| >
