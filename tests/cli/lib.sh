@@ -6,6 +6,8 @@
 # poll SECONDS CMD...  runs CMD every 0.1 s until it succeeds (at most SECONDS); non-zero on timeout
 # wait_text FILE TEXT  waits until FILE holds TEXT (at most 30 s); non-zero on timeout
 # start_live_log LOG DRIVE  a daemon's log being written at LOG (live_log.py), $relay its pid
+# serial_config PROTOCOL DEVICE [BAUD [SECTIONS]]  writes $tmp/serial.toml: [encoder] serial on
+#                 DEVICE, store and state in $tmp; SECTIONS (TOML text) goes first
 set -u
 run() { ${CROSS_EMULATOR:-} "$@"; }
 fail=0; pass=0
@@ -38,4 +40,28 @@ start_live_log() {
   python3 "$(dirname "${BASH_SOURCE[0]}")/live_log.py" "$tmp/live_sq.log" "$1" "$2" &
   relay=$!
   poll 5 grep -qs " 411#" "$1"
+}
+# serial_config PROTOCOL DEVICE [BAUD [SECTIONS]]: odometryd's config for the serial counts
+# backend (issue 37) as the serial tests run it: reopen after 0.1 s, 3 s for the first record,
+# the calibration store and the state record in $tmp; SECTIONS (e.g. "[loop]\nrate_hz = 500")
+# first.
+serial_config() {
+  : >"$tmp/serial.toml"
+  if [ -n "${4:-}" ]; then printf '%b\n' "$4" >"$tmp/serial.toml"; fi  # no blank line: the
+  # bad-config checks name the line of a key
+  cat >>"$tmp/serial.toml" <<TOML
+[encoder]
+backend = "serial"
+[serial]
+device = "$2"
+protocol = "$1"
+baud = ${3:-115200}
+reopen_period = 0.1
+start_wait = 3.0
+[calibration]
+store = "$tmp/cal.bin"
+backend = "file"
+[resume]
+path = "$tmp/state.bin"
+TOML
 }

@@ -10,27 +10,9 @@
 set -u
 . "$(dirname "$0")/lib.sh"  # run, check, $tmp, jget
 
-config() {  # config PROTOCOL DEVICE [BAUD]
-  cat >"$tmp/serial.toml" <<TOML
-[encoder]
-backend = "serial"
-[serial]
-device = "$2"
-protocol = "$1"
-baud = ${3:-115200}
-reopen_period = 0.1
-start_wait = 3.0
-[calibration]
-store = "$tmp/cal.bin"
-backend = "file"
-[resume]
-path = "$tmp/state.bin"
-TOML
-}
-
 one_protocol() {  # one_protocol PROTOCOL
   local p=$1
-  config "$p" "$tmp/board"
+  serial_config "$p" "$tmp/board"
   rm -f "$tmp/state.bin"
   run "$SERIAL_PEER" --link "$tmp/board" --protocol "$p" --duration 9.5 --log "$tmp/$p.csv" \
     --garbage-at 2.0 --unplug-at 3.5 --unplug-for 0.5 --garbage-at 5.5 --reset-at 6.5 \
@@ -93,7 +75,7 @@ cat "$tmp"/peer-*.err >&2
 # reboot is SIGUSR1 to the peer once the second run has ended, not a time: under a cross build's
 # emulator each start of odometryd takes longer, and a fixed schedule let the third run come
 # after the board's second of booted records, or after the board had stopped (stop 36's CI).
-config diffodom "$tmp/board"
+serial_config diffodom "$tmp/board"
 rm -f "$tmp/state.bin"
 # exec: $! is then the peer (or its emulator) itself, not a subshell that would take the signal.
 (exec ${CROSS_EMULATOR:-} "$SERIAL_PEER" --link "$tmp/board" --protocol diffodom --duration 120 \
@@ -112,7 +94,7 @@ kill "$peer"
 wait "$peer"
 
 # A board that never answers: odometryd runs, the wheels are stale, nothing moves.
-config arduino-bridge "$tmp/board"
+serial_config arduino-bridge "$tmp/board"
 run "$SERIAL_PEER" --link "$tmp/board" --protocol arduino-bridge --duration 4 --silent \
   2>/dev/null &
 peer=$!
@@ -135,11 +117,11 @@ bad() {  # bad NAME PATTERN
   [ "$rc" = 2 ] && grep -q -- "$2" "$tmp/bad.err"
   check "$1 (rc $rc: $(head -c 300 "$tmp/bad.err"))" $?
 }
-config diffodom "$tmp/no-such-board"
+serial_config diffodom "$tmp/no-such-board"
 bad "missing device" "serial.toml:5: serial.device.*no-such-board.*No such file"
-config diffodom /dev/null
+serial_config diffodom /dev/null
 bad "not a tty" "serial.toml:5: serial.device.*/dev/null\" is not a tty"
-config diffodom /dev/null 12345
+serial_config diffodom /dev/null 12345
 bad "unsupported baud" "serial.toml:7: serial.baud = 12345 is not a supported baud rate"
 
 echo "test_serial: $pass passed, $fail failed"

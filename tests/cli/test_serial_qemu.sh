@@ -30,22 +30,7 @@ qemu_start() {  # qemu_start N: QEMU with USART2 on a new pty, linked at $tmp/u2
   ln -sfn "$pts" "$tmp/u2"
 }
 
-cat >"$tmp/serial.toml" <<TOML
-[loop]
-rate_hz = 500
-[encoder]
-backend = "serial"
-[serial]
-device = "$tmp/board"
-protocol = "diffodom"
-reopen_period = 0.1
-start_wait = 3.0
-[calibration]
-store = "$tmp/cal.bin"
-backend = "file"
-[resume]
-path = "$tmp/state.bin"
-TOML
+serial_config diffodom "$tmp/board" 115200 "[loop]\nrate_hz = 500"
 
 python3 "$src/tests/tools/serial_relay.py" --source "$tmp/u2" --link "$tmp/board" \
   --log "$tmp/relay.csv" --duration 30 --start-after 2.0 --garbage-at 4.0 --unplug-at 6.0 \
