@@ -572,8 +572,8 @@ struct StoreNow {
 // store_now: reads --store without changing it (a missing file is not created here); a record
 // without a wheelbase leaves the daemon's configured one, `wheelbase` [m].
 StoreNow store_now(const std::string& path, double wheelbase) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) return {std::nullopt, path + " does not exist yet"};
+  // A missing file says why (not written yet, or a directory that does not exist: a typo).
+  if (auto absent = fw::store_absence(path, NvBackend::kAuto)) return {std::nullopt, absent->text};
   auto s = fw::open_calibration_store(path, NvBackend::kAuto);
   if (!s) return {std::nullopt, s.error().message};
   auto l = s->store->load();
@@ -606,7 +606,7 @@ void print_import(const RecordOpts& o, const calib::UmbmarkInput& ui,
   if (now.factors)
     std::cout << "the import would store (" << now.what << " -> new):\n";
   else
-    std::cout << "the import would store (used during the runs -> new; " << now.what << "):\n";
+    std::cout << "the import would store (used during the runs -> new):\n  (" << now.what << ")\n";
   row("c_l", old.c_l, r.composed.c_l, sd ? std::optional(sd->c_l) : std::nullopt, 1.0, "", 6);
   row("c_r", old.c_r, r.composed.c_r, sd ? std::optional(sd->c_r) : std::nullopt, 1.0, "", 6);
   row("wheelbase", old.wheelbase, r.composed.wheelbase,

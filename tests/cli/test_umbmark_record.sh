@@ -142,7 +142,8 @@ PY
 check "live record CSV = simulate --csv (same seed) within the CAN resolution" $?
 # The import shows the factors used during the runs against the new ones with their sigmas (the
 # store does not exist yet: nothing else to show), then stores what it showed.
-grep -q "the import would store (used during the runs -> new; .*rec.bin does not exist yet):" "$tmp/session" &&
+grep -q "the import would store (used during the runs -> new):" "$tmp/session" &&
+  grep -q "^  (.*rec.bin does not exist yet; it is created when a calibration is first stored" "$tmp/session" &&
   grep -Eq "^  c_l +1.000000 -> [0-9.]+  \(sigma [0-9.]+\)$" "$tmp/session" &&
   grep -Eq "^  wheelbase +340.0 mm -> [0-9.]+ mm  \(sigma [0-9.]+ mm\)$" "$tmp/session"
 check "record: the import shows old -> new and sigmas: $(grep -A3 "import would" "$tmp/session" | tr '\n' '|')" $?
