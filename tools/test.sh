@@ -136,11 +136,9 @@ build_config() {
   # Under CI the default tree keeps line tables only (-g1, as the sanitizer presets): debug
   # information does not change the code GCC generates, the package strips it anyway, and full
   # -g is a quarter of every file's compile. A developer's default tree keeps full -g.
-  local flags=()
-  if [[ $1 == default ]]; then
-    flags=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g -DNDEBUG")  # CMake's own default for GCC
-    if in_ci; then flags=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG"); fi
-  fi
+  local flags=() g=-g  # -g: CMake's own default for GCC
+  if in_ci; then g=-g1; fi
+  if [[ $1 == default ]]; then flags=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 $g -DNDEBUG"); fi
   cmake --preset "$1" -DODO_WERROR=$werror "${flags[@]}" >/dev/null &&
     cmake --build --preset "$1" -j"$2"
 }
