@@ -430,8 +430,8 @@ bool read_end_pose(Prompter& in, PoseFeed& feed, const RecordOpts& o, const char
     if (!out.path || *out.path >= kMinPathFraction * 4.0 * o.side) return true;
     std::ostringstream m;
     m << "the odometry moved " << std::fixed << std::setprecision(3) << *out.path
-      << " m since the start pose, a square of " << o.side << " m is " << 4.0 * o.side
-      << " m: drive the square (is --side right?), then press Enter";
+      << " m since the start pose, a square of " << std::defaultfloat << o.side << " m is "
+      << 4.0 * o.side << " m: drive the square (is --side right?), then press Enter";
     if (in.scripted()) {
       std::cerr << "odomctl " << kCmd << ": " << m.str() << "\n";
       return false;

@@ -1,6 +1,9 @@
 # lib.sh - what every CLI test script shares; sourced, not run:  . "$(dirname "$0")/lib.sh"
 # run CMD...      runs a target binary (under the cross build's emulator when CROSS_EMULATOR is set)
-# check NAME RC   counts a check as passed when RC is 0, else prints "FAIL: NAME"
+# check NAME RC   counts a check as passed when RC is 0, else prints "FAIL: NAME". A NAME with a
+#                 command substitution sets $? before RC is expanded: take the status first
+#                 (`rc_=$?` on the line before); `check "... $(cat err)" $?` always passed (39
+#                 checks until stop 40)
 # $tmp            a scratch directory removed at exit
 # jget FILE KEY   prints the value at the dotted KEY of the JSON object in FILE
 # poll SECONDS CMD...  runs CMD every 0.1 s until it succeeds (at most SECONDS); non-zero on timeout

@@ -17,14 +17,16 @@ printf '[loop]\nstatus_period = 0\n[calibration]\nstore = "%s"\n' "$tmp/cal.bin"
 run "$ODOMETRYD" --config "$tmp/d0.toml" --virtual-time --duration 1 --json >"$tmp/out" 2>"$tmp/err"
 check "odometryd on a missing store exit 0" $?
 [ "$(jget "$tmp/out" calibration_state)" = 0 ] && grep -q "uncalibrated .*running on nominal values" "$tmp/err"
-check "odometryd on a missing store: state 0, nominal: $(grep calibration "$tmp/err")" $?
+rc_=$?
+check "odometryd on a missing store: state 0, nominal: $(grep calibration "$tmp/err")" $rc_
 [ ! -e "$tmp/cal.bin" ]; check "odometryd does not create the store" $?
 # A store device that is not there: runs on nominal values, state 2 (an error, not "uncalibrated").
 printf '[loop]\nstatus_period = 0\n[calibration]\nstore = "/dev/mtd99"\n' >"$tmp/dx.toml"
 run "$ODOMETRYD" --config "$tmp/dx.toml" --virtual-time --duration 1 --json >"$tmp/out" 2>"$tmp/err"
 check "odometryd on a missing store device exit 0" $?
 [ "$(jget "$tmp/out" calibration_state)" = 2 ] && grep -q "ERROR: cannot read the store.*NOMINAL" "$tmp/err"
-check "odometryd on a missing store device: state 2: $(grep calibration "$tmp/err")" $?
+rc_=$?
+check "odometryd on a missing store device: state 2: $(grep calibration "$tmp/err")" $rc_
 
 # set: a subset; the rest keep their values.
 run "$ODOMCTL" calib set "${S[@]}" --cl 0.998 --wheelbase 0.337 >/dev/null 2>"$tmp/err"

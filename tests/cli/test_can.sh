@@ -127,7 +127,8 @@ kill -0 $dpid 2>/dev/null
 alive=$?
 [ $rc = 0 ] && [ $alive = 0 ] && grep -Eq "^# [1-9][0-9]* frames, [1-9][0-9]* of this protocol" "$tmp/live.out" &&
   [ "$n2" -gt "$n1" ]
-check "decode beside the running daemon: rc $rc, daemon running $alive, $(tail -1 "$tmp/live.out"), lines $n1 -> $n2" $?
+rc_=$?
+check "decode beside the running daemon: rc $rc, daemon running $alive, $(tail -1 "$tmp/live.out"), lines $n1 -> $n2" $rc_
 wait $dpid
 check "live --can-log daemon exit 0" $?
 # Ring accounting kept: the JSON counts every frame as written or dropped.
@@ -144,7 +145,8 @@ run "$ODOMCTL" decode "$tmp/partial.log" >"$tmp/p.out" 2>"$tmp/p.err"
 rc=$?
 [ $rc = 0 ] && grep -q "^# $whole frames" "$tmp/p.out" &&
   grep -q "partial.log:$((whole + 1)): the last line has no newline yet (still being written?): left out" "$tmp/p.err"
-check "decode: partial last line left out: rc $rc, $(tail -1 "$tmp/p.out"), $(cat "$tmp/p.err")" $?
+rc_=$?
+check "decode: partial last line left out: rc $rc, $(tail -1 "$tmp/p.out"), $(cat "$tmp/p.err")" $rc_
 
 echo "test_can.sh: $pass passed, $fail failed"
 [ "$fail" = 0 ]

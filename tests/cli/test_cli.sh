@@ -46,14 +46,16 @@ printf '[calibration]\nstore = ""\n[gyro]\ndelay = 0\n' >"$tmp/g0.toml"
 run "$ODOMCTL" replay --ticks "$tmp/spin.csv" --config "$tmp/g0.toml" --json >"$tmp/cfg.json" 2>"$tmp/err"
 check "replay spin log, --config: exit 0" $?
 [ "$(jget "$tmp/def.json" gyro.disagreements)" -gt 0 ] && [ "$(jget "$tmp/cfg.json" gyro.disagreements)" = 0 ]
-check "replay --config takes [gyro] delay: $(jget "$tmp/def.json" gyro.disagreements) events with the default, $(jget "$tmp/cfg.json" gyro.disagreements) with the config" $?
+rc_=$?
+check "replay --config takes [gyro] delay: $(jget "$tmp/def.json" gyro.disagreements) events with the default, $(jget "$tmp/cfg.json" gyro.disagreements) with the config" $rc_
 run "$ODOMCTL" replay --ticks "$tmp/spin.csv" "${geometry[@]}" --no-gyro --json >"$tmp/odo.json" 2>/dev/null
 [ "$(jget "$tmp/cfg.json" theta)" = "$(jget "$tmp/odo.json" theta)" ]
 check "replay --config, nothing flagged: the heading is odometry's" $?
 printf '[gyro]\nwindow = 0.015\n' >"$tmp/gbad.toml"
 run "$ODOMCTL" replay --ticks "$tmp/spin.csv" --config "$tmp/gbad.toml" >"$tmp/out" 2>"$tmp/err"
 rc=$?; [ $rc = 2 ] && grep -q "gbad.toml:2: gyro.window = 0.015 is outside the allowed range \[0.02, 10\] s" "$tmp/err"
-check "replay --config: a bad key is the daemon's message with its line (got $rc: $(cat "$tmp/err"))" $?
+rc_=$?
+check "replay --config: a bad key is the daemon's message with its line (got $rc: $(cat "$tmp/err"))" $rc_
 run "$ODOMCTL" replay --ticks "$tmp/spin.csv" --config "$tmp/g0.toml" --wheelbase 0.3 >"$tmp/out" 2>"$tmp/err"
 rc=$?; [ $rc = 2 ] && grep -q -- "--config excludes --wheelbase" "$tmp/err"
 check "replay --config with a geometry option: exit 2 (got $rc)" $?

@@ -8,7 +8,8 @@ T="$tmp/ticks.csv"; F="$tmp/fixes.csv"
 
 run "$ODOMCTL" selfcal simulate --scenario open --excursions 8 --seed 3 \
   --ticks-out "$T" --fixes-out "$F" >"$tmp/sim.txt" 2>"$tmp/err"
-check "simulate open exit 0 ($(cat "$tmp/err"))" $?
+rc_=$?
+check "simulate open exit 0 ($(cat "$tmp/err"))" $rc_
 [ -s "$T" ] && [ -s "$F" ] && head -1 "$T" | grep -qx "t,left,right" &&
   head -1 "$F" | grep -qx "t,x,y,theta,sigma_xy,sigma_theta"
 check "simulate open writes the count log and the fixes" $?
@@ -19,7 +20,8 @@ fit=$(sed -n 's/^fit them    //p' "$tmp/sim.txt")
 [ -n "$fit" ]; check "simulate open prints the fit-fixes command" $?
 # shellcheck disable=SC2086
 run $ODOMCTL ${fit#odomctl } --json >"$tmp/fit.json" 2>"$tmp/err"
-check "fit-fixes on the simulated files exit 0 ($(cat "$tmp/err"))" $?
+rc_=$?
+check "fit-fixes on the simulated files exit 0 ($(cat "$tmp/err"))" $rc_
 python3 - "$tmp/sim.json" "$tmp/fit.json" <<'PY'
 import json, sys
 s, f = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
@@ -44,7 +46,7 @@ open(sys.argv[2], "w").write("\n".join(rows) + "\n")
 PY
 run "$ODOMCTL" calib fit-fixes --ticks "$T" --fixes "$tmp/deg.csv" "${args[@]}" >"$tmp/out" 2>"$tmp/err"
 rc=$?; [ $rc = 2 ]; check "fixes in degrees exit 2 (got $rc)" $?
-grep -q "deg.csv:4: field .theta. = 90 is outside.*looks like degrees" "$tmp/err"; check "degrees named: $(cat "$tmp/err")" $?
+grep -q "deg.csv:4: field .theta. = 90 is outside.*looks like degrees" "$tmp/err"; rc_=$?; check "degrees named: $(cat "$tmp/err")" $rc_
 [ ! -s "$tmp/out" ]; check "degrees: nothing on stdout" $?
 
 # A fix after the log's end: refused, naming the fix and the span.
@@ -57,7 +59,8 @@ PY
 run "$ODOMCTL" calib fit-fixes --ticks "$T" --fixes "$tmp/late.csv" "${args[@]}" >"$tmp/out" 2>"$tmp/err"
 rc=$?; [ $rc = 2 ]; check "fix outside the log exit 2 (got $rc)" $?
 grep -q "late.csv: fix 9 at t = .* is outside the time span of" "$tmp/err"
-check "fix outside the log named: $(cat "$tmp/err")" $?
+rc_=$?
+check "fix outside the log named: $(cat "$tmp/err")" $rc_
 
 # Too uncertain: the verdict says which bound failed.
 run "$ODOMCTL" calib fit-fixes --ticks "$T" --fixes "$F" "${args[@]}" --max-sigma-wheelbase 1e-6 \
@@ -65,19 +68,23 @@ run "$ODOMCTL" calib fit-fixes --ticks "$T" --fixes "$F" "${args[@]}" --max-sigm
 check "too-uncertain exit 0" $?
 [ "$(jget "$tmp/out" verdict)" = too-uncertain ] &&
   jget "$tmp/out" failed_bound | grep -q "^sigma(b | scale) = .* m > max_sigma_wheelbase = 1e-06 m$"
-check "too-uncertain names the bound: $(cat "$tmp/out")" $?
+rc_=$?
+check "too-uncertain names the bound: $(cat "$tmp/out")" $rc_
 run "$ODOMCTL" calib fit-fixes --ticks "$T" --fixes "$F" "${args[@]}" --max-sigma-wheelbase 1e-6 \
   >"$tmp/out" 2>"$tmp/err"
 grep -q "^verdict     too-uncertain: sigma(b | scale) = " "$tmp/out"
-check "too-uncertain text names the bound: $(grep verdict "$tmp/out")" $?
+rc_=$?
+check "too-uncertain text names the bound: $(grep verdict "$tmp/out")" $rc_
 
 # The dock scenario writes no files; an unknown scenario is named.
 run "$ODOMCTL" selfcal simulate --ticks-out "$tmp/x.csv" >"$tmp/out" 2>"$tmp/err"
 rc=$?; [ $rc = 2 ] && grep -q "need --scenario open" "$tmp/err"
-check "dock with --ticks-out exit 2 (got $rc): $(cat "$tmp/err")" $?
+rc_=$?
+check "dock with --ticks-out exit 2 (got $rc): $(cat "$tmp/err")" $rc_
 run "$ODOMCTL" selfcal simulate --scenario park >"$tmp/out" 2>"$tmp/err"
 rc=$?; [ $rc = 2 ] && grep -q "\-\-scenario = 'park' must be dock or open" "$tmp/err"
-check "unknown scenario exit 2 (got $rc): $(cat "$tmp/err")" $?
+rc_=$?
+check "unknown scenario exit 2 (got $rc): $(cat "$tmp/err")" $rc_
 
 echo "selfcal cli: $pass passed, $fail failed"
 [ "$fail" = 0 ]

@@ -85,11 +85,13 @@ poll 5 test -e "$tmp/board"
 run "$ODOMETRYD" --config "$tmp/serial.toml" --duration 2 --json --quiet >"$tmp/r1.json" 2>/dev/null
 run "$ODOMETRYD" --config "$tmp/serial.toml" --duration 2 --json --quiet >"$tmp/r2.json" 2>"$tmp/r2.err"
 [ "$(jget "$tmp/r2.json" resume.reason)" = resumed ]
-check "restart while the board counts: resumed ($(grep 'resume:' "$tmp/r2.err"))" $?
+rc_=$?
+check "restart while the board counts: resumed ($(grep 'resume:' "$tmp/r2.err"))" $rc_
 kill -USR1 "$peer"  # the controller reboots while odometryd is down; 1 s of booted records
 run "$ODOMETRYD" --config "$tmp/serial.toml" --duration 1 --json --quiet >"$tmp/r3.json" 2>"$tmp/r3.err"
 [ "$(jget "$tmp/r3.json" resume.reason)" = controller-reset ]
-check "restart after a controller reset: fresh start, controller-reset ($(grep 'resume:' "$tmp/r3.err"))" $?
+rc_=$?
+check "restart after a controller reset: fresh start, controller-reset ($(grep 'resume:' "$tmp/r3.err"))" $rc_
 kill "$peer"
 wait "$peer"
 
@@ -115,14 +117,15 @@ bad() {  # bad NAME PATTERN
   run "$ODOMETRYD" --config "$tmp/serial.toml" --duration 0.5 >/dev/null 2>"$tmp/bad.err"
   local rc=$?
   [ "$rc" = 2 ] && grep -q -- "$2" "$tmp/bad.err"
-  check "$1 (rc $rc: $(head -c 300 "$tmp/bad.err"))" $?
+  rc_=$?
+  check "$1 (rc $rc: $(head -c 300 "$tmp/bad.err"))" $rc_
 }
 serial_config diffodom "$tmp/no-such-board"
-bad "missing device" "serial.toml:5: serial.device.*no-such-board.*No such file"
+bad "missing device" "serial.toml:4: serial.device.*no-such-board.*No such file"
 serial_config diffodom /dev/null
-bad "not a tty" "serial.toml:5: serial.device.*/dev/null\" is not a tty"
+bad "not a tty" "serial.toml:4: serial.device.*/dev/null\" is not a tty"
 serial_config diffodom /dev/null 12345
-bad "unsupported baud" "serial.toml:7: serial.baud = 12345 is not a supported baud rate"
+bad "unsupported baud" "serial.toml:6: serial.baud = 12345 is not a supported baud rate"
 
 echo "test_serial: $pass passed, $fail failed"
 [ "$fail" = 0 ]

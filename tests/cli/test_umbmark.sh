@@ -211,10 +211,12 @@ rc=$?; [ $rc = 2 ] && grep -q -- "--noise" "$tmp/err"; check "simulate bad noise
 # every spelling, exit 2, before any square is driven.
 run "$ODOMCTL" umbmark simulate --gyro cheap >"$tmp/out" 2>"$tmp/err"
 rc=$?; [ $rc = 2 ] && grep -qx -- "odomctl umbmark simulate: --gyro = 'cheap' must be none or consumer or industrial" "$tmp/err" && ! grep -q "squares driven" "$tmp/err"
-check "simulate bad gyro exit 2 (got $rc): $(cat "$tmp/err")" $?
+rc_=$?
+check "simulate bad gyro exit 2 (got $rc): $(cat "$tmp/err")" $rc_
 run "$ODOMCTL" umbmark simulate --eb-form borenstein >"$tmp/out" 2>"$tmp/err"
 rc=$?; [ $rc = 2 ] && grep -qx -- "odomctl umbmark simulate: --eb-form = 'borenstein' must be umbmark or chong" "$tmp/err"
-check "simulate bad eb-form exit 2 (got $rc): $(cat "$tmp/err")" $?
+rc_=$?
+check "simulate bad eb-form exit 2 (got $rc): $(cat "$tmp/err")" $rc_
 
 echo "umbmark cli: $pass passed, $fail failed"
 [ $fail = 0 ]

@@ -53,7 +53,8 @@ timeout 20 ${CROSS_EMULATOR:-} "$ODOMCTL" selfcal simulate --excursions 1000 --s
 rc=$?
 [ $rc = 2 ] && [ ! -s "$tmp/bad.out" ] && [ "$(wc -l <"$tmp/bad.err")" = 1 ] &&
   grep -q "^odomctl selfcal simulate: $tmp/no/such/dir/s.svg: cannot create" "$tmp/bad.err"
-check "selfcal simulate --plot bad path: exit 2 before any work, one line (rc $rc: $(cat "$tmp/bad.err"))" $?
+rc_=$?
+check "selfcal simulate --plot bad path: exit 2 before any work, one line (rc $rc: $(cat "$tmp/bad.err"))" $rc_
 
 python3 - "$tmp/u3.svg" <<'PY'
 import re, sys

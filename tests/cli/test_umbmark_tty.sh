@@ -62,14 +62,16 @@ check "record: return error and running centre of gravity on screen" $?
 tm send-keys -t t C-c && wait_text "$tmp/rec.err" "stopped;" &&
   [ "$(cat "$tmp/rec.err")" = "odomctl umbmark record: stopped; 1 runs saved in runs.csv: the same command resumes" ] &&
   grep -q "^cw,0.0120,0.0030,,0$" "$tmp/runs.csv" && [ "$(wc -l <"$tmp/runs.csv")" = 2 ]
-check "record: Ctrl-C says what Ctrl-D says and keeps the saved run: $(cat "$tmp/rec.err") $(tr '\n' '|' <"$tmp/runs.csv")" $?
+rc_=$?
+check "record: Ctrl-C says what Ctrl-D says and keeps the saved run: $(cat "$tmp/rec.err") $(tr '\n' '|' <"$tmp/runs.csv")" $rc_
 tm kill-session -t t 2>/dev/null
 # Ctrl-D at the same point: the same words.
 tm new-session -d -s t -x 120 -y 60 \
   "${CROSS_EMULATOR:-} $ODOMCTL umbmark record --csv runs.csv --can-log pose.log --wheelbase 0.34 2>recd.err; sleep 30"
 wait_pane "Run 2 of 10: cw" && wait_pane "reference point to the back wall" && tm send-keys -t t C-d &&
   wait_text "$tmp/recd.err" "stopped;" && cmp -s "$tmp/rec.err" "$tmp/recd.err"
-check "record: Ctrl-D says the same: $(cat "$tmp/recd.err")" $?
+rc_=$?
+check "record: Ctrl-D says the same: $(cat "$tmp/recd.err")" $rc_
 tm kill-session -t t 2>/dev/null
 tm new-session -d -s t -x 120 -y 60 \
   "${CROSS_EMULATOR:-} $ODOMCTL umbmark record --csv runs.csv --can-log pose.log --wheelbase 0.34; sleep 30"
