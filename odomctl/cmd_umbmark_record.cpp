@@ -5,8 +5,10 @@
 #include <signal.h>
 #include <sys/stat.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <csignal>
 #include <cstdlib>
 #include <ctime>
@@ -16,6 +18,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -69,6 +72,7 @@ class PosePairer {
       x_seq_ = seq;
     } else if (m == protocol::Msg::kPoseYTheta && protocol::decode_pose_y_theta(f, y, th, seq) &&
                seq == x_seq_) {
+      x_seq_ = -1;  // a second PoseYTheta of this number joins only a PoseX sent after it
       return Pose2{x_, y, th};
     }
     return std::nullopt;
@@ -99,7 +103,7 @@ void catch_interrupt() {
 }
 
 // PoseReading: a pose read at an Enter, and the odometry's path length since the read before
-// [m] when the feed saw every pose in between (a log does; the bus queue does not).
+// [m] when the feed saw every pose in between (unknown across a restarted log or a silent bus).
 struct PoseReading {
   Pose2 pose;
   std::optional<double> path;
@@ -240,7 +244,11 @@ class LogPoseFeed final : public PoseFeed {
   bool path_complete_ = true;  // every pose since the last reading was read
 };
 
-// BusPoseFeed: the next complete pose the daemon broadcasts on a SocketCAN interface.
+// BusPoseFeed: the daemon's pose broadcast on a SocketCAN interface, read by a thread of its own
+// from the start: every pose pair is joined as it arrives, so that a reading has the odometry's
+// path since the one before (the no-motion check) and a pose completed after the Enter. The
+// socket alone would not do: while a person drives and measures, its queue fills and the kernel
+// drops the newest frames.
 class BusPoseFeed final : public PoseFeed {
  public:
   static constexpr double kWait = 3.0;  // [s] for a pose pair: pose_hz >= 0.5 is enough
@@ -255,37 +263,78 @@ class BusPoseFeed final : public PoseFeed {
     return std::unique_ptr<PoseFeed>(new BusPoseFeed(iface, std::move(bus).value(), base_id, node));
   }
 
+  ~BusPoseFeed() override {
+    stop_ = true;
+    reader_.join();
+  }
+
   Result<PoseReading> latest() override {
-    // What waits in the socket was queued while the person measured: old, and once the queue
-    // is full the kernel drops the newest frames. Empty it, then take the next complete pair.
-    CanFrame f{};
-    while (bus_->receive(f)) {
-    }
-    // A fresh pairer: the half pair it held is from before the drain, and the sequence number
-    // repeats (8 bits), so an old PoseX could complete a new PoseYTheta into a pose that never was.
-    PosePairer pairer(base_id_, node_);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(kWait);
-    while (std::chrono::steady_clock::now() < deadline && !interrupted) {
-      if (!bus_->receive(f)) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(2));
-        continue;
+    const auto asked = std::chrono::steady_clock::now();
+    const auto deadline = asked + std::chrono::duration<double>(kWait);
+    std::unique_lock<std::mutex> l(m_);
+    // A pose completed before the Enter may be from before the robot stopped: wait for the next.
+    while (!(pose_ && pose_at_ >= asked) && !interrupted) {
+      if (std::chrono::steady_clock::now() >= deadline) {
+        std::ostringstream m;
+        m << iface_ << ": no pose frames of node " << node_ << " within " << kWait
+          << " s (is odometryd broadcasting on " << iface_ << "?)";
+        return make_error(Errc::kIo, m.str());
       }
-      if (auto p = pairer.take(f)) return PoseReading{*p, std::nullopt};
+      // Bounded wait: Ctrl-C sets `interrupted` without a notify.
+      fresh_.wait_for(l, std::chrono::milliseconds(50));
     }
-    std::ostringstream m;
-    m << iface_ << ": no pose frames of node " << node_ << " within " << kWait
-      << " s (is odometryd broadcasting on " << iface_ << "?)";
-    return make_error(Errc::kIo, m.str());
+    if (interrupted) return make_error(Errc::kIo, "interrupted");
+    PoseReading r{*pose_, path_complete_ ? std::optional(path_since_) : std::nullopt};
+    path_since_ = 0.0;
+    path_complete_ = true;
+    return r;
   }
 
  private:
   BusPoseFeed(std::string iface, std::unique_ptr<CanBus> bus, std::uint32_t base_id, int node)
-      : iface_(std::move(iface)), bus_(std::move(bus)), base_id_(base_id), node_(node) {}
+      : iface_(std::move(iface)), bus_(std::move(bus)), node_(node), pairer_(base_id, node) {
+    reader_ = std::thread([this] { read_bus(); });
+  }
+
+  // read_bus: the reader thread: each pose joined as it arrives, until the feed is destroyed.
+  void read_bus() {
+    CanFrame f{};
+    while (!stop_) {
+      if (!bus_->receive(f)) {
+        // The listener is non-blocking; 2 ms is a tenth of the fastest pose period (50 Hz).
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        continue;
+      }
+      if (auto p = pairer_.take(f)) take_pose(*p);
+    }
+  }
+
+  void take_pose(const Pose2& p) {
+    const auto now = std::chrono::steady_clock::now();
+    std::lock_guard<std::mutex> l(m_);
+    if (pose_) {
+      // A silence longer than kWait (the daemon stopped, restarted, the link was down) hides
+      // the path in between: unknown, not the chord across it.
+      if (now - pose_at_ > std::chrono::duration<double>(kWait)) path_complete_ = false;
+      path_since_ += std::hypot(p.x - pose_->x, p.y - pose_->y);
+    }
+    pose_ = p;
+    pose_at_ = now;
+    fresh_.notify_all();
+  }
 
   std::string iface_;
-  std::unique_ptr<CanBus> bus_;
-  std::uint32_t base_id_;
+  std::unique_ptr<CanBus> bus_;  // read by the reader thread only
   int node_;
+  PosePairer pairer_;  // the reader thread's
+  std::atomic<bool> stop_{false};
+  std::mutex m_;  // guards what follows: written by the reader, taken by latest()
+  std::condition_variable fresh_;
+  std::optional<Pose2> pose_;
+  std::chrono::steady_clock::time_point pose_at_{};
+  double path_since_ = 0.0;    // [m] odometry path since the last reading
+  bool path_complete_ = true;  // no silence since the last reading
+  std::thread reader_;         // last: started once everything it uses exists
 };
 
 // Prompter: asks on stdout and reads one line from the terminal or from --answers (then echoed,

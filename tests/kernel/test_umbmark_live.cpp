@@ -7,7 +7,8 @@
 //    same runs CSV byte for byte: the bus path reads what the log path reads.
 //  - The running daemon: odometryd on vcan with the simulated robot standing still, its pose set
 //    with `cansend`; a session that takes the interface from the daemon's config (--config)
-//    prints that pose as its start and end pose.
+//    prints that pose as its start pose, and refuses the end pose: the odometry did not move.
+//  Every end pose a session takes here was driven to: its reader thread sums the path.
 //  - No broadcast: a scripted session stops with one line naming the interface and the wait.
 //  - A pair split by the emptying of the queue: the PoseYTheta left over is not joined to the
 //    PoseX of an earlier pair that had the same sequence number.
@@ -24,7 +25,9 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstring>
+#include <deque>
 #include <fstream>
 #include <mutex>
 #include <sstream>
@@ -108,12 +111,32 @@ class Broadcaster {
     std::lock_guard<std::mutex> l(m_);
     pose_ = p;
   }
+  // drive: one pose of `path` per period, as a moving robot's; whether the last one (held
+  // after) is being sent within 30 s.
+  bool drive(const std::vector<protocol::PoseMsg>& path) {
+    {
+      std::lock_guard<std::mutex> l(m_);
+      path_.assign(path.begin(), path.end());
+    }
+    return wait_until(
+        [&] {
+          std::lock_guard<std::mutex> l(m_);
+          return path_.empty();
+        },
+        30.0);
+  }
 
  private:
   void run() {
     while (!stop_) {
       {
         std::lock_guard<std::mutex> l(m_);
+        if (!path_.empty()) {
+          const std::uint8_t seq = pose_.seq;
+          pose_ = path_.front();
+          pose_.seq = seq;
+          path_.pop_front();
+        }
         pose_.seq = static_cast<std::uint8_t>(pose_.seq + 1);
         const auto [fx, fy] = pose_frames(pose_);
         out_.send(fx);
@@ -126,8 +149,29 @@ class Broadcaster {
   std::atomic<bool> stop_{false};
   std::mutex m_;
   protocol::PoseMsg pose_{};
+  std::deque<protocol::PoseMsg> path_;  // poses still to drive through
   std::thread thread_;
 };
+
+// detour: the poses of a robot that drives from a out along x by kOut and back to b, in 2 cm
+// steps: 9 m of odometry path, more than the 8 m half of a 4 m square (the default --side)
+// the session asks for before it takes an end pose.
+constexpr double kOut = 4.5;
+std::vector<protocol::PoseMsg> detour(const protocol::PoseMsg& a, const protocol::PoseMsg& b) {
+  std::vector<protocol::PoseMsg> path;
+  const auto leg = [&](const protocol::PoseMsg& from, const protocol::PoseMsg& to) {
+    const int n = static_cast<int>(std::ceil(std::hypot(to.x - from.x, to.y - from.y) / 0.02));
+    for (int i = 1; i <= n; ++i) {
+      const double f = static_cast<double>(i) / n;
+      path.push_back({from.x + f * (to.x - from.x), from.y + f * (to.y - from.y),
+                      from.theta + f * (to.theta - from.theta), 0});
+    }
+  };
+  const protocol::PoseMsg out{a.x + kOut, a.y, a.theta, 0};
+  leg(a, out);
+  leg(out, b);
+  return path;
+}
 
 // write_log: a candump -L log holding one pose pair stamped now (the session refuses a pose
 // older than its Enter), replaced whole (rename).
@@ -233,8 +277,16 @@ TEST(UmbmarkRecordLive, BusSessionWritesTheSameCsvAsTheLogSession) {
   ASSERT_TRUE(b.ok());
   b.set(kPoses[0]);
   const pid_t bus = spawn(record_cmd(dir, "bus", "--can " + ifc));
-  EXPECT_TRUE(drive_session(dir + "/bus.fifo", dir + "/bus.out",
-                            [&](int k) { b.set(kPoses[static_cast<std::size_t>(k)]); }))
+  // Before an end Enter the odometry drives a detour from the start pose to the end pose: the
+  // session takes no end pose the odometry did not drive to (issue 35).
+  const auto set_pose = [&](int k) {
+    const auto i = static_cast<std::size_t>(k);
+    if (k % 2 == 0)
+      b.set(kPoses[i]);
+    else
+      EXPECT_TRUE(b.drive(detour(kPoses[i - 1], kPoses[i])));
+  };
+  EXPECT_TRUE(drive_session(dir + "/bus.fifo", dir + "/bus.out", set_pose))
       << slurp(dir + "/bus.out") << slurp(dir + "/bus.err");
   EXPECT_EQ(wait_exit(bus), 0) << slurp(dir + "/bus.err");
 
@@ -257,10 +309,11 @@ TEST(UmbmarkRecordLive, BusSessionWritesTheSameCsvAsTheLogSession) {
   EXPECT_NE(out.find("odometry at end: x -0.1745 m, y 0.0621 m"), std::string::npos) << out;
 }
 
-// The end pose's PoseX waits in the queue when Enter is pressed, so the session empties it away;
-// its PoseYTheta arrives after, with the sequence number of the pair the session took at the
-// start. Joining the two would give the start's x with the end's y and theta (the CI failure of
-// stop 27: its cw run had dx = 0); the session must wait for the next whole pair.
+// The end pose's PoseX arrives before the Enter, its PoseYTheta after, with the sequence number
+// of the pair the session took at the start. Until stop 40 the session emptied the socket's
+// queue at an Enter: joining the PoseYTheta to the start's PoseX then gave the start's x with the
+// end's y and theta (the CI failure of stop 27: its cw run had dx = 0). Since then a reader
+// thread joins every pair as it arrives: the end pose is the end's x, y and theta either way.
 TEST(UmbmarkRecordLive, APoseXEmptiedFromTheQueueIsNotJoinedToTheNextPoseYTheta) {
   ODO_REQUIRE_VM();
   const std::string ifc = "vcanu2", dir = "/tmp/odo_umb_split";
@@ -289,6 +342,16 @@ TEST(UmbmarkRecordLive, APoseXEmptiedFromTheQueueIsNotJoinedToTheNextPoseYTheta)
       return shows(dir + "/split.out", when, 1);
     };
     ASSERT_TRUE(send_until_shown(pose_frames(start), "start")) << slurp(dir + "/split.err");
+    // The robot drives 9 m to 0.1 m short of the end (whole pairs, numbered from 100 on): a
+    // session that took the pose completed before the Enter would show x 0.2000.
+    std::uint8_t seq = 100;
+    for (auto p : detour(start, {0.2000, 0.2000, 0.0500, 0})) {
+      p.seq = seq++;
+      const auto [fx, fy] = pose_frames(p);
+      tx.send(fx);
+      tx.send(fy);
+      std::this_thread::sleep_for(1ms);  // a robot's rate, not a burst the queue would drop
+    }
     const auto e = pose_frames(end);
     tx.send(e.first);  // queued now, emptied by the Enter below
     std::this_thread::sleep_for(100ms);
@@ -306,7 +369,7 @@ TEST(UmbmarkRecordLive, APoseXEmptiedFromTheQueueIsNotJoinedToTheNextPoseYTheta)
   EXPECT_NE(out.find("odometry at end: x 0.3000 m, y 0.2000 m"), std::string::npos) << out;
 }
 
-TEST(UmbmarkRecordLive, ReadsTheRunningDaemonsPoseAndSaysWhenThereIsNone) {
+TEST(UmbmarkRecordLive, ReadsTheRunningDaemonsPoseRefusesASquareNotDrivenAndSaysWhenThereIsNone) {
   ODO_REQUIRE_VM();
   const std::string ifc = "vcanu1", dir = "/tmp/odo_umb_daemon";
   vcan_up(ifc);
@@ -349,10 +412,18 @@ TEST(UmbmarkRecordLive, ReadsTheRunningDaemonsPoseAndSaysWhenThereIsNone) {
   const int rc = run(rec_cfg + "/daemon.csv > " + dir + "/daemon.out 2> " + dir + "/daemon.err");
   kill(-daemon, SIGTERM);
   wait_exit(daemon);
-  EXPECT_EQ(rc, 0) << slurp(dir + "/daemon.err") << slurp(dir + "/d.err");
-  const std::string out = slurp(dir + "/daemon.out");
-  // The robot stands still: every pose read is the one set, 0.1234 rad = 7.070 deg.
-  EXPECT_EQ(count(out, "x 1.2340 m, y -0.5670 m, theta 7.070 deg"), 4u) << out;
+  // The robot stands still: the start pose read is the one set (0.1234 rad = 7.070 deg); the
+  // end pose is refused (issue 35: the odometry did not move), which ends a scripted session
+  // (exit 1) before any run is saved.
+  EXPECT_EQ(rc, 1) << slurp(dir + "/daemon.err") << slurp(dir + "/d.err");
+  const std::string out = slurp(dir + "/daemon.out"), err = slurp(dir + "/daemon.err");
+  EXPECT_EQ(count(out, "odometry at start: x 1.2340 m, y -0.5670 m, theta 7.070 deg"), 1u) << out;
+  EXPECT_EQ(count(out, "odometry at end"), 0u) << out;
+  EXPECT_NE(err.find("the odometry moved 0.000 m since the start pose, a square of 4 m is 16 m: "
+                     "drive the square (is --side right?), then press Enter"),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(access((dir + "/daemon.csv").c_str(), F_OK), -1);
   // An interface that does not exist is one line before the first question (exit 2).
   EXPECT_EQ(run(std::string(ODOMCTL_PATH) + " umbmark record --wheelbase 0.5 --can vcannope" +
                 " --csv " + dir + "/x.csv < /dev/null > " + dir + "/x.out 2> " + dir + "/x.err"),
