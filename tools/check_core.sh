@@ -6,10 +6,13 @@
 #              machinery is 88 KB of a microcontroller's flash; hal/format.hpp words numbers),
 #              and compile with -fno-exceptions -fno-rtti (preset core-portable: those
 #              libraries only); the microcontroller build stands on this
+#   composition  firmware/ (the composition root) does no raw Linux I/O: no header of files,
+#              sockets, ioctl or file systems (fcntl.h, unistd.h, sys/*, linux/*, termios.h,
+#              poll.h); that is drivers/' job (issue 33). Threads and their semaphores stay.
 #   functions  no function of the project's own code (tests excepted) is longer than 60 lines
 #              (clang-tidy's readability-function-size over build/default's compile database)
 # The layer table needs no check here: configure (odo_check_layers) fails on a wrong link.
-# Usage: tools/check_core.sh [portable] [functions]   (default: both)
+# Usage: tools/check_core.sh [portable] [composition] [functions]   (default: all three)
 set -euo pipefail
 ODO_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ODO_ROOT"
@@ -38,6 +41,19 @@ check_portable() {
   fi
 }
 
+check_composition() {
+  local bad
+  bad=$(grep -rnE '#include <(unistd\.h|fcntl\.h|poll\.h|termios\.h|sys/[a-z_/]+\.h|linux/[a-z_/]+\.h)>' \
+    firmware || true)
+  if [[ -n $bad ]]; then
+    echo "check_core: composition: firmware/ must leave Linux I/O to drivers/:"
+    echo "$bad"
+    rc=1
+  else
+    echo "check_core: composition: firmware/ includes no Linux I/O header"
+  fi
+}
+
 check_functions() {
   local db=build/default/compile_commands.json files out
   [[ -f $db ]] || cmake --preset default >/dev/null
@@ -57,10 +73,11 @@ check_functions() {
 }
 
 checks=("$@")
-((${#checks[@]})) || checks=(portable functions)
+((${#checks[@]})) || checks=(portable composition functions)
 for c in "${checks[@]}"; do
   case $c in
     portable) check_portable ;;
+    composition) check_composition ;;
     functions) check_functions ;;
     *) echo "check_core: unknown check $c" >&2; exit 2 ;;
   esac

@@ -1,11 +1,5 @@
 #include "odo/firmware/state_persist.hpp"
 
-#include <fcntl.h>
-#include <linux/magic.h>
-#include <sys/stat.h>
-#include <sys/statfs.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -21,6 +15,7 @@
 #include <utility>
 
 #include "odo/calibration/record.hpp"
+#include "odo/drivers/state_file.hpp"
 #include "odo/hal/crc.hpp"
 
 namespace odo::fw {
@@ -64,14 +59,6 @@ int gyro_resume_text(const loop::ResumeDecision& d, bool tell, char* out, std::s
         out, n, "; gyro: %s, detection waits for the next standstill\n",
         d.gyro_matches ? "its bias was not learnt yet" : "the record is another gyro's (or none)");
   return std::clamp(k, 0, static_cast<int>(n) - 1);
-}
-
-// on_tmpfs: whether the directory of `path` is a tmpfs (emptied by every reboot).
-bool on_tmpfs(const std::string& path) {
-  const std::size_t slash = path.rfind('/');
-  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash + 1);
-  struct statfs f {};
-  return ::statfs(dir.c_str(), &f) == 0 && f.f_type == TMPFS_MAGIC;
 }
 
 }  // namespace
@@ -120,23 +107,20 @@ Result<loop::BootId> current_boot_id(const std::string& state_path, const char* 
   }
   // A record on a tmpfs (emptied by every reboot) is from this boot by construction: the
   // all-zero id stands for "this boot" in both the record and the check.
-  if (on_tmpfs(state_path)) return loop::BootId{};
+  if (drivers::on_tmpfs(state_path)) return loop::BootId{};
   return id;
 }
 
 Result<loop::StateRecord> read_state_file(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) {
-    if (errno == ENOENT)
+  std::array<std::uint8_t, loop::kStateFileBytes> b{};
+  auto n = drivers::read_file_head(path, b);
+  if (!n) {
+    if (n.error().code == Errc::kNotFound)
       return make_error(Errc::kNotFound,
                         "no state file yet at " + path + " (odometryd writes it while it runs)");
-    return io_error("cannot open", path);
+    return std::move(n).error();
   }
-  std::array<std::uint8_t, loop::kStateFileBytes> b{};
-  const ssize_t n = ::pread(fd, b.data(), b.size(), 0);
-  ::close(fd);
-  if (n < 0) return io_error("cannot read", path);
-  auto r = loop::decode_state_file(std::span<const std::uint8_t>(b.data(), std::size_t(n)));
+  auto r = loop::decode_state_file(std::span<const std::uint8_t>(b.data(), *n));
   if (!r) return make_error(r.error().code, path + ": " + r.error().message);
   return r;
 }
@@ -180,51 +164,31 @@ bool counters_survive_restart(const Config& cfg) {
 
 // ---- StatePersister ----
 
-namespace {
-
-// make_state_directory: creates the state file's directory when it is missing (one level: run by
-// hand there is no systemd to make /run/odometryd), with the mode systemd's RuntimeDirectory=
-// gives it, 0755 whatever the umask; true if it was made.
-bool make_state_directory(const std::string& path) {
-  const std::size_t slash = path.find_last_of('/');
-  if (slash == std::string::npos || slash == 0) return false;
-  const std::string dir = path.substr(0, slash);
-  if (::mkdir(dir.c_str(), 0755) != 0) return false;
-  return ::chmod(dir.c_str(), 0755) == 0;
-}
-
-}  // namespace
-
 Result<std::unique_ptr<StatePersister>> StatePersister::create(const std::string& path,
                                                                double rate_hz, double loop_hz,
                                                                const loop::OdometryLoop& loop,
                                                                const loop::StateRecord& identity) {
-  int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0 && errno == ENOENT && make_state_directory(path))
-    fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0) return io_error("cannot open the state file", path);
   // Both slots exist from the start; the older record in them stays readable until replaced.
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || (st.st_size < static_cast<off_t>(loop::kStateFileBytes) &&
-                                ::ftruncate(fd, loop::kStateFileBytes) != 0)) {
-    auto e = io_error("cannot size the state file", path);
-    ::close(fd);
-    return e;
-  }
+  auto file = drivers::StateFile::open(path, loop::kStateFileBytes);
+  if (!file) return std::move(file).error();
   const auto every = static_cast<std::uint64_t>(std::max(1.0, std::round(loop_hz / rate_hz)));
-  return std::unique_ptr<StatePersister>(new StatePersister(fd, every, loop, identity));
+  return std::unique_ptr<StatePersister>(
+      new StatePersister(std::move(file).value(), every, loop, identity));
 }
 
-StatePersister::StatePersister(int fd, std::uint64_t every, const loop::OdometryLoop& loop,
-                               const loop::StateRecord& identity)
-    : fd_(fd), every_(every), loop_(loop), identity_(identity), sequence_(identity.sequence) {
+StatePersister::StatePersister(std::unique_ptr<drivers::StateFile> file, std::uint64_t every,
+                               const loop::OdometryLoop& loop, const loop::StateRecord& identity)
+    : file_(std::move(file)),
+      every_(every),
+      loop_(loop),
+      identity_(identity),
+      sequence_(identity.sequence) {
   sem_init(&wake_, 0, 0);
 }
 
 StatePersister::~StatePersister() {
   stop();
   sem_destroy(&wake_);
-  ::close(fd_);
 }
 
 void StatePersister::on_tick(const loop::LoopSnapshot&) noexcept {
@@ -269,8 +233,7 @@ void StatePersister::write_newest() noexcept {
   r.gyro_id = identity_.gyro_id;
   loop::StateBytes b{};
   loop::encode_state(r, b);
-  const auto off = static_cast<off_t>((r.sequence % 2) * loop::kStateSlotBytes);
-  if (::pwrite(fd_, b.data(), b.size(), off) == static_cast<ssize_t>(b.size())) {
+  if (file_->write_at((r.sequence % 2) * loop::kStateSlotBytes, b)) {
     last_written_ = r.sequence;
     written_.fetch_add(1, std::memory_order_relaxed);
   } else {

@@ -19,6 +19,10 @@
 #include "odo/loop/state_record.hpp"
 #include "odo/loop/triple_buffer.hpp"
 
+namespace odo::drivers {
+class StateFile;  // drivers/state_file.hpp: the file's Linux side
+}  // namespace odo::drivers
+
 namespace odo::fw {
 
 inline constexpr const char* kBootIdPath = "/proc/sys/kernel/random/boot_id";
@@ -82,12 +86,12 @@ class StatePersister final : public loop::TickObserver {
   }
 
  private:
-  StatePersister(int fd, std::uint64_t every, const loop::OdometryLoop& loop,
-                 const loop::StateRecord& identity);
+  StatePersister(std::unique_ptr<drivers::StateFile> file, std::uint64_t every,
+                 const loop::OdometryLoop& loop, const loop::StateRecord& identity);
   void run(std::ostream& log, std::optional<loop::ResumeReason> fixed, const std::string& note);
   void write_newest() noexcept;
 
-  int fd_;
+  std::unique_ptr<drivers::StateFile> file_;
   std::uint64_t every_;  // ticks per record
   const loop::OdometryLoop& loop_;
   loop::StateRecord identity_;
