@@ -36,7 +36,8 @@
 #               systemd-analyze, removed and purged on this machine (CI is throw-away), and
 #               installed with apt on a fresh debootstrap chroot (tests/package/fresh_install.sh)
 #   rules       after default: tools/check_core.sh (the core rooms portable: no OS header, thread
-#               or stream, built with -fno-exceptions -fno-rtti; no function over 60 lines)
+#               or stream, built with -fno-exceptions -fno-rtti; firmware/ no Linux I/O header;
+#               no function over 60 lines)
 # Environment: ODO_JOBS (parallel build jobs, default nproc), ODO_CONFIGS (space-separated
 # subset of the configurations above), ODO_RULES=0, ODO_SOAK=0, ODO_KERNEL=0, ODO_MCU=0, ODO_PACKAGES=0 (skip those
 # stages), ODO_FRESH_INSTALL=0 (no chroot install).
@@ -412,7 +413,7 @@ stage_package() {  # the Debian package of one build tree
 # 60 lines. A broken rule fails the run like a failed test.
 stage_rules() {
   local t0=$SECONDS
-  if tools/check_core.sh portable functions 2>&1 | tee build/rules.log; then
+  if tools/check_core.sh portable composition functions 2>&1 | tee build/rules.log; then
     summary+=("rules: ok ($((SECONDS - t0)) s)")
     n_pass=$((n_pass + 1))
   else
