@@ -31,7 +31,11 @@ echo "fresh-ci: chroot ready in $(($(date +%s) - t0)) s"
 rm -rf "$R/root/repo" && git clone -q "$repo" "$R/root/repo"
 t1=$(date +%s)
 bundle=/etc/ssl/certs/ca-certificates.crt  # node and npm read the CAs from these, as on the kind
-chroot "$R" /usr/bin/env -i HOME=/root PATH=/usr/sbin:/usr/bin:/sbin:/bin CI=true LANG=C.UTF-8 \
+# In a mount namespace of its own with the chroot bound onto itself: its / is then a mount point,
+# as a real machine's is, so that `unshare --mount` works inside (cli_golden_installed; in a bare
+# chroot it fails: "cannot change root filesystem propagation").
+unshare --mount sh -c 'mount --rbind "$1" "$1" && shift && exec "$@"' fresh "$R" \
+  chroot "$R" /usr/bin/env -i HOME=/root PATH=/usr/sbin:/usr/bin:/sbin:/bin CI=true LANG=C.UTF-8 \
   NODE_EXTRA_CA_CERTS=$bundle SSL_CERT_FILE=$bundle \
   bash -c 'cd /root/repo && bash .ci/run' >"$R.log" 2>&1
 rc=$?
