@@ -11,9 +11,6 @@
 namespace odo::fw {
 namespace {
 
-// What is kept of the record while no fix is in the window: a late CAN fix is at most 4.1 s old.
-constexpr TimeNs kKeep = 5'000'000'000;
-
 std::int64_t system_seconds() {
   return static_cast<std::int64_t>(std::time(nullptr));
 }
@@ -38,7 +35,9 @@ SelfCalEstimator::SelfCalEstimator(const SelfCalSetup& s, calib::CalibrationStor
       recorder_(recorder),
       log_(log),
       clock_(clock != nullptr ? clock : &system_seconds),
-      ring_(s.fix_capacity) {}
+      ring_(s.fix_capacity),
+      window_({static_cast<std::size_t>(s.cfg.max_fixes), static_cast<std::size_t>(s.cfg.min_fixes),
+               static_cast<std::size_t>(s.cfg.fit_every), s.ripe_delay}) {}
 
 void SelfCalEstimator::submit(const calib::PoseFix& f) {
   std::lock_guard lk(m_);
@@ -57,52 +56,21 @@ KinematicParams SelfCalEstimator::in_use() const {
 
 void SelfCalEstimator::take_fixes(TimeNs until) {
   calib::PoseFix f;
-  std::uint64_t received = 0, dropped = 0;
+  std::uint64_t received = 0;
   while (ring_.pop(f)) {
-    pending_.push_back(f);
+    window_.add_fix(f);
     ++received;
   }
   {
     std::lock_guard lk(m_);
     received += submitted_.size();
-    pending_.insert(pending_.end(), submitted_.begin(), submitted_.end());
+    for (const calib::PoseFix& g : submitted_) window_.add_fix(g);
     submitted_.clear();
   }
-  std::stable_sort(pending_.begin(), pending_.end(),
-                   [](const calib::PoseFix& a, const calib::PoseFix& b) { return a.t < b.t; });
-  // Ripe: every count up to the fix time has been taken from the ring (the open segment closes
-  // within ripe_delay of the recorded time).
-  std::size_t n = 0;
-  for (; n < pending_.size() && pending_[n].t + s_.ripe_delay <= until; ++n) {
-    const calib::PoseFix& p = pending_[n];
-    // Without a window, trim() keeps the counts of the last kKeep only: an older fix has lost
-    // the counts after it. (A fix before the first segment is fine: the robot stood still.)
-    const bool before_record = window_.empty() && p.t < until - kKeep;
-    if ((!window_.empty() && p.t <= window_.back().t) || before_record) {
-      ++dropped;
-      continue;
-    }
-    window_.push_back(p);
-    flagged_.push_back(false);
-    ++new_fixes_;
-  }
-  pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(n));
+  const std::uint64_t dropped = window_.take_ripe(until);
   std::lock_guard lk(m_);
   counters_.fixes_received += received;
   counters_.fixes_dropped += dropped;
-}
-
-void SelfCalEstimator::trim(TimeNs until) {
-  const auto max_fixes = static_cast<std::size_t>(s_.cfg.max_fixes);
-  if (window_.size() > max_fixes) {
-    const auto cut = static_cast<std::ptrdiff_t>(window_.size() - max_fixes);
-    window_.erase(window_.begin(), window_.begin() + cut);
-    flagged_.erase(flagged_.begin(), flagged_.begin() + cut);
-  }
-  // Counts before the first fix of the window are of no use; without a fix, keep what a late
-  // fix (at most 4.1 s on CAN) can still reach. Bounded memory for any run length.
-  const TimeNs keep_from = !window_.empty() ? window_.front().t : until - kKeep;
-  while (!segs_.empty() && segs_.front().t_end <= keep_from) segs_.pop_front();
 }
 
 void SelfCalEstimator::step() {
@@ -112,7 +80,7 @@ void SelfCalEstimator::step() {
   calib::CountSegment seg;
   std::uint64_t n = 0;
   while (segments_.pop(seg)) {
-    segs_.push_back(seg);
+    window_.add_segment(seg);
     ++n;
   }
   {
@@ -120,11 +88,8 @@ void SelfCalEstimator::step() {
     counters_.segments += n;
   }
   take_fixes(until);
-  trim(until);
-  if (static_cast<int>(window_.size()) >= s_.cfg.min_fixes && new_fixes_ >= s_.cfg.fit_every) {
-    new_fixes_ = 0;
-    fit();
-  }
+  window_.trim(until);
+  if (window_.fit_due()) fit();
 }
 
 void SelfCalEstimator::fit() {
@@ -139,8 +104,7 @@ void SelfCalEstimator::fit() {
   c.max_sigma_factor = s_.cfg.max_sigma_factor;
   c.max_sigma_wheelbase = s_.cfg.max_sigma_wheelbase;
   c.min_improvement = s_.cfg.min_improvement;
-  const std::vector<calib::CountSegment> segs(segs_.begin(), segs_.end());
-  auto track = calib::build_track(segs, window_);
+  auto track = calib::build_track(window_.segments(), window_.fixes());
   auto r = track ? calib::fit_fixes(*track, c) : Result<calib::SelfCalResult>(track.error());
   std::unique_lock lk(m_);
   ++counters_.fits;
@@ -150,14 +114,10 @@ void SelfCalEstimator::fit() {
     log_ << s_.log_prefix << "fit failed: " << r.error().message << std::endl;
     return;
   }
-  for (int i : r->rejected) {
-    if (flagged_[static_cast<std::size_t>(i)]) continue;
-    flagged_[static_cast<std::size_t>(i)] = true;
-    ++counters_.fixes_rejected;
-  }
+  counters_.fixes_rejected += window_.newly_rejected(r->rejected);
   counters_.last = *r;
   lk.unlock();
-  log_ << s_.log_prefix << "" << window_.size() << " fixes (" << r->fixes_rejected
+  log_ << s_.log_prefix << "" << window_.fixes().size() << " fixes (" << r->fixes_rejected
        << " rejected): c_l=" << r->estimate.c_l << " c_r=" << r->estimate.c_r
        << " b=" << r->estimate.wheelbase << " m, held-out chi2/dof " << r->score_candidate << " vs "
        << r->score_in_use << " in use: " << calib::verdict_name(r->verdict) << std::endl;
@@ -211,10 +171,7 @@ void SelfCalEstimator::apply(const calib::SelfCalResult& r) {
   }
   log_ << s_.log_prefix << "applied c_l=" << p.c_l << " c_r=" << p.c_r << " b=" << p.wheelbase
        << " m" << (store_ != nullptr ? s_.stored_note : " (no store configured)") << std::endl;
-  // The next candidate must beat this one on fixes it has not seen: start a new window at the
-  // newest fix.
-  window_.erase(window_.begin(), window_.end() - 1);
-  flagged_.assign(1, false);
+  window_.restart_at_newest();
 }
 
 void SelfCalEstimator::start(double period) {

@@ -16,7 +16,6 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -25,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "odo/calibration/fix_window.hpp"
 #include "odo/calibration/selfcal.hpp"
 #include "odo/calibration/store.hpp"
 #include "odo/firmware/config.hpp"
@@ -95,11 +95,12 @@ class SelfCalEstimator {
     std::size_t pending = 0;   // fixes not ripe yet
   };
   // backlog: from the estimator's thread, or while it is not running (soak and tests).
-  Backlog backlog() const noexcept { return {segs_.size(), window_.size(), pending_.size()}; }
+  Backlog backlog() const noexcept {
+    return {window_.segment_count(), window_.fixes().size(), window_.pending_count()};
+  }
 
  private:
   void take_fixes(TimeNs until);
-  void trim(TimeNs until);
   void fit();
   void apply(const calib::SelfCalResult& r);
 
@@ -117,11 +118,7 @@ class SelfCalEstimator {
   SelfCalCounters counters_;
 
   // Estimator thread only.
-  std::deque<calib::CountSegment> segs_;
-  std::vector<calib::PoseFix> pending_;  // not ripe yet
-  std::vector<calib::PoseFix> window_;
-  std::vector<bool> flagged_;  // window_[i] already counted as rejected
-  int new_fixes_ = 0;
+  calib::FixWindow window_;
 
   std::thread thread_;
   std::condition_variable cv_;
