@@ -2,14 +2,15 @@
 #include "odo/drivers/state_file.hpp"
 
 #include <gtest/gtest.h>
+#include <sched.h>
+#include <sys/mount.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 namespace odo::drivers {
@@ -70,19 +71,30 @@ TEST(StateFile, ReasonsNameThePath) {
       << d.error().message;
 }
 
-// on_tmpfs against the kernel's own list of mounts.
-TEST(StateFile, OnTmpfsAsProcMountsSays) {
-  std::ifstream mounts("/proc/mounts");
-  std::string line, tmpfs_dir;
-  while (std::getline(mounts, line)) {
-    std::istringstream l(line);
-    std::string dev, dir, type;
-    l >> dev >> dir >> type;
-    if (type == "tmpfs" && tmpfs_dir.empty() && ::access(dir.c_str(), R_OK) == 0) tmpfs_dir = dir;
+// on_tmpfs of a tmpfs this test mounts itself: in a child with a mount namespace of its own
+// (the machine untouched, and no dependence on which tmpfs it happens to have). Exit status of
+// the child: 0 on_tmpfs true, 1 false, 2 the namespace or the mount could not be made.
+int on_tmpfs_in_own_mount(const std::string& dir) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (::unshare(CLONE_NEWNS) != 0 ||
+        ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0 ||
+        ::mount("odo-test", dir.c_str(), "tmpfs", 0, "size=64k") != 0)
+      ::_exit(2);
+    ::_exit(on_tmpfs(dir + "/state.bin") ? 0 : 1);
   }
-  EXPECT_FALSE(on_tmpfs("/proc/state.bin"));  // proc, not tmpfs
-  if (tmpfs_dir.empty()) GTEST_SKIP() << "no readable tmpfs in /proc/mounts";
-  EXPECT_TRUE(on_tmpfs(tmpfs_dir + "/state.bin")) << tmpfs_dir;
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 3;
+}
+
+TEST(StateFile, OnTmpfsOfAMountedTmpfsNotOfOtherFileSystems) {
+  const std::string dir = fresh_dir("state_file_tmpfs");
+  ASSERT_EQ(::mkdir(dir.c_str(), 0755), 0);
+  EXPECT_FALSE(on_tmpfs("/proc/state.bin"));  // proc
+  const int r = on_tmpfs_in_own_mount(dir);
+  if (r == 2) GTEST_SKIP() << "cannot make a mount namespace and a tmpfs (needs root)";
+  EXPECT_EQ(r, 0) << "on_tmpfs did not see the tmpfs mounted on " << dir;
 }
 
 }  // namespace
