@@ -12,8 +12,9 @@
 namespace odo::drivers {
 namespace {
 
-Error io_error(const std::string& what, const std::string& path) {
-  return make_error(Errc::kIo, path + ": " + what + " (" + std::strerror(errno) + ")");
+// io_error: "PATH: WHAT (reason of err)".
+Error io_error(const std::string& what, const std::string& path, int err) {
+  return make_error(Errc::kIo, path + ": " + what + " (" + std::strerror(err) + ")");
 }
 
 // make_directory: creates the file's directory when it is missing (one level: run by hand there
@@ -32,13 +33,13 @@ Result<std::unique_ptr<StateFile>> StateFile::open(const std::string& path, std:
   int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (fd < 0 && errno == ENOENT && make_directory(path))
     fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0) return io_error("cannot open the state file", path);
+  if (fd < 0) return io_error("cannot open the state file", path, errno);
   // Sized once here: every later write is in place, within the file (no growth, no allocation
   // in the file system on the writer's path).
   struct stat st {};
   if (::fstat(fd, &st) != 0 ||
       (st.st_size < static_cast<off_t>(bytes) && ::ftruncate(fd, static_cast<off_t>(bytes)) != 0)) {
-    auto e = io_error("cannot size the state file", path);
+    auto e = io_error("cannot size the state file", path, errno);
     ::close(fd);
     return e;
   }
@@ -58,16 +59,12 @@ Result<std::size_t> read_file_head(const std::string& path, std::span<std::uint8
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     if (errno == ENOENT) return make_error(Errc::kNotFound, path + ": no such file");
-    return io_error("cannot open", path);
+    return io_error("cannot open", path, errno);
   }
   const ssize_t n = ::pread(fd, out.data(), out.size(), 0);
-  // errno of pread before close can change it.
-  const int read_errno = errno;
+  const int err = errno;  // pread's, before close can change it
   ::close(fd);
-  if (n < 0) {
-    errno = read_errno;
-    return io_error("cannot read", path);
-  }
+  if (n < 0) return io_error("cannot read", path, err);
   return static_cast<std::size_t>(n);
 }
 

@@ -8,27 +8,26 @@
 #   record: writes the outputs into GOLDEN_DIR (only when behaviour is meant to change)
 set -u
 mode=$1
+. "$(dirname "$0")/lib.sh"  # run, check, $tmp
 # The goldens are the outputs of a machine without the package: odometryd's default store
 # /var/lib/odometryd/calibration.bin is reported as "neither ... nor its directory exists yet".
 # Where that directory exists (the package installed, a store made by hand), the set runs in a
 # mount namespace of its own with an empty /var/lib over the real one: the machine's files are
 # neither read nor touched, and the outputs are those of the goldens' machine.
 if [[ -e /var/lib/odometryd && -z ${ODO_GOLDEN_OWN_VAR_LIB:-} ]]; then
-  ns=(--mount)
-  [[ $(id -u) == 0 ]] || ns+=(--map-root-user)
-  if ! unshare "${ns[@]}" true 2>/dev/null; then
+  if ! own_mount_ns; then
     echo "golden: SKIPPED: /var/lib/odometryd exists and this user cannot make a mount namespace" \
       "to run without it (unshare ${ns[*]})"
     exit 77
   fi
   echo "golden: /var/lib/odometryd exists: the set runs with an empty /var/lib of its own"
+  rm -rf "$tmp"  # exec skips lib.sh's exit trap; the run below makes its own
   exec unshare "${ns[@]}" env ODO_GOLDEN_OWN_VAR_LIB=1 bash -c \
     'mount -t tmpfs golden-var-lib /var/lib && exec bash "$0" "$@"' "$0" "$@"
 fi
 mkdir -p "$2"
 golden=$(cd "$2" && pwd)
 clidir=$(cd "$3" && pwd)
-. "$(dirname "$0")/lib.sh"  # run, check, $tmp
 got="$tmp/got"
 mkdir -p "$got" "$tmp/w/bin"
 ln -s "$ODOMETRYD" "$tmp/w/bin/odometryd"

@@ -11,6 +11,8 @@
 # start_live_log LOG DRIVE  a daemon's log being written at LOG (live_log.py), $relay its pid
 # serial_config PROTOCOL DEVICE [BAUD [SECTIONS]]  writes $tmp/serial.toml: [encoder] serial on
 #                 DEVICE, store and state in $tmp; SECTIONS (TOML text) goes first
+# own_mount_ns    sets ns to unshare's options for a mount namespace of this user's own
+#                 (--map-root-user unless root); non-zero when none can be made here
 set -u
 run() { ${CROSS_EMULATOR:-} "$@"; }
 fail=0; pass=0
@@ -67,4 +69,9 @@ backend = "file"
 [resume]
 path = "$tmp/state.bin"
 TOML
+}
+own_mount_ns() {
+  ns=(--mount)
+  [[ $(id -u) == 0 ]] || ns+=(--map-root-user)
+  unshare "${ns[@]}" true 2>/dev/null
 }

@@ -8,9 +8,7 @@
 # usage: test_golden_installed.sh GOLDEN_DIR CLI_DIR   (env ODOMETRYD, ODOMCTL)
 . "$(dirname "$0")/lib.sh"
 golden=$(cd "$1" && pwd) clidir=$(cd "$2" && pwd) here=$(cd "$(dirname "$0")" && pwd)
-ns=(--mount)
-[[ $(id -u) == 0 ]] || ns+=(--map-root-user)
-if ! unshare "${ns[@]}" true 2>/dev/null; then
+if ! own_mount_ns; then
   echo "SKIPPED: this user cannot make a mount namespace (unshare ${ns[*]})"
   exit 77
 fi
@@ -23,8 +21,8 @@ grep -q "calibration.bin does not exist yet; it is created" "$tmp/d.out"
 check "odometryd in the namespace sees /var/lib/odometryd (the goldens' wording would differ)" $?
 installed env ODOMETRYD="$ODOMETRYD" ODOMCTL="$ODOMCTL" \
   bash "$here/golden.sh" check "$golden" "$clidir" >"$tmp/golden.out" 2>&1
-rc=$?  # before the message: its command substitution would set $? (golden.sh's stop 36 lesson)
-check "golden.sh check passes with /var/lib/odometryd present$(grep -A6 '^FAIL' "$tmp/golden.out" | head -14 | sed 's/^/\n  /')" $rc
+rc_=$?
+check "golden.sh check passes with /var/lib/odometryd present$(grep -A6 '^FAIL' "$tmp/golden.out" | head -14 | sed 's/^/\n  /')" $rc_
 grep -q "^golden: /var/lib/odometryd exists" "$tmp/golden.out"
 check "golden.sh said it ran its set with an empty /var/lib of its own" $?
 grep -q "golden cli: [1-9][0-9]* passed, 0 failed" "$tmp/golden.out"
