@@ -3,7 +3,8 @@
 # its serial lines wherever a test or a person wants them.
 #
 #   tools/mcu-run.sh [--elf PATH] [--usart1 SPEC] [--usart2 SPEC] [--serial-hz HZ]
-#                    [--duration S] [--virtual] [--fault] [-- extra qemu-system-arm args]
+#                    [--duration S] [--rate-hz HZ] [--covariance-ticks N] [--virtual] [--fault]
+#                    [-- extra qemu-system-arm args]
 #
 #   --elf PATH      the image (default build/mcu-stm32f405/board/odo_mcu_qemu.elf; build it with
 #                   cmake --preset mcu-stm32f405 && cmake --build --preset mcu-stm32f405)
@@ -16,6 +17,10 @@
 #                   number, 0 = off (default 100; 576 is the most 115200 baud carries)
 #   --duration S    seconds of loop time, 0 = forever (default: the simulated square + 1 s; the
 #                   firmware then sends its final frames and QEMU exits with its exit code)
+#   --rate-hz HZ    the loop rate (default 100; 50 Hz pose, 10 Hz Status and --serial-hz must
+#                   divide it)
+#   --covariance-ticks N  loop ticks merged into one covariance step, 1..100 (default 1; README
+#                   "Pose uncertainty": 10 at 1 kHz)
 #   --virtual       virtual time as fast as the host allows (-icount shift=0,sleep=off); default:
 #                   paced at real time (-icount shift=0: one instruction a nanosecond, idle time
 #                   waits for the wall clock), as a peer on a real line needs
@@ -32,6 +37,8 @@ while (($#)); do
     --usart2) u2=$2; shift 2 ;;
     --serial-hz) args+=",arg=--serial-hz,arg=$2"; shift 2 ;;
     --duration) args+=",arg=--duration,arg=$2"; shift 2 ;;
+    --rate-hz) args+=",arg=--rate-hz,arg=$2"; shift 2 ;;
+    --covariance-ticks) args+=",arg=--covariance-ticks,arg=$2"; shift 2 ;;
     --virtual) icount=shift=0,sleep=off; shift ;;
     --fault) args+=",arg=--fault"; shift ;;
     --) shift; extra=("$@"); break ;;

@@ -5,6 +5,8 @@
 //   --duration S  run S seconds of loop time (default: the scenario plus 1 s, as odometryd
 //                 --virtual-time; 0 = forever)   --fault  end in a bus fault after start-up
 //   --serial-hz H the serial counts stream's rate on USART2 [Hz], loop rate / whole number, 0 off
+//   --rate-hz H   the loop rate [Hz] (default 100; the CAN and serial rates must divide it)
+//   --covariance-ticks N  error_model.covariance_ticks (loop ticks merged into one covariance step)
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
@@ -36,7 +38,9 @@ namespace {
 struct Options {
   double duration = -1.0;  // [s]; < 0: the scenario's own
   bool fault = false;
-  double serial_hz = -1.0;  // [Hz] serial counts stream on USART2; < 0: BoardConfig's
+  double serial_hz = -1.0;     // [Hz] serial counts stream on USART2; < 0: BoardConfig's
+  double rate_hz = -1.0;       // [Hz] loop rate; < 0: BoardConfig's
+  long covariance_ticks = -1;  // error_model.covariance_ticks; < 0: BoardConfig's
 };
 
 // parse_options: the semihosting command line's words after the program name.
@@ -51,6 +55,12 @@ Options parse_options() noexcept {
     }
     if (std::strcmp(w, "--serial-hz") == 0) {
       if (char* v = std::strtok(nullptr, " ")) o.serial_hz = std::strtod(v, nullptr);
+    }
+    if (std::strcmp(w, "--rate-hz") == 0) {
+      if (char* v = std::strtok(nullptr, " ")) o.rate_hz = std::strtod(v, nullptr);
+    }
+    if (std::strcmp(w, "--covariance-ticks") == 0) {
+      if (char* v = std::strtok(nullptr, " ")) o.covariance_ticks = std::strtol(v, nullptr, 10);
     }
   }
   return o;
@@ -171,12 +181,25 @@ void say_banner(const ClockInfo& ci, const BoardConfig& cfg) {
 
 // broadcast_options: the CAN ids and the pose and Status rates (as loop-tick divisors) of cfg.
 BroadcastOptions broadcast_options(const BoardConfig& cfg) {
+  const std::int64_t pose_div = protocol::divisor_for(cfg.rate_hz, cfg.pose_hz);
+  const std::int64_t status_div = protocol::divisor_for(cfg.rate_hz, cfg.status_hz);
+  if (pose_div < 0 || status_div < 0) fail("--rate-hz: the pose and Status rates must divide it");
   BroadcastOptions bo;
   bo.base_id = cfg.base_id;
   bo.node_id = cfg.node_id;
-  bo.pose_div = static_cast<std::uint32_t>(protocol::divisor_for(cfg.rate_hz, cfg.pose_hz));
-  bo.status_div = static_cast<std::uint32_t>(protocol::divisor_for(cfg.rate_hz, cfg.status_hz));
+  bo.pose_div = static_cast<std::uint32_t>(pose_div);
+  bo.status_div = static_cast<std::uint32_t>(status_div);
   return bo;
+}
+
+// with_options: the built-in configuration with the command line's loop rate and covariance
+// grouping (the loop's own checks refuse values out of range).
+BoardConfig with_options(const Options& opt) noexcept {
+  BoardConfig cfg;
+  if (opt.rate_hz > 0.0) cfg.rate_hz = opt.rate_hz;
+  if (opt.covariance_ticks >= 0)
+    cfg.error_model.covariance_ticks = static_cast<std::uint32_t>(opt.covariance_ticks);
+  return cfg;
 }
 
 }  // namespace
@@ -185,11 +208,11 @@ BroadcastOptions broadcast_options(const BoardConfig& cfg) {
 int main() {
   using namespace odo;
   using namespace odo::board;
-  static const BoardConfig cfg;
   const ClockInfo ci = clock_init();
   pins_init();
-  uart1().init(ci.apb2_hz, cfg.baud, kIrqUsart1);
   const Options opt = parse_options();
+  static const BoardConfig cfg = with_options(opt);
+  uart1().init(ci.apb2_hz, cfg.baud, kIrqUsart1);
   say_banner(ci, cfg);
   auto k = Kinematics::create(cfg.robot);
   if (!k) fail("kinematics");

@@ -188,6 +188,8 @@ void read_serial(TableReader t, SerialSection& s) {
 void read_error_model(TableReader t, ErrorModelParams& k) {
   k.k_left = t.number("k_left", k.k_left, 0.0, kErrorModelKMax, "m^(1/2)");
   k.k_right = t.number("k_right", k.k_right, 0.0, kErrorModelKMax, "m^(1/2)");
+  k.covariance_ticks = static_cast<std::uint32_t>(
+      t.integer("covariance_ticks", k.covariance_ticks, 1, kCovarianceTicksMax));
   t.finish();
 }
 

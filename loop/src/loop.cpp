@@ -316,7 +316,10 @@ void OdometryLoop::run(TimeNs duration, const std::atomic<bool>& stop) noexcept 
   }
   stats_.wakeup_latency = wakeup_hist_.summary();
   stats_.compute_time = compute_hist_.summary();
-  copy_newest();
+  // Ticks still merged into a covariance group (error_model.covariance_ticks > 1) belong in the
+  // final pose's covariance: the last snapshot is what a stop saves and reports.
+  odom_.flush_covariance();
+  copy_newest().cov = odom_.covariance();
   published_.publish();
 }
 

@@ -188,6 +188,8 @@ std::optional<FieldRange> error_model_range(const ErrorModelParams& k) {
     if (!(std::isfinite(v) && v >= 0.0 && v <= kErrorModelKMax))
       return FieldRange{field, v, 0.0, kErrorModelKMax, "m^(1/2)"};
   }
+  if (k.covariance_ticks < 1 || k.covariance_ticks > kCovarianceTicksMax)
+    return integer_range("covariance_ticks", k.covariance_ticks, 1, kCovarianceTicksMax);
   return std::nullopt;
 }
 
@@ -384,6 +386,32 @@ void propagate_arc_known(Cov3& cov, double sin_theta0, double cos_theta0, double
   }
   propagate_arc_terms(cov, sin_theta0, cos_theta0, d_left, d_right, inv_b, k,
                       arc_terms_of(phi, z, narrow_basic_functions(phi, z)));
+}
+
+void PoseCovariance::merge(double sin_theta0, double cos_theta0, double d_left, double d_right,
+                           double b, double phi) noexcept {
+  // A wheel's variance grows with |d|: summed travels of one sign keep sum |d_i| = |sum d_i|, a
+  // reversal within a group would not, so a reversing wheel (or a new wheelbase) closes it.
+  Group& g = group_;
+  if (g.ticks > 0 && (d_left * g.d_left < 0.0 || d_right * g.d_right < 0.0 || b != g.b)) flush();
+  if (g.ticks == 0) {
+    g.sin0 = sin_theta0;
+    g.cos0 = cos_theta0;
+    g.b = b;
+  }
+  g.d_left += d_left;
+  g.d_right += d_right;
+  g.phi += phi;  // the group's heading change as the pose integrated it
+  if (++g.ticks >= k_.covariance_ticks) flush();
+}
+
+void PoseCovariance::flush() noexcept {
+  if (group_.ticks == 0) return;
+  const Group g = group_;
+  group_ = {};
+  // One arc from the group's start heading with its summed travels: for ticks on one
+  // constant-curvature arc the closed form gives what the ticks one by one give.
+  propagate_known(g.sin0, g.cos0, g.d_left, g.d_right, g.b, g.phi);
 }
 
 void propagate_local(Cov3& cov, double sin_theta0, double cos_theta0, double lx, double ly,

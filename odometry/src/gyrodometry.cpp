@@ -527,6 +527,7 @@ void propagate_gyro_arc(Cov3& cov, double sin_theta0, double cos_theta0, double 
 
 void PoseCovariance::step_gyro_sc(double sin_theta0, double cos_theta0, double d_left,
                                   double d_right, double dtheta, double var_heading) noexcept {
+  flush();  // the merged wheel ticks came before this one
   propagate_gyro_arc(cov_, sin_theta0, cos_theta0, 0.5 * (d_left + d_right), dtheta,
                      along_track_variance(d_left, d_right, k_), var_heading);
 }

@@ -52,6 +52,36 @@ TEST(LoopCovariance, SetPoseResetsCovarianceToZero) {
   EXPECT_LT(s.cov[8], before / 100);
 }
 
+TEST(LoopCovariance, MergedTicksAt1kHzGiveTheSamePoseAndCovariance) {
+  // error_model.covariance_ticks = 10 at 1 kHz (the microcontroller's setting): the pose is
+  // untouched (the merge is the covariance's alone) and the final covariance, flushed when the
+  // run ends, is the tick-by-tick one up to how the curvature changes inside the groups that
+  // span a change of segment (error_model's unit tests bound that at 3e-6 of the scale on a
+  // rounded square; this path has a pivot, where the groups close at the reversing wheel).
+  const auto k = *Kinematics::create(nominal_labmate());
+  const sim::Scenario sc = {{3.0, 6.0, 6.0}, {2.0, 5.0, 7.0}, {1.0, -4.0, 4.0}, {3.0, 6.0, 6.0}};
+  Cov3 cov[2];
+  Pose2 pose[2];
+  for (int i = 0; i < 2; ++i) {
+    sim::SimRunOptions o;
+    o.loop.rate_hz = 1000.0;
+    o.loop.error_model.covariance_ticks = i == 0 ? 1 : 10;
+    auto run = sim::SimRun::create(sim::RobotGeometry{}, k, sc, o).value();
+    run->drive(0.5);
+    EXPECT_EQ(run->loop().odometry().covariance(), run->loop().snapshot().cov);
+    cov[i] = run->loop().snapshot().cov;
+    pose[i] = run->loop().snapshot().pose;
+  }
+  EXPECT_EQ(pose[1].x, pose[0].x);
+  EXPECT_EQ(pose[1].y, pose[0].y);
+  EXPECT_EQ(pose[1].theta, pose[0].theta);
+  EXPECT_GT(cov[0][8], 0.0);
+  for (int i = 0; i < 9; ++i) {
+    const double scale = std::sqrt(cov[0][4 * (i / 3)] * cov[0][4 * (i % 3)]);
+    EXPECT_NEAR(cov[1][i], cov[0][i], 3e-6 * scale) << "entry " << i;
+  }
+}
+
 TEST(LoopCovariance, RejectsBadCoefficients) {
   sim::VirtualClock clock;
   auto robot = *sim::SimRobot::create(sim::RobotGeometry{}, {});
@@ -61,6 +91,12 @@ TEST(LoopCovariance, RejectsBadCoefficients) {
   auto r = loop::OdometryLoop::create(cfg, *Kinematics::create(nominal_labmate()), enc, clock);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().message.find("error_model.k_right = -1"), std::string::npos)
+      << r.error().message;
+  cfg.error_model = {};
+  cfg.error_model.covariance_ticks = 0;
+  r = loop::OdometryLoop::create(cfg, *Kinematics::create(nominal_labmate()), enc, clock);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("error_model.covariance_ticks = 0"), std::string::npos)
       << r.error().message;
 }
 

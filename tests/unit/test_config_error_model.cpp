@@ -25,6 +25,13 @@ TEST(ConfigErrorModel, ReadsValues) {
   ASSERT_TRUE(c.ok()) << c.error().message;
   EXPECT_DOUBLE_EQ(c->error_model.k_left, 0.001);
   EXPECT_DOUBLE_EQ(c->error_model.k_right, 0.0);
+  EXPECT_EQ(c->error_model.covariance_ticks, 1u);  // default: every tick
+  for (const std::uint32_t n : {1u, 10u, 100u}) {  // both ends of the range and a middle
+    auto m =
+        parse_config("[error_model]\ncovariance_ticks = " + std::to_string(n) + "\n", "x.toml");
+    ASSERT_TRUE(m.ok()) << m.error().message;
+    EXPECT_EQ(m->error_model.covariance_ticks, n);
+  }
 }
 
 TEST(ConfigErrorModel, RejectsOutOfRangeAndUnknownKeys) {
@@ -38,6 +45,13 @@ TEST(ConfigErrorModel, RejectsOutOfRangeAndUnknownKeys) {
       {"[error_model]\n\nk_right = 0.58\n", "bad.toml:3: error_model.k_right = 0.58 is outside"},
       {"[error_model]\nk_right = \"small\"\n", "bad.toml:2: error_model.k_right must be a number"},
       {"[error_model]\nk = 0.1\n", "bad.toml:2: error_model.k is not a known setting"},
+      // covariance_ticks: whole ticks, 1..kCovarianceTicksMax (100), both ends and a fraction.
+      {"[error_model]\ncovariance_ticks = 0\n",
+       "bad.toml:2: error_model.covariance_ticks = 0 is outside the allowed range [1, 100]"},
+      {"[error_model]\n\ncovariance_ticks = 101\n",
+       "bad.toml:3: error_model.covariance_ticks = 101 is outside the allowed range [1, 100]"},
+      {"[error_model]\ncovariance_ticks = 2.5\n",
+       "bad.toml:2: error_model.covariance_ticks must be an integer"},
   };
   for (const Bad& b : cases) {
     auto c = parse_config(b.text, "bad.toml");

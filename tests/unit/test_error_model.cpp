@@ -368,6 +368,14 @@ TEST(ErrorModel, ParameterRanges) {
   EXPECT_NE(bad.error().message.find("[0, 0.1]"), std::string::npos);
   EXPECT_FALSE(check_error_model({0.0004, std::nan("")}));
   EXPECT_FALSE(check_error_model({0.0004, 0.2}));
+  EXPECT_TRUE(check_error_model({0.0004, 0.00058, 100}));
+  auto ticks = check_error_model({0.0004, 0.00058, 0});
+  ASSERT_FALSE(ticks);
+  EXPECT_NE(
+      ticks.error().message.find("covariance_ticks = 0 is outside the allowed range [1, 100]"),
+      std::string::npos)
+      << ticks.error().message;
+  EXPECT_FALSE(check_error_model({0.0004, 0.00058, 101}));
 }
 
 TEST(PoseCovariance, ResetZeroes) {
@@ -376,6 +384,101 @@ TEST(PoseCovariance, ResetZeroes) {
   EXPECT_GT(pc.cov()[TT], 0.0);
   pc.reset();
   for (double v : pc.cov()) EXPECT_EQ(v, 0.0);
+}
+
+// drive: n ticks of wheel travels (dl, dr) [m] through pc as the loop's Odometry does (the pose
+// integrator's start heading and its (d_R - d_L) / b as phi).
+void drive(PoseCovariance& pc, PoseIntegrator& pose, int n, double dl, double dr) {
+  for (int i = 0; i < n; ++i) {
+    const double s0 = pose.sin_theta(), c0 = pose.cos_theta(), phi = (dr - dl) / kB;
+    pose.step_arc(0.5 * (dl + dr), phi);
+    pc.step_sc_phi(s0, c0, dl, dr, kB, phi);
+  }
+}
+
+TEST(PoseCovarianceMerged, StraightLineInGroupsHasTheHandValues) {
+  // The hand values of StraightLineHandValues (D = 10 m, b = 0.34 m), driven as 1000 ticks of
+  // 1 cm merged ten at a time: 100 arcs of 0.1 m. The closed form is consistent, so the sum of
+  // the pieces is the whole; the tolerance is the rounding of 100 sums (a few ulp each).
+  PoseCovariance pc({kL, kR, 10});
+  PoseIntegrator pose;
+  drive(pc, pose, 1000, 0.01, 0.01);
+  EXPECT_EQ(pc.pending_ticks(), 0u);
+  const Cov3& p = pc.cov();
+  EXPECT_NEAR(p[XX], 1.241e-6, 1e-12 * 1.241e-6);
+  EXPECT_NEAR(p[YY], 4.964e-4 / 0.3468, 1e-12 * 4.964e-4 / 0.3468);
+  EXPECT_NEAR(p[XY], 1.764e-5 / 1.36, 1e-12 * 1.764e-5 / 1.36);
+  EXPECT_NEAR(p[XT], 1.764e-6 / 0.68, 1e-12 * 1.764e-6 / 0.68);
+  EXPECT_NEAR(p[YT], 4.964e-5 / 0.2312, 1e-12 * 4.964e-5 / 0.2312);
+  EXPECT_NEAR(p[TT], 4.964e-6 / 0.1156, 1e-12 * 4.964e-6 / 0.1156);
+}
+
+TEST(PoseCovarianceMerged, ArcInGroupsEqualsArcTickByTick) {
+  // A constant-curvature arc (d_R / d_L = 1.1, 2000 ticks, 0.59 rad): any grouping of its ticks
+  // is the same arc cut into other pieces, so the covariance is the same to rounding.
+  PoseCovariance one(kParams), grouped({kL, kR, 7});  // 7: groups that end mid-run, 2000 = 7*285+5
+  PoseIntegrator p1, p2;
+  drive(one, p1, 2000, 0.001, 0.0011);
+  drive(grouped, p2, 2000, 0.001, 0.0011);
+  EXPECT_EQ(grouped.pending_ticks(), 5u);
+  grouped.flush();
+  EXPECT_EQ(grouped.pending_ticks(), 0u);
+  expect_cov_near(grouped.cov(), one.cov(), 1e-11, "arc");
+}
+
+TEST(PoseCovarianceMerged, LagsByThePendingTicksAndResetDropsThem) {
+  // Nine ticks of ten: none propagated yet; the tenth propagates the group.
+  PoseCovariance pc({kL, kR, 10});
+  PoseIntegrator pose;
+  drive(pc, pose, 9, 0.01, 0.01);
+  EXPECT_EQ(pc.pending_ticks(), 9u);
+  for (double v : pc.cov()) EXPECT_EQ(v, 0.0);
+  drive(pc, pose, 1, 0.01, 0.01);
+  EXPECT_EQ(pc.pending_ticks(), 0u);
+  EXPECT_GT(pc.cov()[TT], 0.0);
+  // A set pose is exact: the pending ticks belong to the pose it replaced.
+  drive(pc, pose, 4, 0.01, 0.01);
+  pc.reset();
+  EXPECT_EQ(pc.pending_ticks(), 0u);
+  pc.flush();
+  for (double v : pc.cov()) EXPECT_EQ(v, 0.0);
+}
+
+TEST(PoseCovarianceMerged, AReversingWheelClosesTheGroup) {
+  // 5 cm forward then 5 cm back, 1 cm a tick, groups of 10. Summed over the reversal the travels
+  // would cancel (no variance at all); closed at it, each straight half is its own arc, as tick by
+  // tick: tt = (k_L^2 + k_R^2) * 0.1 m / b^2 = 4.964e-8 / 0.1156.
+  PoseCovariance one(kParams), grouped({kL, kR, 10});
+  PoseIntegrator p1, p2;
+  for (auto* g : {&one, &grouped}) {
+    PoseIntegrator& p = g == &one ? p1 : p2;
+    drive(*g, p, 5, 0.01, 0.01);
+    drive(*g, p, 5, -0.01, -0.01);
+  }
+  grouped.flush();
+  EXPECT_NEAR(grouped.cov()[TT], 4.964e-8 / 0.1156, 1e-12 * 4.964e-8 / 0.1156);
+  expect_cov_near(grouped.cov(), one.cov(), 1e-12, "reversal");
+}
+
+TEST(PoseCovarianceMerged, RoundedCornersInGroupsStayWithinThreeMillionths) {
+  // A square with rounded corners at 1 kHz: 4 m sides at 0.2 m/s (0.2 mm a tick) and quarter
+  // turns on arcs (0.1 and 0.3 mm a tick: phi = 0.2 mm / b = 5.9e-4 rad a tick, 2670 ticks),
+  // in groups of 10. No wheel reverses, so a group that spans a corner's start or end is taken
+  // as one arc although its curvature changes inside it: eight such groups in 17 m. Each moves
+  // part of 10 ticks' noise by a fraction of 10 ticks' heading change (5.9e-3 rad), against the
+  // whole path's covariance: measured 2.8e-7 of the scale (entry x-y, 1.8e-10 m^2 of 6.5e-4); the
+  // bound is ten times that.
+  PoseCovariance one(kParams), grouped({kL, kR, 10});
+  PoseIntegrator p1, p2;
+  for (auto* g : {&one, &grouped}) {
+    PoseIntegrator& p = g == &one ? p1 : p2;
+    for (int side = 0; side < 4; ++side) {
+      drive(*g, p, 20003, 0.0002, 0.0002);  // 20003: the corners fall inside groups
+      drive(*g, p, 2670, 0.0001, 0.0003);
+    }
+  }
+  grouped.flush();
+  expect_cov_near(grouped.cov(), one.cov(), 3e-6, "rounded square");
 }
 
 TEST(ErrorModel, TwistCovarianceOfTheWheelsHandValues) {

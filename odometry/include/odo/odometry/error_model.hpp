@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <optional>
 
 #include "odo/hal/field_range.hpp"
@@ -20,13 +21,21 @@ using Cov3 = std::array<double, 9>;
 struct ErrorModelParams {
   double k_left = 0.00040;   // k_L [m^(1/2)], the paper's fitted value
   double k_right = 0.00058;  // k_R [m^(1/2)]
+  // Loop ticks merged into one covariance step (1: every tick). The closed form is consistent
+  // (an arc cut into pieces gives the covariance of the whole), so a group of ticks taken as one
+  // arc of their summed travels changes the covariance only by how much the group's curvature
+  // varies; a fast loop (1 kHz on a microcontroller) saves the step's cost on all other ticks.
+  std::uint32_t covariance_ticks = 1;
 };
 
 // Allowed range of k_L and k_R [m^(1/2)]: 0 (no noise) up to 0.1 (10 cm after 1 m).
 inline constexpr double kErrorModelKMax = 0.1;
+// Allowed range of covariance_ticks: 1 up to 100 (0.1 s of covariance lag at 1 kHz).
+inline constexpr std::uint32_t kCovarianceTicksMax = 100;
 
-// error_model_range: the first coefficient that is not finite or not within
-// [0, kErrorModelKMax], as data (field "k_left" or "k_right"); nullopt when both are.
+// error_model_range: the first parameter that is not finite or not within its range (k_left,
+// k_right: [0, kErrorModelKMax]; covariance_ticks: [1, kCovarianceTicksMax]), as data; nullopt
+// when all are.
 std::optional<FieldRange> error_model_range(const ErrorModelParams& k);
 // check_error_model: the same as an error (message from range_message).
 Status check_error_model(const ErrorModelParams& k);
@@ -97,45 +106,84 @@ void propagate_arc_known(Cov3& cov, double sin_theta0, double cos_theta0, double
 void propagate_local(Cov3& cov, double sin_theta0, double cos_theta0, double lx, double ly,
                      const Cov3& q) noexcept;
 
-// PoseCovariance: the running covariance of the integrated pose; starts at zero.
+// PoseCovariance: the running covariance of the integrated pose; starts at zero. With
+// covariance_ticks = n > 1 the ticks' arcs are summed and propagated as one arc every n ticks
+// (and before anything that must follow them: a gyro tick, a wheel that reverses, a new
+// wheelbase); cov() then lags the pose by at most n - 1 ticks.
 class PoseCovariance {
  public:
   explicit PoseCovariance(const ErrorModelParams& k = {}) : k_(k) {}
   // reset: zero covariance (a pose that was just set is taken as exact).
-  void reset() noexcept { cov_ = {}; }
+  void reset() noexcept {
+    cov_ = {};
+    group_ = {};
+  }
   // restore: continue from a covariance saved earlier (a resumed state record).
-  void restore(const Cov3& cov) noexcept { cov_ = cov; }
+  void restore(const Cov3& cov) noexcept {
+    cov_ = cov;
+    group_ = {};
+  }
   // step: add one tick's arc; theta0 is the heading at the start of the tick [rad], d_left and
   // d_right the wheel travels of the tick [m], b the wheelbase [m].
   void step(double theta0, double d_left, double d_right, double b) noexcept {
+    flush();
     propagate_arc(cov_, theta0, d_left, d_right, b, k_);
   }
   // step_sc: the same with the start heading as sin and cos (no trigonometric call).
   void step_sc(double sin_theta0, double cos_theta0, double d_left, double d_right,
                double b) noexcept {
+    flush();
     propagate_arc(cov_, sin_theta0, cos_theta0, d_left, d_right, b, k_);
   }
   // step_sc_phi: step_sc of a tick whose phi = (d_right - d_left) / b [rad] the caller has
-  // computed (the pose step's heading change); 1 / b is kept from the last tick's b.
+  // computed (the pose step's heading change); 1 / b is kept from the last tick's b. Merged
+  // into groups of covariance_ticks ticks.
   void step_sc_phi(double sin_theta0, double cos_theta0, double d_left, double d_right, double b,
                    double phi) noexcept {
+    if (k_.covariance_ticks > 1) {
+      merge(sin_theta0, cos_theta0, d_left, d_right, b, phi);
+      return;
+    }
+    propagate_known(sin_theta0, cos_theta0, d_left, d_right, b, phi);
+  }
+  // step_gyro_sc: a tick whose heading change dtheta [rad] came from the gyro, with heading
+  // variance var_heading [rad^2] (gyrodometry.hpp propagate_gyro_arc; defined there).
+  void step_gyro_sc(double sin_theta0, double cos_theta0, double d_left, double d_right,
+                    double dtheta, double var_heading) noexcept;
+  // flush: propagate the ticks merged so far (none: nothing), so that cov() includes them.
+  void flush() noexcept;
+  // pending_ticks: ticks merged but not yet in cov() (0 with covariance_ticks = 1).
+  std::uint32_t pending_ticks() const noexcept { return group_.ticks; }
+  void set_params(const ErrorModelParams& k) noexcept {
+    flush();
+    k_ = k;
+  }
+  const ErrorModelParams& params() const noexcept { return k_; }
+  const Cov3& cov() const noexcept { return cov_; }
+
+ private:
+  // Group: the ticks merged since the last covariance step.
+  struct Group {
+    std::uint32_t ticks = 0;
+    double sin0 = 0.0, cos0 = 1.0;  // of the heading at the start of the group's first tick
+    double d_left = 0.0, d_right = 0.0, phi = 0.0;  // summed [m, m, rad]
+    double b = 0.0;                                 // wheelbase of every tick in it [m]
+  };
+  // merge: add one tick to the group, propagating the group when it is full.
+  void merge(double sin_theta0, double cos_theta0, double d_left, double d_right, double b,
+             double phi) noexcept;
+  // propagate_known: one arc with phi known, 1 / b kept for the last b.
+  void propagate_known(double sin_theta0, double cos_theta0, double d_left, double d_right,
+                       double b, double phi) noexcept {
     if (b != inv_b_of_) {  // the wheelbase changes only with a new calibration
       inv_b_of_ = b;
       inv_b_ = 1.0 / b;
     }
     propagate_arc_known(cov_, sin_theta0, cos_theta0, d_left, d_right, b, inv_b_, phi, k_);
   }
-  // step_gyro_sc: a tick whose heading change dtheta [rad] came from the gyro, with heading
-  // variance var_heading [rad^2] (gyrodometry.hpp propagate_gyro_arc; defined there).
-  void step_gyro_sc(double sin_theta0, double cos_theta0, double d_left, double d_right,
-                    double dtheta, double var_heading) noexcept;
-  void set_params(const ErrorModelParams& k) noexcept { k_ = k; }
-  const ErrorModelParams& params() const noexcept { return k_; }
-  const Cov3& cov() const noexcept { return cov_; }
-
- private:
   ErrorModelParams k_;
   Cov3 cov_{};
+  Group group_{};
   double inv_b_of_ = 0.0;  // the wheelbase [m] that inv_b_ is the reciprocal of
   double inv_b_ = 0.0;     // 1.0 / inv_b_of_ [1/m]
 };

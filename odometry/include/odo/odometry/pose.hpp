@@ -177,6 +177,9 @@ class Odometry {
   // var_heading [rad^2] instead of the wheels' differential noise (propagate_gyro_arc).
   void advance_fused(double d_l, double d_r, double dt, double dtheta, double ds_correction,
                      bool gyro_heading, double var_heading) noexcept;
+  // flush_covariance: propagate the ticks the covariance still has merged
+  // (ErrorModelParams::covariance_ticks > 1), so that covariance() is the pose's.
+  void flush_covariance() noexcept { cov_.flush(); }
   // set_kinematics: swap in new calibration (e.g. after SIGHUP); the pose is kept.
   void set_kinematics(const Kinematics& k) noexcept { k_ = k; }
 
@@ -189,7 +192,8 @@ class Odometry {
   double distance() const noexcept { return distance_; }            // path length of the centre [m]
   double last_d_left() const noexcept { return d_left_; }    // wheel travel of the last tick [m]
   double last_d_right() const noexcept { return d_right_; }  // [m]
-  // covariance: of (x, y, theta), row-major [m^2, m rad, rad^2], accumulated by advance().
+  // covariance: of (x, y, theta), row-major [m^2, m rad, rad^2], accumulated by advance(); with
+  // covariance_ticks = n > 1 it is that of the pose up to n - 1 ticks ago.
   const Cov3& covariance() const noexcept { return cov_.cov(); }
 
  private:
