@@ -11,8 +11,10 @@
 #              poll.h); that is drivers/' job (issue 33). Threads and their semaphores stay.
 #   functions  no function of the project's own code (tests excepted) is longer than 60 lines
 #              (clang-tidy's readability-function-size over build/default's compile database)
+#   tests      every GoogleTest target is named after its tier and unit (`<label>_<unit>`,
+#              tests/CMakeLists.txt's odo_add_gtest), so a test's tier is in its name (issue 33)
 # The layer table needs no check here: configure (odo_check_layers) fails on a wrong link.
-# Usage: tools/check_core.sh [portable] [composition] [functions]   (default: all three)
+# Usage: tools/check_core.sh [portable] [composition] [functions] [tests]   (default: all four)
 set -euo pipefail
 ODO_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$ODO_ROOT"
@@ -72,13 +74,29 @@ check_functions() {
   fi
 }
 
+check_tests() {
+  local bad
+  # odo_add_gtest(NAME LABEL TIER ...): NAME must start with TIER_.
+  bad=$(grep -oE 'odo_add_gtest\([A-Za-z0-9_]+ LABEL [a-z0-9]+' tests/CMakeLists.txt |
+    sed -E 's/odo_add_gtest\(([A-Za-z0-9_]+) LABEL ([a-z0-9]+)/\1 \2/' |
+    awk '{ if (index($1, $2 "_") != 1) print "  " $1 " (label " $2 ")" }')
+  if [[ -n $bad ]]; then
+    echo "check_core: tests: a test target's name must start with its tier (<label>_<unit>):"
+    echo "$bad"
+    rc=1
+  else
+    echo "check_core: tests: every test target is named <tier>_<unit>"
+  fi
+}
+
 checks=("$@")
-((${#checks[@]})) || checks=(portable composition functions)
+((${#checks[@]})) || checks=(portable composition functions tests)
 for c in "${checks[@]}"; do
   case $c in
     portable) check_portable ;;
     composition) check_composition ;;
     functions) check_functions ;;
+    tests) check_tests ;;
     *) echo "check_core: unknown check $c" >&2; exit 2 ;;
   esac
 done
