@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "odo/board/board_config.hpp"
+#include "odo/board/bxcan.hpp"
 #include "odo/board/mmio_bus.hpp"
 #include "odo/board/pins.hpp"
 #include "odo/board/serial_stream.hpp"
@@ -38,9 +39,9 @@ namespace {
 struct Options {
   double duration = -1.0;  // [s]; < 0: the scenario's own
   bool fault = false;
-  double serial_hz = -1.0;     // [Hz] serial counts stream on USART2; < 0: BoardConfig's
-  double rate_hz = -1.0;       // [Hz] loop rate; < 0: BoardConfig's
-  long covariance_ticks = -1;  // error_model.covariance_ticks; < 0: BoardConfig's
+  double serial_hz = -1.0;         // [Hz] serial counts stream on USART2; < 0: BoardConfig's
+  double rate_hz = -1.0;           // [Hz] loop rate; < 0: BoardConfig's
+  double covariance_ticks = -1.0;  // error_model.covariance_ticks; < 0: BoardConfig's
 };
 
 // parse_options: the semihosting command line's words after the program name.
@@ -60,7 +61,7 @@ Options parse_options() noexcept {
       if (char* v = std::strtok(nullptr, " ")) o.rate_hz = std::strtod(v, nullptr);
     }
     if (std::strcmp(w, "--covariance-ticks") == 0) {
-      if (char* v = std::strtok(nullptr, " ")) o.covariance_ticks = std::strtol(v, nullptr, 10);
+      if (char* v = std::strtok(nullptr, " ")) o.covariance_ticks = std::strtod(v, nullptr);
     }
   }
   return o;
@@ -192,13 +193,37 @@ BroadcastOptions broadcast_options(const BoardConfig& cfg) {
   return bo;
 }
 
+// pose_bus: where the protocol's frames go. QEMU models no bxCAN: there USART1 carries them as
+// SLCAN. A board: CAN1 at 500 kbit/s (PB8 RX, PB9 TX), its filter passing only this node's
+// set-pose frames into FIFO 0; USART1 keeps the '#' reports.
+CanBus& pose_bus(const BoardConfig& cfg) noexcept {
+#if ODO_BOARD_SIM
+  (void)cfg;
+  static SlcanBus bus(uart1());
+  return bus;
+#else
+  reg(rcc::kApb1Enr) |= 1u << 25;  // CAN1EN: the controller's clock before its registers
+  static MmioBus mmio;
+  static BxCan can(mmio);
+  const std::uint32_t set_pose =
+      protocol::frame_id(cfg.base_id, cfg.node_id, protocol::Msg::kSetPose);
+  if (auto s = can.init(BxCan::kBtr500k, set_pose, 0x7FFu); !s) fail(s.error().message.c_str());
+  return can;
+#endif
+}
+
 // with_options: the built-in configuration with the command line's loop rate and covariance
 // grouping (the loop's own checks refuse values out of range).
 BoardConfig with_options(const Options& opt) noexcept {
   BoardConfig cfg;
   if (opt.rate_hz > 0.0) cfg.rate_hz = opt.rate_hz;
-  if (opt.covariance_ticks >= 0)
-    cfg.error_model.covariance_ticks = static_cast<std::uint32_t>(opt.covariance_ticks);
+  // strtod, already linked for the rates, instead of strtol (1 KB more); a fraction or a value
+  // out of range becomes 0 and the loop's own check refuses it.
+  if (opt.covariance_ticks >= 0.0) {
+    const double n = opt.covariance_ticks;
+    const bool whole = n == static_cast<double>(static_cast<std::uint32_t>(n)) && n <= 1e6;
+    cfg.error_model.covariance_ticks = whole ? static_cast<std::uint32_t>(n) : 0u;
+  }
   return cfg;
 }
 
@@ -228,9 +253,9 @@ int main() {
   lc.calibration = cal.status;
   TimerClock& clock = timer_clock();
   auto created = loop::OdometryLoop::create(lc, *kc, latched, clock);
-  if (!created) fail("loop configuration");
+  if (!created) fail(created.error().message.c_str());  // names the setting and its range
   static std::unique_ptr<loop::OdometryLoop> lp = std::move(created).value();
-  static SlcanBus bus(uart1());
+  CanBus& bus = pose_bus(cfg);
   static PoseBroadcaster bc(broadcast_options(cfg), bus, lp->commands());
   lp->add_observer(&bc);
   uart2().init(ci.apb1_hz, cfg.baud, kIrqUsart2);

@@ -31,6 +31,8 @@ void pins_init() noexcept {
   alternate(kGpioA, 7, 2);                      // TIM3 CH2: left encoder B
   alternate(kGpioB, 6, 2);                      // TIM4 CH1: right encoder A
   alternate(kGpioB, 7, 2);                      // TIM4 CH2: right encoder B
+  alternate(kGpioB, 8, 9);                      // CAN1 RX (pulled up: recessive when unwired)
+  alternate(kGpioB, 9, 9);                      // CAN1 TX
 }
 
 }  // namespace odo::board

@@ -145,6 +145,11 @@ pose "$tmp/mcukhz.log" >"$tmp/mcukhz.pose"
 rc=$?  # before the name is expanded: its $(...) would set $? to its own status
 check "1 kHz: $(wc -l <"$tmp/mcukhz.pose") pose frames equal odometryd's" $rc
 
+qemu "$tmp/khzbad.txt" --covariance-ticks 0 --duration 1
+[ $? = 2 ] && tr '\r' '\n' <"$tmp/khzbad.txt" |
+  grep -q '^# error: error_model.covariance_ticks = 0 is outside the allowed range \[1, 100\]'
+check "--covariance-ticks 0 refused (exit 2) naming the setting and its range" $?
+
 # 3. Fault report.
 qemu "$tmp/fault.txt" --fault
 [ $? = 3 ]
