@@ -306,6 +306,30 @@ TEST(ZeroAlloc, AnAllocationInsideATickIsCaught) {
   EXPECT_EQ(g_frees.load(), 10u);
 }
 
+TEST(ZeroAlloc, CovarianceMergedOverTicksAllocatesNothing) {
+  // error_model.covariance_ticks = 10 at 1 kHz (the microcontroller's setting): the groups of
+  // ticks, their early closes at the corners' reversing wheels and a set pose's drop of the
+  // pending ticks, over both squares.
+  fw::Config cfg = fw::default_config();
+  cfg.sim.scenario = fw::SimScenario::kSquares;
+  auto kin = Kinematics::create(cfg.robot);
+  auto rig = fw::Rig::create(cfg, *kin, true);
+  ASSERT_TRUE(rig.ok()) << rig.error().message;
+  loop::LoopConfig lc;
+  lc.rate_hz = 1000.0;
+  lc.error_model.covariance_ticks = 10;
+  auto loop = loop::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
+  loop->start();
+  AllocWindow w;
+  for (int i = 0; i < 200'000; ++i) {
+    loop->tick();
+    if (i == 150'005) ASSERT_TRUE(loop->post(loop::SetPose{{0.0, 0.0, 0.0}}));
+  }
+  w.disarm();
+  EXPECT_EQ(g_allocs.load(), 0u);
+  EXPECT_GT(loop->odometry().covariance()[8], 0.0);  // the groups were propagated
+}
+
 TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   // The daemon's own wiring: default config (simulated LabMate driving two squares), 1 kHz on
   // the virtual clock, ground-truth observer attached. Start-up may allocate; ticks may not.
