@@ -22,7 +22,7 @@ std::uint8_t gyro_state(const loop::LoopGyroStatus& g) noexcept {
 
 CanBroadcaster::CanBroadcaster(const CanBroadcastOptions& o, CanBus& bus,
                                loop::CommandQueue* commands, CanFrameRing* log) noexcept
-    : o_(o), bus_(&bus), log_(log), rx_(o, bus, commands) {}
+    : o_(o), bus_(&bus), log_(log), rx_(o, bus, commands, c_) {}
 
 void CanBroadcaster::send(const CanFrame& f, std::int64_t loop_time) noexcept {
   switch (bus_->send(f)) {

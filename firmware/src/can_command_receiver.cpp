@@ -26,14 +26,14 @@ void CanCommandReceiver::take_commands(CanFrame& f) noexcept {
       continue;  // not for us (a SocketCAN filter normally keeps these out)
     protocol::SetPoseCmd cmd;
     if (!protocol::decode_set_pose(f, cmd)) {
-      ++c_.set_pose_rejected;
+      ++c_->set_pose_rejected;
       continue;
     }
     if (commands_ != nullptr && !commands_->post(loop::SetPose{Pose2{cmd.x, cmd.y, cmd.theta}})) {
-      ++c_.set_pose_rejected;  // the loop's queue is full (it stopped taking commands)
+      ++c_->set_pose_rejected;  // the loop's queue is full (it stopped taking commands)
       continue;
     }
-    ++c_.set_pose_applied;
+    ++c_->set_pose_applied;
     ++pending_ack_;
   }
 }
@@ -41,12 +41,12 @@ void CanCommandReceiver::take_commands(CanFrame& f) noexcept {
 void CanCommandReceiver::take_fix(const CanFrame& f, protocol::Msg m) noexcept {
   if (m == protocol::Msg::kFixPose) {
     have_fix_half_ = protocol::decode_fix_pose(f, fix_half_);
-    if (!have_fix_half_) ++c_.fixes_refused;
+    if (!have_fix_half_) ++c_->fixes_refused;
     return;
   }
   protocol::FixMsg fm = fix_half_;
   if (!have_fix_half_ || !protocol::decode_fix_sigma(f, fm) || fm.seq != fix_half_.seq) {
-    ++c_.fixes_refused;
+    ++c_->fixes_refused;
     return;
   }
   have_fix_half_ = false;
@@ -58,9 +58,9 @@ void CanCommandReceiver::take_fix(const CanFrame& f, protocol::Msg m) noexcept {
   p.sigma_xy = fm.sigma_xy;
   p.sigma_theta = fm.sigma_theta;
   if (fixes_->push(p))
-    ++c_.fixes_forwarded;
+    ++c_->fixes_forwarded;
   else
-    ++c_.fixes_refused;
+    ++c_->fixes_refused;
 }
 
 }  // namespace odo::fw

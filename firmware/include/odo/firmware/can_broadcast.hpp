@@ -57,7 +57,7 @@ class CanBroadcaster final : public loop::TickObserver {
   void send_final(const loop::LoopSnapshot& snap) noexcept;
 
   // counters: what was sent and dropped, and what the receiver took.
-  CanBroadcastCounters counters() const noexcept { return {c_, rx_.counters()}; }
+  const CanBroadcastCounters& counters() const noexcept { return c_; }
   std::uint8_t seq() const noexcept { return seq_; }
   // set_fix_ring: configure time; FixPose + FixSigma addressed to this node go there (null:
   // fix frames are ignored).
@@ -85,9 +85,9 @@ class CanBroadcaster final : public loop::TickObserver {
   CanBroadcastOptions o_;
   CanBus* bus_;
   CanFrameRing* log_;
-  CanTxCounters c_;
-  CanCommandReceiver rx_;  // set-pose and fixes, taken at the start of each tick
-  std::uint8_t seq_ = 0;   // pose group counter (first group: 0)
+  CanBroadcastCounters c_;  // the transmit part here, the command part the receiver's
+  CanCommandReceiver rx_;   // set-pose and fixes, taken at the start of each tick
+  std::uint8_t seq_ = 0;    // pose group counter (first group: 0)
   bool sent_any_pose_ = false;
   std::uint8_t ack_ = 0;  // set-pose commands applied (mod 256), in the status frame
   // Ticks strictly between quiet_after_ and quiet_after_ + quiet_span_ + 1 are a multiple of no

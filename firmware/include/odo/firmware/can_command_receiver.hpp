@@ -33,9 +33,11 @@ struct CanCommandCounters {
 class CanCommandReceiver {
  public:
   // bus: where commands arrive; commands: the loop's queue for set-pose commands (may be null:
-  // commands ignored).
-  CanCommandReceiver(const CanReceiveOptions& o, CanBus& bus, loop::CommandQueue* commands) noexcept
-      : o_(o), bus_(&bus), commands_(commands) {}
+  // commands ignored); counters: where the counts go (the owner's, so that its own counters
+  // and these are one struct its readers can hold a reference to).
+  CanCommandReceiver(const CanReceiveOptions& o, CanBus& bus, loop::CommandQueue* commands,
+                     CanCommandCounters& counters) noexcept
+      : o_(o), bus_(&bus), commands_(commands), c_(&counters) {}
 
   // receive: on the loop thread, once a tick: takes up to max_rx_per_tick frames; `stamp` is
   // the tick's sample time [ns] (a fix's age counts back from it).
@@ -47,7 +49,7 @@ class CanCommandReceiver {
     pending_ack_ = 0;
     return n;
   }
-  const CanCommandCounters& counters() const noexcept { return c_; }
+  const CanCommandCounters& counters() const noexcept { return *c_; }
   // set_fix_ring: configure time; FixPose + FixSigma addressed to this node go there (null:
   // fix frames are ignored).
   void set_fix_ring(loop::FixRing* r) noexcept { fixes_ = r; }
@@ -63,7 +65,7 @@ class CanCommandReceiver {
   CanReceiveOptions o_;
   CanBus* bus_;
   loop::CommandQueue* commands_;
-  CanCommandCounters c_;
+  CanCommandCounters* c_;
   std::uint32_t pending_ack_ = 0;  // requested this tick, applied at the next one
   loop::FixRing* fixes_ = nullptr;
   protocol::FixMsg fix_half_;  // the last FixPose received

@@ -42,7 +42,7 @@ class CanLink {
   void close_log();
   // finish: send_final, then close_log.
   void finish(const loop::LoopSnapshot& snap);
-  CanBroadcastCounters counters() const noexcept { return bc_->counters(); }
+  const CanBroadcastCounters& counters() const noexcept { return bc_->counters(); }
   // set_fix_ring: absolute fixes received on this link go to `r` (configure time).
   void set_fix_ring(loop::FixRing* r) noexcept { bc_->set_fix_ring(r); }
   std::uint64_t log_written() const noexcept { return log_ ? log_->written() : 0; }
