@@ -5,7 +5,7 @@
 #include <ctime>
 
 #include "odo/firmware/calibration_store.hpp"
-#include "odo/firmware/can_broadcast.hpp"
+#include "odo/firmware/can_link.hpp"
 #include "odo/loop/loop.hpp"
 
 namespace odo::fw {

@@ -17,7 +17,7 @@
 #include <unistd.h>
 
 #include "odo/drivers/serial_port.hpp"
-#include "odo/firmware/can_broadcast.hpp"
+#include "odo/firmware/can_link.hpp"
 #include "odo/firmware/config.hpp"
 #include "odo/firmware/rig.hpp"
 #include "odo/firmware/state_persist.hpp"

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 
+#include "odo/hal/choice.hpp"
 #include "odo/hal/time.hpp"
 
 namespace odo {
@@ -19,6 +20,17 @@ enum EncoderFlag : std::uint32_t {
   kEncoderControllerReset = 1u << 6,    // serial: the controller restarted (counts re-based)
   kEncoderNoValidData = 1u << 7,        // serial: bytes arrive, none valid (wrong baud/protocol?)
 };
+
+// The flags' names in odometryd's status line (README), in the order they are printed.
+inline constexpr Choice<EncoderFlag> kEncoderFlagNames[] = {
+    {kEncoderStaleLeft, "stale-left"},
+    {kEncoderStaleRight, "stale-right"},
+    {kEncoderInvalidTransition, "invalid-transition"},
+    {kEncoderImplausibleJump, "implausible-jump"},
+    {kEncoderReadError, "read-error"},
+    {kEncoderLinkError, "link-error"},
+    {kEncoderControllerReset, "controller-reset"},
+    {kEncoderNoValidData, "no-valid-data(wrong-baud?)"}};
 
 // Cumulative event counters of a backend since start; they only grow.
 struct EncoderCounters {

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 
+#include "odo/hal/choice.hpp"
 #include "odo/hal/time.hpp"
 
 namespace odo {
@@ -21,6 +22,13 @@ enum GyroFlag : std::uint32_t {
   // but not a fault either; after the timeout it becomes kGyroStale.
   kGyroStarting = 1u << 4,
 };
+
+// The flags' names in odometryd's status line (README "Gyro"), in the order they are printed.
+inline constexpr Choice<GyroFlag> kGyroFlagNames[] = {{kGyroStarting, "starting"},
+                                                      {kGyroStale, "stale"},
+                                                      {kGyroSaturated, "saturated"},
+                                                      {kGyroInvalid, "invalid"},
+                                                      {kGyroReadError, "read-error"}};
 
 // Cumulative event counters of a gyro backend since start; they only grow.
 struct GyroCounters {
