@@ -323,7 +323,9 @@ TEST(ZeroAlloc, CovarianceMergedOverTicksAllocatesNothing) {
   AllocWindow w;
   for (int i = 0; i < 200'000; ++i) {
     loop->tick();
-    if (i == 150'005) ASSERT_TRUE(loop->post(loop::SetPose{{0.0, 0.0, 0.0}}));
+    if (i == 150'005) {
+      ASSERT_TRUE(loop->post(loop::SetPose{{0.0, 0.0, 0.0}}));
+    }
   }
   w.disarm();
   EXPECT_EQ(g_allocs.load(), 0u);
