@@ -221,7 +221,8 @@ BoardConfig with_options(const Options& opt) noexcept {
   // out of range becomes 0 and the loop's own check refuses it.
   if (opt.covariance_ticks >= 0.0) {
     const double n = opt.covariance_ticks;
-    const bool whole = n == static_cast<double>(static_cast<std::uint32_t>(n)) && n <= 1e6;
+    // The bound first: converting a double beyond uint32_t's range is undefined.
+    const bool whole = n <= 1e6 && n == static_cast<double>(static_cast<std::uint32_t>(n));
     cfg.error_model.covariance_ticks = whole ? static_cast<std::uint32_t>(n) : 0u;
   }
   return cfg;
