@@ -356,7 +356,9 @@ TEST(CandumpLog, TimeStampsBeyondTheNanosecondClockAreRefused) {
 // The DBC file is the signal table written out: its BO_ and SG_ lines are exactly those derived
 // from protocol/signals.hpp (ids for node 1 at base 0x400), factors and limits as plain decimals.
 TEST(CanProtocolDbc, FileMatchesTheSignalTable) {
-  std::ifstream in(std::string(ODO_SOURCE_DIR) + "/protocol/odometry.dbc");
+  std::string path = ODO_SOURCE_DIR;
+  path += "/protocol/odometry.dbc";  // two steps: see TESTING.md, "The tests' precompiled header"
+  std::ifstream in(path);
   ASSERT_TRUE(in) << "protocol/odometry.dbc not found";
   std::vector<std::string> got;
   for (std::string line; std::getline(in, line);) {
