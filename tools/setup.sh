@@ -15,7 +15,7 @@ test_pkgs=(libgtest-dev libgmock-dev libbenchmark-dev valgrind
   can-utils python3-can iproute2  # CAN kernel tests in the VM (candump, cansend, ip, tc)
   rt-tests stress-ng systemd  # cyclictest + load for tools/jitter.sh; systemd-analyze verify
   clang-14 libclang-rt-14-dev libfuzzer-14-dev  # fuzz preset: clang-14 + libFuzzer (TESTING.md)
-  clang-tidy-14  # tools/check_core.sh: no function over 60 lines (readability-function-size)
+  universal-ctags  # tools/check_core.sh: no function over 60 lines (tools/function_size.py)
   tmux librsvg2-bin  # cli_umbmark_tty (a real terminal), cli_umbmark_svg (rsvg-convert)
   libfastrtps-dev fastddsgen  # the independent Fast DDS peer of the ROS 2 tests (fastddsgen: Java)
   # The microcontroller firmware (preset mcu-stm32f405, board/) and its QEMU tests (stage mcu).
