@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include "odo/analysis/umbmark_tools.hpp"
+#include "odo/sim/sim_run.hpp"
+#include "odo/sim/skid_steer.hpp"
 
 namespace odo::test {
 namespace {
@@ -18,6 +21,32 @@ analysis::UmbmarkSimResult simulate_skid4(int runs) {
   auto r = analysis::run_umbmark_simulation(o);
   EXPECT_TRUE(r.ok()) << (r.ok() ? "" : r.error().message);
   return r.ok() ? std::move(r).value() : analysis::UmbmarkSimResult{};
+}
+
+TEST(UmbmarkSkid4, GeometricTrackOdometryOverestimatesTheSpotTurn) {
+  // The skid body through the same SimRun path as the LabMate (SimEncoderSource, the loop at its
+  // default rate): a spot turn whose rims each travel d = (pi/2) t / 2 makes odometry with the
+  // geometric track t report 90 deg, while the body turns only 2d / B = (pi/2) t / B with
+  // B = 0.5583531 m (unit_skid_steer): 90 deg / 1.486603 = 60.54 deg, about its own centre.
+  const sim::RobotGeometry g = sim::skid4_geometry();
+  auto believed = Kinematics::create(sim::nominal_params(0.196, g.wheelbase, g));
+  ASSERT_TRUE(believed.ok());
+  auto body = sim::SkidSteerBody::create(sim::jackal_skid_params());
+  ASSERT_TRUE(body.ok());
+  const double pi = std::numbers::pi, d = pi / 2.0 * g.wheelbase / 2.0, duration = 2.0;
+  const double w = d / 0.098 / duration;  // [rad/s] of each wheel
+  sim::SimRunOptions ro;
+  ro.skid = &*body;
+  auto run = sim::SimRun::create(g, *believed, {{duration, -w, w}}, ro);
+  ASSERT_TRUE(run.ok());
+  (*run)->drive(0.5);
+  const Pose2 odo = (*run)->loop().odometry().pose();
+  const Pose2 truth = (*run)->robot().true_pose();
+  EXPECT_NEAR(odo.theta, pi / 2.0, 1e-3);  // whole encoder counts
+  EXPECT_NEAR(truth.theta, pi / 2.0 * g.wheelbase / 0.5583531, 1e-6);
+  EXPECT_NEAR(truth.x, 0.0, 1e-12);
+  EXPECT_NEAR(truth.y, 0.0, 1e-12);
+  EXPECT_EQ(body->unconverged(), 0U);
 }
 
 TEST(UmbmarkSkid4, OnePassFindsTheFrictionModelsTrackAndImprovesTenfold) {
