@@ -55,28 +55,38 @@ struct Driver {
   double turn_rim = 0.0, turn_angle = 0.0;  // skid body: spot turns' rim travel [m], angle [rad]
   std::uint64_t unconverged = 0;            // skid body: friction solves that did not converge
 
-  // square: one square in direction d with factors f; the return error truth - odometry in the
-  // start frame (which is the odometry frame: both start at the origin, heading 0).
-  Result<UmbmarkRun> square(const Factors& f, Direction d, bool bumps) {
+  // believed: the kinematics of the robot driving with factors f.
+  Result<Kinematics> believed(const Factors& f) const {
     KinematicParams p = sim::nominal_params(base.diameter, base.wheelbase, base.truth);
     p.wheelbase = f.wheelbase;
     p.c_l = f.c_l;
     p.c_r = f.c_r;
-    auto k = Kinematics::create(p);
+    return Kinematics::create(p);
+  }
+
+  // floor_options: the floor under one square in direction d (roughness, bumps).
+  sim::UmbmarkFloor::Options floor_options(Direction d, bool bumps) const {
+    sim::UmbmarkFloor::Options fo;
+    fo.wheel_radius = base.diameter / 2.0;
+    fo.roughness_height = o.noise == UmbmarkNoise::kPaper ? kPaperRoughness : 0.0;
+    fo.bumps = bumps ? 10 : 0;
+    fo.bump_loss = kBumpLoss;
+    fo.first_leg = o.side;
+    fo.bumps_under_left = d == Direction::kCcw;  // the wheel facing the inside of the square
+    return fo;
+  }
+
+  // square: one square in direction d with factors f; the return error truth - odometry in the
+  // start frame (which is the odometry frame: both start at the origin, heading 0).
+  Result<UmbmarkRun> square(const Factors& f, Direction d, bool bumps) {
+    auto k = believed(f);
     if (!k) return std::move(k).error();
     sim::SquareOptions so;
     so.side = o.side;
     so.direction = d == Direction::kCw ? sim::Turn::kClockwise : sim::Turn::kCounterClockwise;
     const bool paper = o.noise == UmbmarkNoise::kPaper;
     const std::uint64_t seed = seed_of(o.seed, run_index++);
-    sim::UmbmarkFloor::Options fo;
-    fo.wheel_radius = base.diameter / 2.0;
-    fo.roughness_height = paper ? kPaperRoughness : 0.0;
-    fo.bumps = bumps ? 10 : 0;
-    fo.bump_loss = kBumpLoss;
-    fo.first_leg = o.side;
-    fo.bumps_under_left = d == Direction::kCcw;  // the wheel facing the inside of the square
-    sim::UmbmarkFloor floor(fo, seed);
+    sim::UmbmarkFloor floor(floor_options(d, bumps), seed);
     sim::SimRunOptions ro;
     ro.perturbation = &floor;
     ro.gyro = gyro;
