@@ -81,12 +81,13 @@ constexpr RangeRow kSlipEps{"slip_eps", 0.0, 1.0, "m/s", true};
 
 SkidSteerParams jackal_skid_params() {
   // Clearpath's jackal_control/config/control.yaml: wheel_separation 0.37559 m (the geometric
-  // track), wheel_radius 0.098 m, wheel_separation_multiplier 1.5; the published wheelbase
-  // 0.262 m gives a = 0.131 m; mass 17 kg (Jackal datasheet). Centre of mass at the geometric
-  // centre. Rubber on a hard floor mu ~ 0.8 in both directions, as the isotropic Coulomb model of
-  // Kozlowski & Pazderski assumes; the twist depends only on mu_lat / mu_long (scaling both
-  // scales every force alike), which sets the spot-turn track t (1 + (mu_lat a / (mu_long c))^2)
-  // with c = t/2: 1.4865 t here, the order of Clearpath's multiplier 1.5.
+  // track), wheel_radius 0.098 m, wheel_separation_multiplier 1.5; wheelbase 0.262 m as issue
+  // 38 gives it (not checked against Clearpath's URDF here), a = 0.131 m; mass 17 kg (Jackal
+  // datasheet). Centre of mass at the geometric centre. Rubber on a hard floor mu ~ 0.8 in both
+  // directions, as the isotropic Coulomb model of Kozlowski & Pazderski assumes; the twist
+  // depends only on mu_lat / mu_long (scaling both scales every force alike), which sets the
+  // spot-turn track t (1 + (mu_lat a / (mu_long c))^2) with c = t/2: 1.4866 t here, the order
+  // of Clearpath's multiplier 1.5.
   return SkidSteerParams{};
 }
 
