@@ -266,6 +266,40 @@ struct SimulateOpts {
   bool json = false;
 };
 
+// skid_json / print_skid: the --robot skid4 effective tracks (README "Skid-steer bases").
+json skid_json(const analysis::SkidTrackReport& k) {
+  json arcs = json::array();
+  for (const analysis::SkidArcTrack& a : k.arcs)
+    arcs.push_back(json{{"com_x", a.com_x},
+                        {"radius", a.radius},
+                        {"true_radius", a.true_radius},
+                        {"track", a.track}});
+  return json{{"geometric_track", k.geometric},
+              {"guessed_track", k.guessed},
+              {"found_track", k.found},
+              {"spot_turn_track", k.spot_turn},
+              {"arcs", arcs},
+              {"unconverged", k.unconverged}};
+}
+
+void print_skid(const analysis::SkidTrackReport& k) {
+  const double dev = 100.0 * (k.found - k.spot_turn) / k.spot_turn;
+  std::cout << std::setprecision(1) << "effective track [mm]: geometric " << k.geometric * 1e3
+            << ", guess x" << analysis::kSkidTrackMultiplier << " " << k.guessed * 1e3
+            << ", UMBmark found " << k.found * 1e3 << ", friction model in the spot turns "
+            << k.spot_turn * 1e3 << std::setprecision(2) << " (found " << std::showpos << dev
+            << std::noshowpos << " %)\n"
+            << "friction model on steady arcs at 0.2 m/s (radius 0: spot turn) [mm]:\n"
+            << std::setw(10) << "com_x" << std::setw(10) << "radius" << std::setw(13)
+            << "true radius" << std::setw(9) << "track\n";
+  for (const analysis::SkidArcTrack& a : k.arcs) {
+    std::cout << std::setprecision(1) << std::setw(10) << a.com_x * 1e3 << std::setw(10)
+              << a.radius * 1e3 << std::setw(13) << a.true_radius * 1e3 << std::setw(8)
+              << a.track * 1e3 << "\n";
+  }
+  if (k.unconverged > 0) std::cout << "unconverged friction solves: " << k.unconverged << "\n";
+}
+
 // gyro_comparison_json / print_gyro_comparison: the --gyro figures (README "Gyro").
 json gyro_comparison_json(const analysis::UmbmarkGyroComparison& g) {
   return json{{"eps_theta_nonsys_plain", opt(g.eps_plain)},
@@ -346,6 +380,7 @@ void print_simulate_json(const analysis::UmbmarkSimResult& r) {
   }
   json out{{"passes", passes}, {"improvement", r.improvement}};
   if (r.gyro) out["gyro"] = gyro_comparison_json(*r.gyro);
+  if (r.skid) out["skid"] = skid_json(*r.skid);
   std::cout << out.dump() << "\n";
 }
 
@@ -389,6 +424,7 @@ void print_simulate_text(const analysis::UmbmarkSimResult& r, const std::string&
               << " deg\n";
   }
   if (r.gyro) print_gyro_comparison(*r.gyro, gyro_class);
+  if (r.skid) print_skid(*r.skid);
 }
 
 // run_simulate: `odomctl ... simulate` once its options are parsed; sets exit_code.
@@ -434,7 +470,8 @@ void add_simulate(CLI::App& parent, int& exit_code) {
   CLI::App* c = parent.add_subcommand(
       "simulate", "automated UMBmark self-calibration of the simulated robot (virtual time)");
   c->add_option("--robot", o->robot,
-                "simulated robot: labmate (the UMBmark report's LabMate) or nominal")
+                "simulated robot: labmate (the UMBmark report's LabMate) or skid4 (a "
+                "Jackal-sized 4WD skid-steer base)")
       ->capture_default_str();
   c->add_option("--runs", o->sim.runs, "squares a direction per set")->capture_default_str();
   c->add_option("--passes", o->sim.passes, "calibration passes")->capture_default_str();

@@ -12,6 +12,7 @@
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_gyro.hpp"
 #include "odo/sim/sim_run.hpp"
+#include "odo/sim/skid_steer.hpp"
 
 namespace odo::analysis {
 namespace {
@@ -23,46 +24,89 @@ using calib::UmbmarkRun;
 constexpr double kNominalDiameter = 0.15;   // [m] Dn of the simulated LabMate
 constexpr double kNominalWheelbase = 0.34;  // [m] what the uncalibrated LabMate believes
 
+// SimBase: the robot of --robot: its true geometry, the belief the first set starts from and,
+// for a skid-steer base, the friction model its body moves with.
+struct SimBase {
+  sim::RobotGeometry truth;
+  double diameter = 0.0;   // [m] nominal wheel diameter the robot believes
+  double wheelbase = 0.0;  // [m] wheelbase the uncalibrated robot believes
+  std::optional<sim::SkidSteerParams> skid;
+};
+
+SimBase sim_base(UmbmarkRobot r) {
+  if (r == UmbmarkRobot::kSkid4) {
+    const sim::RobotGeometry g = sim::skid4_geometry();
+    // The uncalibrated skid-steer base believes the published guess: geometric track x 1.5.
+    return SimBase{g, g.wheel_diameter_left, kSkidTrackMultiplier * g.wheelbase,
+                   sim::jackal_skid_params()};
+  }
+  return SimBase{sim::labmate_geometry(kNominalDiameter), kNominalDiameter, kNominalWheelbase, {}};
+}
+
 struct Driver {
   const UmbmarkSimOptions& o;
-  sim::RobotGeometry truth = sim::labmate_geometry(kNominalDiameter);
+  SimBase base;
   std::uint64_t run_index = 0;  // every run draws its own random sequences
   int done = 0, total = 0;
   const std::function<void(int, int)>& progress;
-  const sim::GyroModel* gyro = nullptr;  // the fused squares' gyro (--gyro); null: plain
-  bool exact_reference = false;          // no reference-sensor error (gyro comparison)
-  std::uint64_t events = 0;              // flagged intervals of the fused squares
+  const sim::GyroModel* gyro = nullptr;     // the fused squares' gyro (--gyro); null: plain
+  bool exact_reference = false;             // no reference-sensor error (gyro comparison)
+  std::uint64_t events = 0;                 // flagged intervals of the fused squares
+  double turn_rim = 0.0, turn_angle = 0.0;  // skid body: spot turns' rim travel [m], angle [rad]
+  std::uint64_t unconverged = 0;            // skid body: friction solves that did not converge
+
+  // believed: the kinematics of the robot driving with factors f.
+  Result<Kinematics> believed(const Factors& f) const {
+    KinematicParams p = sim::nominal_params(base.diameter, base.wheelbase, base.truth);
+    p.wheelbase = f.wheelbase;
+    p.c_l = f.c_l;
+    p.c_r = f.c_r;
+    return Kinematics::create(p);
+  }
+
+  // floor_options: the floor under one square in direction d (roughness, bumps).
+  sim::UmbmarkFloor::Options floor_options(Direction d, bool bumps) const {
+    sim::UmbmarkFloor::Options fo;
+    fo.wheel_radius = base.diameter / 2.0;
+    fo.roughness_height = o.noise == UmbmarkNoise::kPaper ? kPaperRoughness : 0.0;
+    fo.bumps = bumps ? 10 : 0;
+    fo.bump_loss = kBumpLoss;
+    fo.first_leg = o.side;
+    fo.bumps_under_left = d == Direction::kCcw;  // the wheel facing the inside of the square
+    return fo;
+  }
 
   // square: one square in direction d with factors f; the return error truth - odometry in the
   // start frame (which is the odometry frame: both start at the origin, heading 0).
   Result<UmbmarkRun> square(const Factors& f, Direction d, bool bumps) {
-    KinematicParams p = sim::nominal_params(kNominalDiameter, kNominalWheelbase, truth);
-    p.wheelbase = f.wheelbase;
-    p.c_l = f.c_l;
-    p.c_r = f.c_r;
-    auto k = Kinematics::create(p);
+    auto k = believed(f);
     if (!k) return std::move(k).error();
     sim::SquareOptions so;
     so.side = o.side;
     so.direction = d == Direction::kCw ? sim::Turn::kClockwise : sim::Turn::kCounterClockwise;
     const bool paper = o.noise == UmbmarkNoise::kPaper;
     const std::uint64_t seed = seed_of(o.seed, run_index++);
-    sim::UmbmarkFloor::Options fo;
-    fo.wheel_radius = kNominalDiameter / 2.0;
-    fo.roughness_height = paper ? kPaperRoughness : 0.0;
-    fo.bumps = bumps ? 10 : 0;
-    fo.bump_loss = kBumpLoss;
-    fo.first_leg = o.side;
-    fo.bumps_under_left = d == Direction::kCcw;  // the wheel facing the inside of the square
-    sim::UmbmarkFloor floor(fo, seed);
+    sim::UmbmarkFloor floor(floor_options(d, bumps), seed);
     sim::SimRunOptions ro;
     ro.perturbation = &floor;
     ro.gyro = gyro;
     ro.gyro_seed = seed ^ 0x6E0ULL;
-    auto run = sim::SimRun::create(truth, *k, sim::square_scenario(*k, so), ro);
+    std::optional<sim::SkidSteerBody> body;
+    if (base.skid) {
+      auto b = sim::SkidSteerBody::create(*base.skid);
+      if (!b) return std::move(b).error();
+      body.emplace(std::move(b).value());
+      ro.skid = &*body;
+    }
+    auto run = sim::SimRun::create(base.truth, *k, sim::square_scenario(*k, so), ro);
     if (!run) return std::move(run).error();
     // One second of standstill after the path: the last readings see the robot stopped.
     (*run)->drive(1.0);
+    if (body) {
+      turn_rim += body->spot_turn_rim();
+      turn_angle += body->spot_turn_angle();
+      unconverged += body->unconverged();
+    }
     if (const Gyrodometry* g = (*run)->loop().fusion()) {
       const FusionCounters& c = g->counters();
       events += c.disagreements + c.speed_events + c.accel_events;
@@ -157,6 +201,34 @@ Result<UmbmarkGyroComparison> gyro_comparison(Driver& drv, const Factors& uncal,
   return c;
 }
 
+// skid_report: the effective tracks of --robot skid4: UMBmark's b against the guess, the spot
+// turns' track from the truth, and steady arcs of growing radius from the same friction model.
+SkidTrackReport skid_report(const Driver& drv, double found) {
+  const sim::SkidSteerParams& p = *drv.base.skid;
+  SkidTrackReport r;
+  r.geometric = p.track;
+  r.guessed = kSkidTrackMultiplier * p.track;
+  r.found = found;
+  r.spot_turn = drv.turn_angle > 0.0 ? drv.turn_rim / drv.turn_angle : 0.0;
+  r.unconverged = drv.unconverged;
+  constexpr double kArcSpeed = 0.2;  // [m/s]
+  for (const double com_x : {p.com_x, p.com_x + kSkidComOffset}) {
+    sim::SkidSteerParams q = p;
+    q.com_x = com_x;
+    for (const double radius : kSkidArcRadii) {
+      // The rim speeds a robot believing the geometric track commands for this arc.
+      const double c = 0.5 * p.track;
+      const double vl = radius > 0.0 ? kArcSpeed * (radius - c) / radius : -kArcSpeed;
+      const double vr = radius > 0.0 ? kArcSpeed * (radius + c) / radius : kArcSpeed;
+      const sim::SkidSolution s = sim::solve_skid_twist(q, vl, vr);
+      if (!s.converged) ++r.unconverged;
+      const double w = s.twist.omega;
+      r.arcs.push_back({com_x, radius, std::hypot(s.twist.vx, s.twist.vy) / w, (vr - vl) / w});
+    }
+  }
+  return r;
+}
+
 }  // namespace
 
 std::ostream& operator<<(std::ostream& out, UmbmarkRobot r) {
@@ -188,13 +260,13 @@ Status check_umbmark_sim_options(const UmbmarkSimOptions& o) {
 Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
                                                 const std::function<void(int, int)>& progress) {
   if (auto s = check_umbmark_sim_options(o); !s) return std::move(s).error();
-  Driver drv{o, sim::labmate_geometry(kNominalDiameter), 0, 0, 0, progress};
+  Driver drv{o, sim_base(o.robot), 0, 0, 0, progress};
   // Pass 1 drives a "before" set (plus the bump runs) and a verification; later passes reuse
   // the previous verification as their "before" set.
   drv.total =
       2 * o.runs * (1 + (o.bumps ? 1 : 0) + o.passes + (o.gyro != UmbmarkGyro::kNone ? 7 : 0));
   UmbmarkSimResult res;
-  auto first = drv.set(Factors{1.0, 1.0, kNominalWheelbase}, false);
+  auto first = drv.set(Factors{1.0, 1.0, drv.base.wheelbase}, false);
   if (!first) return std::move(first).error();
   if (o.bumps) {
     auto b = drv.set(first->factors, true);
@@ -224,6 +296,7 @@ Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
     if (!g) return std::move(g).error();
     res.gyro = *g;
   }
+  if (drv.base.skid) res.skid = skid_report(drv, res.passes.back().result.composed.wheelbase);
   const double last = res.passes.back().after.e_max_syst;
   res.improvement = last > 0.0 ? res.passes.front().before.e_max_syst / last : 0.0;
   return res;

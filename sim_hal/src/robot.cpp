@@ -5,6 +5,7 @@
 #include <string>
 
 #include "odo/hal/format.hpp"
+#include "odo/sim/skid_steer.hpp"
 
 namespace odo::sim {
 namespace {
@@ -138,6 +139,10 @@ void SimRobot::move(double dt, const Segment& seg) noexcept {
     perturbation_->perturb(p_l, p_r);
     d_l = p_l;
     d_r = p_r;
+  }
+  if (skid_ != nullptr) {
+    pose_ = skid_->step(pose_, d_l, d_r, dt);
+    return;
   }
   // Constant wheel speeds give a constant-curvature arc: the exact arc step is the truth. The
   // centre moves along the chord ds * sinc(h) at the mean heading theta + h, h = dtheta / 2.

@@ -15,6 +15,7 @@ Result<std::unique_ptr<SimRun>> SimRun::create(const RobotGeometry& g, const Kin
   if (!robot) return std::move(robot).error();
   std::unique_ptr<SimRun> run(new SimRun(std::move(robot).value(), o));
   if (o.perturbation != nullptr) run->robot_.set_travel_perturbation(o.perturbation);
+  run->robot_.set_skid_body(o.skid);
   loop::LoopConfig lc = o.loop;
   if (o.gyro != nullptr) {
     auto gyro = SimGyro::create(run->robot_, *o.gyro, o.gyro_seed);

@@ -176,6 +176,9 @@ keep u.svg umb_sim.svg
 case_ c_umb_sim_text $C umbmark simulate --runs 2 --passes 1 --seed 9
 case_ c_umb_sim_bad $C umbmark simulate --runs 0
 case_ c_umb_sim_noise $C umbmark simulate --noise loud
+case_ c_umb_sim_skid4 $C umbmark simulate --robot skid4 --runs 1
+case_ c_umb_sim_skid4_json $C umbmark simulate --robot skid4 --runs 1 --json
+case_ c_umb_sim_robot_bad $C umbmark simulate --robot foo
 printf '[loop]\nstatus_period = 0\n[calibration]\nstore = "sim.bin"\n' >d2.toml
 case_ d_with_sim_store $D --config d2.toml --virtual-time --duration 1 --json
 

@@ -27,7 +27,8 @@ Result<std::vector<calib::UmbmarkRun>> read_umbmark_runs(std::istream& in,
 // UmbmarkRobot, UmbmarkNoise: choices of the UMBmark simulation, spelt once in their tables
 // (odomctl --robot, --noise); printed with their spelling.
 enum class UmbmarkRobot : std::uint8_t {
-  kLabmate,  // the reference robot of DESIGN.md (only one so far)
+  kLabmate,  // the reference robot of DESIGN.md
+  kSkid4,    // a Jackal-sized 4WD skid-steer base (sim::jackal_skid_params; README "Skid-steer")
 };
 enum class UmbmarkNoise : std::uint8_t {
   kNone,
@@ -38,7 +39,8 @@ enum class UmbmarkGyro : std::uint8_t { kNone, kConsumer, kIndustrial };
 inline constexpr Choice<UmbmarkGyro> kUmbmarkGyros[] = {{UmbmarkGyro::kNone, "none"},
                                                         {UmbmarkGyro::kConsumer, "consumer"},
                                                         {UmbmarkGyro::kIndustrial, "industrial"}};
-inline constexpr Choice<UmbmarkRobot> kUmbmarkRobots[] = {{UmbmarkRobot::kLabmate, "labmate"}};
+inline constexpr Choice<UmbmarkRobot> kUmbmarkRobots[] = {{UmbmarkRobot::kLabmate, "labmate"},
+                                                          {UmbmarkRobot::kSkid4, "skid4"}};
 inline constexpr Choice<UmbmarkNoise> kUmbmarkNoises[] = {{UmbmarkNoise::kNone, "none"},
                                                           {UmbmarkNoise::kPaper, "paper"}};
 std::ostream& operator<<(std::ostream& out, UmbmarkRobot r);
@@ -103,7 +105,38 @@ struct UmbmarkGyroComparison {
   std::uint64_t events = 0;        // flagged intervals started over all fused squares
 };
 
+// Multiplier of the geometric track in Clearpath's Jackal and Husky configs
+// (wheel_separation_multiplier): the guess --robot skid4 starts from.
+inline constexpr double kSkidTrackMultiplier = 1.5;
+
+// SkidArcTrack: the effective track the skid body's friction model shows on one steady arc.
+struct SkidArcTrack {
+  double com_x = 0.0;        // [m] centre of mass ahead of the geometric centre
+  double radius = 0.0;       // [m] of the commanded arc (geometric-track rim speeds); 0: spot
+  double true_radius = 0.0;  // [m] |(vx, vy)| / omega: the geometric centre's true path radius
+  double track = 0.0;        // [m] (v_right - v_left) / omega
+};
+// The arcs of SkidTrackReport: centre speed 0.2 m/s (the legs' speed; spot turns: rims at
+// +-0.2 m/s), the base's own centre of mass and one kSkidComOffset ahead (a payload forward:
+// where the plain effective-track model stops holding, README "Skid-steer bases").
+inline constexpr double kSkidArcRadii[] = {0.0, 0.5, 1.0, 2.0, 5.0, 10.0, 50.0};  // [m]
+inline constexpr double kSkidComOffset = 0.02;                                    // [m]
+
+// SkidTrackReport (--robot skid4): the effective track UMBmark found against the guess and
+// against what the simulator's friction model produces.
+struct SkidTrackReport {
+  double geometric = 0.0;  // t [m]
+  double guessed = 0.0;    // kSkidTrackMultiplier * t [m], the first set's wheelbase
+  double found = 0.0;      // b [m] of the last pass
+  // The squares' on-the-spot turns, from the truth: sum |d_right - d_left| rim travel over sum
+  // |turned angle| [m].
+  double spot_turn = 0.0;
+  std::vector<SkidArcTrack> arcs;  // steady arcs (kSkidArcRadii; com_x 0, kSkidComOffset)
+  std::uint64_t unconverged = 0;   // friction solves that did not converge
+};
+
 struct UmbmarkSimResult {
+  std::optional<SkidTrackReport> skid;        // with --robot skid4
   std::optional<UmbmarkGyroComparison> gyro;  // with --gyro
   std::vector<UmbmarkSimPass> passes;
   std::vector<calib::UmbmarkRun> bump_runs;  // extended UMBmark runs of pass 1 (--bumps)

@@ -14,6 +14,8 @@
 
 namespace odo::sim {
 
+class SkidSteerBody;
+
 // True physical geometry of the simulated base.
 struct RobotGeometry {
   double wheel_diameter_left = 0.15;   // [m]
@@ -119,6 +121,10 @@ class SimRobot {
   const Scenario& scenario() const noexcept { return scenario_; }
   // set_travel_perturbation: applied to every step's ground travel (not owned; null = none).
   void set_travel_perturbation(TravelPerturbation* p) noexcept { perturbation_ = p; }
+  // set_skid_body: move as this skid-steer body (its friction decides the twist from the rim
+  // travels) instead of the differential-drive arc of wheelbase g.wheelbase (not owned; null =
+  // the arc). The encoders still count the wheel rotation.
+  void set_skid_body(SkidSteerBody* b) noexcept { skid_ = b; }
 
  private:
   SimRobot(const RobotGeometry& g, Scenario s, const Pose2& start);
@@ -154,6 +160,7 @@ class SimRobot {
   double angle_r_ = 0.0;
   double counts_per_wheel_rad_ = 0.0;
   TravelPerturbation* perturbation_ = nullptr;
+  SkidSteerBody* skid_ = nullptr;
 };
 
 }  // namespace odo::sim

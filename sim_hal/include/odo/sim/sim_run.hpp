@@ -22,6 +22,7 @@ struct SimRunOptions {
   std::int64_t counter_offset = 0;             // counter value at zero counts (start near the wrap)
   loop::LoopConfig loop;                       // rate, error model, calibration status
   TravelPerturbation* perturbation = nullptr;  // floor or wheel noise on the true travel
+  SkidSteerBody* skid = nullptr;  // the robot moves as this skid-steer body (not owned)
   // gyro: a simulated gyro of this model fused by the loop (loop.gyrodometry, its noise model
   // taken from the model); the robot first stands still for gyro_lead_in [s] so that the
   // fusion learns the gyro's bias before it moves. Null: odometry alone.
