@@ -40,7 +40,7 @@ Result<std::unique_ptr<Ros2Output>> Ros2Output::create(const ros2::Config* c, do
 
 void Ros2Output::on_tick(const loop::LoopSnapshot& snap) noexcept {
   ros2::OdomSample& s = samples_.back();
-  s.sample_time = snap.stamp;
+  s.stamp = snap.stamp;
   s.x = snap.pose.x;
   s.y = snap.pose.y;
   s.theta = snap.pose.theta;

@@ -64,7 +64,7 @@ Result<RosTime> to_ros_time(TimeNs monotonic, TimeNs realtime_minus_monotonic) {
 }
 
 Result<OdometryFields> odometry_fields(const OdomSample& s, TimeNs realtime_minus_monotonic) {
-  auto stamp = to_ros_time(s.sample_time, realtime_minus_monotonic);
+  auto stamp = to_ros_time(s.stamp, realtime_minus_monotonic);
   if (!stamp) return std::move(stamp).error();
   OdometryFields f;
   f.stamp = *stamp;

@@ -273,7 +273,7 @@ TEST(Ros2Bridge, EarlyWakeUpKeepsTheRateAndStillSendsTheLastSampleAtStop) {
   EXPECT_GE(st.free_run_published, 1u);  // the first write
   EXPECT_GT(st.spin_count, 0u);
   EXPECT_GT(st.spin_wait_sum_ns, 0);
-  EXPECT_EQ(st.last_published, final_sample.sample_time);
+  EXPECT_EQ(st.last_published, final_sample.stamp);
   EXPECT_EQ(st.write_errors, 0u);
 }
 

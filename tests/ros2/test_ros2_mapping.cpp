@@ -123,7 +123,7 @@ TEST(Ros2Mapping, WallClockStepMovesTheNextStampByTheStep) {
 
 TEST(Ros2Mapping, OdometryFields) {
   OdomSample s;
-  s.sample_time = 2 * kNsPerSecond + 5;
+  s.stamp = 2 * kNsPerSecond + 5;
   s.x = 1.25;
   s.y = -0.5;
   s.theta = M_PI;  // wraps to pi (in (-pi, pi]): q = (0, 0, 1, cos(pi/2) ~ 6e-17)

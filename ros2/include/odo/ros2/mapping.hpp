@@ -16,14 +16,14 @@ using Cov6 = std::array<double, 36>;  // row-major 6x6, as in geometry_msgs
 
 // One published state of the loop, as the DDS thread reads it from a snapshot.
 struct OdomSample {
-  TimeNs sample_time = 0;  // encoder sample time on CLOCK_MONOTONIC [ns]
-  double x = 0.0;          // [m] in the odometry frame
-  double y = 0.0;          // [m]
-  double theta = 0.0;      // [rad], cumulative (wrapped by the mapping)
-  Cov3 pose_cov{};         // row-major 3x3 over (x, y, theta) [m^2, m rad, rad^2]
-  double v = 0.0;          // forward speed of the base [m/s]
-  double omega = 0.0;      // turn rate [rad/s], CCW positive
-  Cov2 twist_cov{};        // row-major 2x2 over (v, omega)
+  TimeNs stamp = 0;    // encoder sample time on CLOCK_MONOTONIC [ns]
+  double x = 0.0;      // [m] in the odometry frame
+  double y = 0.0;      // [m]
+  double theta = 0.0;  // [rad], cumulative (wrapped by the mapping)
+  Cov3 pose_cov{};     // row-major 3x3 over (x, y, theta) [m^2, m rad, rad^2]
+  double v = 0.0;      // forward speed of the base [m/s]
+  double omega = 0.0;  // turn rate [rad/s], CCW positive
+  Cov2 twist_cov{};    // row-major 2x2 over (v, omega)
 };
 
 // builtin_interfaces/Time: sec over all int32, nanosec in [0, 1e9).
