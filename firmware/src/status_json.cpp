@@ -44,7 +44,7 @@ nlohmann::json gyro_json(const loop::LoopGyroStatus& g) {
   j["disagreements"] = g.fusion.disagreements;
   j["speed_events"] = g.fusion.speed_events;
   j["accel_events"] = g.fusion.accel_events;
-  j["gyro_used_ticks"] = g.fusion.flagged_ticks;
+  j["gyro_used_ticks"] = g.fusion.gyro_used_ticks;
   j["faults"] = g.fusion.gyro_faults;
   j["bias"] = g.bias;
   j["bias_valid"] = g.bias_valid;
