@@ -23,7 +23,7 @@ nlohmann::json gyro_json(const FusionCounters& c) {
   return {{"disagreements", c.disagreements},
           {"speed_events", c.speed_events},
           {"accel_events", c.accel_events},
-          {"gyro_used_ticks", c.flagged_ticks}};
+          {"gyro_used_ticks", c.gyro_used_ticks}};
 }
 
 // run_replay: `odomctl ... replay` once its options are parsed; sets exit_code.
@@ -67,7 +67,7 @@ void run_replay(const ReplayOpts& o, int& exit_code) {
     if (r->fused)
       std::cout << "gyro      fused: " << r->fusion.disagreements << " disagreements, "
                 << r->fusion.speed_events + r->fusion.accel_events << " limit events, "
-                << r->fusion.flagged_ticks << " gyro-heading ticks\n";
+                << r->fusion.gyro_used_ticks << " gyro-heading ticks\n";
   }
   exit_code = kExitOk;
 }

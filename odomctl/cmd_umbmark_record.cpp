@@ -470,10 +470,10 @@ bool read_pose(Prompter& in, PoseFeed& feed, const std::string& prompt, PoseRead
 // read_end_pose: the pose after the square; odometry that did not move along the square between
 // the two Enters (the log's poses in between: less than half of 4 L) is refused: on a terminal
 // the Enter is asked for again, in a script the session ends.
-bool read_end_pose(Prompter& in, PoseFeed& feed, const RecordOpts& o, const char* dir,
+bool read_end_pose(Prompter& in, PoseFeed& feed, const RecordOpts& o, std::string_view dir,
                    PoseReading& out) {
   const std::string prompt =
-      std::string("  drive the ") + dir + " square now; press Enter when it has stopped: ";
+      "  drive the " + std::string(dir) + " square now; press Enter when it has stopped: ";
   for (;;) {
     if (!read_pose(in, feed, prompt, out)) return false;
     if (!out.path || *out.path >= kMinPathFraction * 4.0 * o.side) return true;
@@ -539,7 +539,7 @@ bool end_readings(Prompter& in, const RecordOpts& o, Direction d, bool bumps,
 // record_run: one run of the plan, from the start mark to the computed return error.
 bool record_run(Prompter& in, PoseFeed& feed, const RecordOpts& o, Direction d, bool bumps,
                 UmbmarkRun& run) {
-  const char* dir = d == Direction::kCw ? "cw" : "ccw";
+  const std::string_view dir = choice_name(calib::kDirections, d);
   std::cout << "  Put the robot on the start mark, heading along the first leg"
             << (bumps ? (d == Direction::kCw ? "; ten ~10 mm cables under the right wheel's "
                                                "track on the first leg"

@@ -25,13 +25,11 @@ Result<std::vector<calib::UmbmarkRun>> read_umbmark_runs(std::istream& in,
     }
     calib::UmbmarkRun r;
     const std::string& dir = f[static_cast<std::size_t>(c[0])];
-    if (dir == "cw") {
-      r.direction = calib::Direction::kCw;
-    } else if (dir == "ccw") {
-      r.direction = calib::Direction::kCcw;
-    } else {
-      return csv.error("field 'direction' = '" + dir + "' must be cw or ccw");
-    }
+    if (auto d = choice_value<calib::Direction>(calib::kDirections, dir))
+      r.direction = *d;
+    else
+      return csv.error("field 'direction' = '" + dir + "' must be " +
+                       choice_join(calib::kDirections, " or "));
     auto number = [&](int col, const char* field, const char* unit) -> Result<double> {
       auto v = csv.parse_double(f[static_cast<std::size_t>(col)], field);
       if (!v) return std::move(v).error();
@@ -68,8 +66,8 @@ std::string format_umbmark_runs(const std::vector<calib::UmbmarkRun>& runs) {
   std::ostringstream s;
   s << "direction,ex,ey,etheta,bumps\n" << std::fixed;
   for (const calib::UmbmarkRun& r : runs) {
-    s << (r.direction == calib::Direction::kCw ? "cw" : "ccw") << "," << std::setprecision(4)
-      << r.ex << "," << r.ey << ",";
+    s << choice_name(calib::kDirections, r.direction) << "," << std::setprecision(4) << r.ex << ","
+      << r.ey << ",";
     if (r.etheta) s << std::setprecision(5) << *r.etheta;
     s << "," << (r.bumps ? 1 : 0) << "\n";
   }

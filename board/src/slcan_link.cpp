@@ -39,9 +39,9 @@ void PoseBroadcaster::take_commands() noexcept {
     if (!protocol::split_id(o_.base_id, f, node, m) || node != o_.node_id ||
         m != protocol::Msg::kSetPose)
       continue;
-    protocol::SetPoseCmd cmd;
+    SetPose cmd;
     if (!protocol::decode_set_pose(f, cmd)) continue;
-    if (commands_->post(loop::SetPose{Pose2{cmd.x, cmd.y, cmd.theta}})) {
+    if (commands_->post(cmd)) {
       ++set_pose_applied_;
       ++pending_ack_;
     }

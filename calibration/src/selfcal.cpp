@@ -235,17 +235,8 @@ Status check_track(const FixTrack& t) {
 }  // namespace detail
 
 const char* verdict_name(Verdict v) noexcept {
-  switch (v) {
-    case Verdict::kAccepted:
-      return "accepted";
-    case Verdict::kTooUncertain:
-      return "too-uncertain";
-    case Verdict::kNotBetter:
-      return "not-better";
-    case Verdict::kNoHeldOut:
-      break;
-  }
-  return "no-held-out";
+  // The table's names are string literals: their data() is NUL-terminated.
+  return choice_name(kVerdictNames, v).data();
 }
 
 Status check_selfcal_config(const SelfCalConfig& c) {

@@ -22,15 +22,8 @@ std::size_t round_up(std::size_t v, std::size_t unit) {
 }  // namespace
 
 const char* status_name(StoreStatus s) noexcept {
-  switch (s) {
-    case StoreStatus::kOk:
-      return "ok";
-    case StoreStatus::kCorrupt:
-      return "corrupt";
-    case StoreStatus::kUncalibrated:
-      break;
-  }
-  return "uncalibrated";
+  // The table's names are string literals: their data() is NUL-terminated.
+  return choice_name(kStoreStatusNames, s).data();
 }
 
 std::string LoadResult::describe() const {

@@ -10,8 +10,8 @@
 namespace odo::calib {
 namespace {
 
-const char* name(Direction d) {
-  return d == Direction::kCw ? "cw" : "ccw";
+std::string name(Direction d) {
+  return std::string(choice_name(kDirections, d));
 }
 
 // factor_range: a correction factor outside the record's [kFactorMin, kFactorMax].
@@ -169,7 +169,7 @@ Result<UmbmarkResult> umbmark_compute(const UmbmarkInput& in) {
   out.cw = centre_of_gravity(in.runs, Direction::kCw);
   out.ccw = centre_of_gravity(in.runs, Direction::kCcw);
   for (const CentreOfGravity* g : {&out.cw, &out.ccw}) {
-    const char* d = g == &out.cw ? "cw" : "ccw";
+    const std::string d = name(g == &out.cw ? Direction::kCw : Direction::kCcw);
     if (g->n == 0) {
       return make_error(Errc::kInvalidArgument,
                         std::string("field 'direction': no ") + d + " run without bumps");

@@ -60,7 +60,8 @@ void CanBroadcaster::send_pose_group(const loop::LoopSnapshot& s) noexcept {
 
 void CanBroadcaster::send_velocity(const loop::LoopSnapshot& s) noexcept {
   CanFrame f;
-  protocol::encode_velocity(id(protocol::Msg::kVelocity), protocol::VelocityMsg{s.v, s.w, seq_}, f);
+  protocol::encode_velocity(id(protocol::Msg::kVelocity), protocol::VelocityMsg{s.v, s.omega, seq_},
+                            f);
   send(f, s.loop_time);
 }
 

@@ -24,12 +24,12 @@ void CanCommandReceiver::take_commands(CanFrame& f) noexcept {
     }
     if (m != protocol::Msg::kSetPose || !o_.set_pose)
       continue;  // not for us (a SocketCAN filter normally keeps these out)
-    protocol::SetPoseCmd cmd;
+    SetPose cmd;
     if (!protocol::decode_set_pose(f, cmd)) {
       ++c_->set_pose_rejected;
       continue;
     }
-    if (commands_ != nullptr && !commands_->post(loop::SetPose{Pose2{cmd.x, cmd.y, cmd.theta}})) {
+    if (commands_ != nullptr && !commands_->post(cmd)) {
       ++c_->set_pose_rejected;  // the loop's queue is full (it stopped taking commands)
       continue;
     }

@@ -23,7 +23,7 @@ Result<std::unique_ptr<Ros2Output>> Ros2Output::create(const ros2::Config* c, do
   Ros2Output* self = out.get();
   auto bridge = ros2::Bridge::create(
       *c, loop_hz, [self](ros2::OdomSample& s) { return self->read(s); },
-      [self](const ros2::SetPose& p) { self->post(p); });
+      [self](const ros2::PoseWithCovarianceFields& p) { self->post(p); });
   if (!bridge) return std::move(bridge).error();
   out->bridge_ = std::move(bridge).value();
   out->priority_ = c->priority;
@@ -40,13 +40,13 @@ Result<std::unique_ptr<Ros2Output>> Ros2Output::create(const ros2::Config* c, do
 
 void Ros2Output::on_tick(const loop::LoopSnapshot& snap) noexcept {
   ros2::OdomSample& s = samples_.back();
-  s.sample_time = snap.stamp;
+  s.stamp = snap.stamp;
   s.x = snap.pose.x;
   s.y = snap.pose.y;
   s.theta = snap.pose.theta;
   s.pose_cov = snap.has_cov ? snap.cov : Cov3{};
   s.v = snap.v;
-  s.omega = snap.w;
+  s.omega = snap.omega;
   // The twist is the tick's difference quotient of what it measured, so its covariance is the
   // error model's for those travels, with the wheelbase and heading source of that tick.
   s.twist_cov = twist_covariance(snap.motion, k_);
@@ -57,9 +57,9 @@ bool Ros2Output::read(ros2::OdomSample& s) {
   return samples_.latest(s);
 }
 
-void Ros2Output::post(const ros2::SetPose& p) {
+void Ros2Output::post(const ros2::PoseWithCovarianceFields& p) {
   // The loop takes a set pose as exact (its covariance becomes 0); p.cov is not used.
-  if (loop_.post(loop::SetPose{Pose2{p.x, p.y, p.theta}})) {
+  if (loop_.post(p.set_pose)) {
     set_pose_posted_.fetch_add(1, std::memory_order_relaxed);
   } else {
     set_pose_dropped_.fetch_add(1, std::memory_order_relaxed);

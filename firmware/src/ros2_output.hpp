@@ -53,7 +53,7 @@ class Ros2Output final : public loop::TickObserver {
   // read: the bridge thread's SampleSource (the buffer's reader side).
   bool read(ros2::OdomSample& s);
   // post: the bridge thread's SetPoseSink.
-  void post(const ros2::SetPose& p);
+  void post(const ros2::PoseWithCovarianceFields& p);
 
   int priority_ = 0;  // [ros2] priority of the publish thread
   ErrorModelParams k_;

@@ -41,10 +41,10 @@ static_assert(kGyroStale == 1 && kGyroSaturated == 2 && kGyroInvalid == 4 && kGy
 // gyro_json: the gyro and its fusion ([gyro]; README "Gyro").
 nlohmann::json gyro_json(const loop::LoopGyroStatus& g) {
   nlohmann::json j;
-  j["bumps_detected"] = g.fusion.disagreements;
+  j["disagreements"] = g.fusion.disagreements;
   j["speed_events"] = g.fusion.speed_events;
   j["accel_events"] = g.fusion.accel_events;
-  j["gyro_used_ticks"] = g.fusion.flagged_ticks;
+  j["gyro_used_ticks"] = g.fusion.gyro_used_ticks;
   j["faults"] = g.fusion.gyro_faults;
   j["bias"] = g.bias;
   j["bias_valid"] = g.bias_valid;

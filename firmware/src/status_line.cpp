@@ -57,7 +57,7 @@ std::string gyro_text(const loop::LoopGyroStatus& g) {
   else
     s += g.bias_valid ? "fusing" : "learning-bias";
   const FusionCounters& c = g.fusion;
-  return s + counts_text({{{"bumps", c.disagreements},
+  return s + counts_text({{{"disagreements", c.disagreements},
                            {"speed", c.speed_events},
                            {"accel", c.accel_events},
                            {"faults", c.gyro_faults}}});

@@ -247,7 +247,7 @@ void OdometryLoop::record_wakeup(TimeNs latency) noexcept {
   snap.loop_time = woke - start_;
   snap.pose = odom_.pose();
   snap.v = odom_.linear_velocity();
-  snap.w = odom_.angular_velocity();
+  snap.omega = odom_.angular_velocity();
   // What the tick measured, field by field (the gyro's part in fill_gyro_status, with a fusion).
   snap.motion.d_left = odom_.last_d_left();
   snap.motion.d_right = odom_.last_d_right();

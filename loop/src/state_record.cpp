@@ -171,8 +171,7 @@ Result<StateRecord> decode_state_file(std::span<const std::uint8_t> bytes) {
 }
 
 std::string_view resume_reason_name(ResumeReason r) noexcept {
-  const auto i = static_cast<std::size_t>(r);
-  return i < std::size(kResumeReasonNames) ? kResumeReasonNames[i] : "?";
+  return choice_name(kResumeReasonNames, r);
 }
 
 ResumeDecision decide_resume(const StateRecord& rec, const ResumeContext& ctx,

@@ -472,7 +472,7 @@ void Gyrodometry::open_interval(std::uint32_t why, double odo, double dt, FusedT
   const double n2 = p_.noise.rate_noise_density * p_.noise.rate_noise_density;
   const double t = static_cast<double>(interval_ticks_) * dt;
   out.var_heading = n2 * t + b_res_ * b_res_ * t * t;
-  counters_.flagged_ticks += interval_ticks_;
+  counters_.gyro_used_ticks += interval_ticks_;
 }
 
 void Gyrodometry::continue_interval(double odo, double err, double dt, FusedTick& out) noexcept {
@@ -486,7 +486,7 @@ void Gyrodometry::continue_interval(double odo, double err, double dt, FusedTick
   const double k = static_cast<double>(interval_ticks_);
   out.var_heading = n2 * dt + b_res_ * b_res_ * dt * dt * (2.0 * k + 1.0);
   ++interval_ticks_;
-  ++counters_.flagged_ticks;
+  ++counters_.gyro_used_ticks;
 }
 
 double Gyrodometry::travel_step(double c) noexcept {

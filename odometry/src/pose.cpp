@@ -86,7 +86,7 @@ void Odometry::integrate(double d_l, double d_r, double ds, double dth, double d
       inv_dt_ = 1.0 / dt;
     }
     v_ = ds * inv_dt_;
-    w_ = dth * inv_dt_;
+    omega_ = dth * inv_dt_;
   }
 }
 

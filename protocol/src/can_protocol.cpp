@@ -98,7 +98,7 @@ void encode_pose_y_theta(std::uint32_t id, const PoseMsg& p, CanFrame& f) noexce
 void encode_velocity(std::uint32_t id, const VelocityMsg& v, CanFrame& f) noexcept {
   start(id, f);
   put_value(f, sig::v, v.v);
-  put_value(f, sig::w, v.w);
+  put_value(f, sig::omega, v.omega);
   put_raw(f, sig::seq, v.seq);
 }
 
@@ -141,15 +141,16 @@ void encode_encoder_faults(std::uint32_t id, const EncoderCounters& c, CanFrame&
   for (const auto& s : sig::kEncoderFaultFields) put_count(f, *s.signal, c.*s.field);
 }
 
-void encode_set_pose(std::uint32_t id, const SetPoseCmd& c, CanFrame& f) noexcept {
+void encode_set_pose(std::uint32_t id, const SetPose& c, CanFrame& f) noexcept {
   start(id, f);
-  if (c.reset) {
-    f.len = 0;
-    return;
-  }
-  put_value(f, sig::set_x, c.x);
-  put_value(f, sig::set_y, c.y);
-  put_raw(f, sig::set_theta, theta_raw(c.theta));
+  put_value(f, sig::set_x, c.pose.x);
+  put_value(f, sig::set_y, c.pose.y);
+  put_raw(f, sig::set_theta, theta_raw(c.pose.theta));
+}
+
+void encode_set_pose_reset(std::uint32_t id, CanFrame& f) noexcept {
+  start(id, f);
+  f.len = 0;
 }
 
 bool decode_pose_x(const CanFrame& f, double& x, std::uint8_t& seq) noexcept {
@@ -170,7 +171,7 @@ bool decode_pose_y_theta(const CanFrame& f, double& y, double& theta, std::uint8
 bool decode_velocity(const CanFrame& f, VelocityMsg& v) noexcept {
   if (f.len != 8) return false;
   v.v = get_value(f, sig::v);
-  v.w = get_value(f, sig::w);
+  v.omega = get_value(f, sig::omega);
   v.seq = static_cast<std::uint8_t>(get_raw(f, sig::seq));
   return true;
 }
@@ -214,18 +215,17 @@ bool decode_encoder_faults(const CanFrame& f, EncoderCounters& c) noexcept {
   return true;
 }
 
-bool decode_set_pose(const CanFrame& f, SetPoseCmd& c) noexcept {
+bool decode_set_pose(const CanFrame& f, SetPose& c) noexcept {
   if (f.len == 0) {
-    c = SetPoseCmd{true, 0.0, 0.0, 0.0};
+    c = SetPose{};
     return true;
   }
   if (f.len != 8) return false;
   const std::int64_t th = get_raw(f, sig::set_theta);
   if (th < sig::set_theta.raw_min || th > sig::set_theta.raw_max) return false;
-  c.reset = false;
-  c.x = get_value(f, sig::set_x);
-  c.y = get_value(f, sig::set_y);
-  c.theta = static_cast<double>(th) * sig::set_theta.scale;
+  c.pose.x = get_value(f, sig::set_x);
+  c.pose.y = get_value(f, sig::set_y);
+  c.pose.theta = static_cast<double>(th) * sig::set_theta.scale;
   return true;
 }
 

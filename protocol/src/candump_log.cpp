@@ -125,9 +125,9 @@ bool decode_protocol_frame(std::uint32_t base_id, const CanFrame& f, DecodedFram
   out.message = m.name;
   out.n_fields = m.signals.size();
   if (out.msg == Msg::kSetPose) {
-    SetPoseCmd c;
+    SetPose c;
     if (!decode_set_pose(f, c)) return false;  // DLC 0 or 8, theta within its range
-    if (c.reset) {
+    if (f.len == 0) {
       out.message = "SetPose(reset)";
       for (std::size_t i = 0; i < out.n_fields; ++i) out.fields[i] = {m.signals[i]->name, 0.0};
       return true;

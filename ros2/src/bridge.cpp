@@ -145,7 +145,7 @@ Status Bridge::Impl::open() {
 Bridge::Impl::Published Bridge::Impl::publish_once() {
   OdomSample s;
   if (!source(s)) return Published::kNoSample;
-  if (s.sample_time == last_sample) {
+  if (s.stamp == last_sample) {
     unchanged_skipped.fetch_add(1, std::memory_order_relaxed);
     return Published::kUnchanged;
   }
@@ -153,7 +153,7 @@ Bridge::Impl::Published Bridge::Impl::publish_once() {
 }
 
 Bridge::Impl::Published Bridge::Impl::publish(const OdomSample& s) {
-  last_sample = s.sample_time;
+  last_sample = s.stamp;
   // The offset is read at every publish, so a wall-clock step shows in the next stamp.
   auto f = odometry_fields(s, realtime_minus_monotonic());
   if (!f) {
@@ -172,8 +172,8 @@ Bridge::Impl::Published Bridge::Impl::publish(const OdomSample& s) {
     write_errors.fetch_add(1, std::memory_order_relaxed);
   } else {
     odom_published.fetch_add(1, std::memory_order_relaxed);
-    last_published.store(s.sample_time, std::memory_order_relaxed);
-    const TimeNs age = now_ns(CLOCK_MONOTONIC) - s.sample_time;
+    last_published.store(s.stamp, std::memory_order_relaxed);
+    const TimeNs age = now_ns(CLOCK_MONOTONIC) - s.stamp;
     write_age_sum_ns.fetch_add(age, std::memory_order_relaxed);
     const auto bin = static_cast<std::size_t>(std::clamp<TimeNs>(age / kAgeBinNs, 0, kAgeBins - 1));
     age_hist[bin].fetch_add(1, std::memory_order_relaxed);
@@ -238,7 +238,7 @@ Bridge::Impl::Published Bridge::Impl::publish_due(TimeNs due) {
   const bool polling = cfg.spin_us > 0 && woke < poll_until;
   OdomSample s;
   TimeNs now = woke;
-  while (!(source(s) && s.sample_time >= first)) {
+  while (!(source(s) && s.stamp >= first)) {
     if (now >= poll_until) {
       if (polling) spin_wait_sum_ns.fetch_add(now - woke, std::memory_order_relaxed);
       if (now < due + period_ns / 2) {

@@ -64,7 +64,7 @@ Result<RosTime> to_ros_time(TimeNs monotonic, TimeNs realtime_minus_monotonic) {
 }
 
 Result<OdometryFields> odometry_fields(const OdomSample& s, TimeNs realtime_minus_monotonic) {
-  auto stamp = to_ros_time(s.sample_time, realtime_minus_monotonic);
+  auto stamp = to_ros_time(s.stamp, realtime_minus_monotonic);
   if (!stamp) return std::move(stamp).error();
   OdometryFields f;
   f.stamp = *stamp;
@@ -79,8 +79,8 @@ Result<OdometryFields> odometry_fields(const OdomSample& s, TimeNs realtime_minu
   return f;
 }
 
-Result<SetPose> set_pose_from_fields(RosTime stamp, double x, double y, const Quaternion& q,
-                                     const Cov6& cov) {
+Result<PoseWithCovarianceFields> set_pose_from_fields(RosTime stamp, double x, double y,
+                                                      const Quaternion& q, const Cov6& cov) {
   auto bad = [](const std::string& what) {
     return make_error(Errc::kInvalidArgument, "set_pose: " + what);
   };
@@ -88,11 +88,9 @@ Result<SetPose> set_pose_from_fields(RosTime stamp, double x, double y, const Qu
   const double n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
   if (!std::isfinite(n2) || n2 < 1e-12)
     return bad("orientation must be a finite non-zero quaternion");
-  SetPose p;
+  PoseWithCovarianceFields p;
   p.stamp = stamp;
-  p.x = x;
-  p.y = y;
-  p.theta = yaw_from_quaternion(q);
+  p.set_pose.pose = {x, y, yaw_from_quaternion(q)};
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) {
       const double v = cov[kPoseIndex[r] * 6 + kPoseIndex[c]];

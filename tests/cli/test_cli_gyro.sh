@@ -22,13 +22,13 @@ python3 - "$tmp/sim.json" "$tmp/plain.json" <<'PY'
 import json, sys
 f = json.load(open(sys.argv[1])); p = json.load(open(sys.argv[2]))
 g = f["gyro"]
-keys = {"bumps_detected", "speed_events", "accel_events", "gyro_used_ticks", "faults", "bias",
+keys = {"disagreements", "speed_events", "accel_events", "gyro_used_ticks", "faults", "bias",
         "bias_valid", "scale", "flags", "samples", "stale_events", "saturated", "invalid",
         "read_errors"}
 assert set(g) == keys, sorted(set(g) ^ keys)
 assert 99990 <= g["samples"] <= 100000, g  # 1 kHz for 100 s, less the 2 ms delay
 for k in ("faults", "stale_events", "saturated", "invalid", "read_errors", "flags",
-          "gyro_used_ticks", "bumps_detected", "speed_events", "accel_events"):
+          "gyro_used_ticks", "disagreements", "speed_events", "accel_events"):
     assert g[k] == 0, (k, g)
 assert g["bias_valid"] is True, g  # learnt before the robot set off
 assert abs(g["bias"]) < 0.05, g    # the consumer model's offset is 1 deg/s (1.745e-2 rad/s)
@@ -66,7 +66,7 @@ check "can gyro real time exit 0" $?
 grep "^t=" "$tmp/line.err" | head -1 | grep -q "enc=ok  gyro=learning-bias$"
 check "status line: gyro=learning-bias before the stop" $?
 grep "^t=" "$tmp/line.err" | tail -1 |
-  grep -q "gyro=stale (bumps=0 speed=0 accel=0 faults=1)$"
+  grep -q "gyro=stale (disagreements=0 speed=0 accel=0 faults=1)$"
 check "status line: gyro=stale with faults=1 after the stop" $?
 
 # A missing IIO device: exit 2, the file, section and device named.

@@ -25,8 +25,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   f.id = odo::protocol::frame_id(odo::protocol::kDefaultBaseId, node, odo::protocol::Msg::kSetPose);
   std::memcpy(f.data.data(), data + 2, std::min<std::size_t>(8, size - 2));
 
-  odo::protocol::SetPoseCmd c;
-  const bool ok = odo::protocol::decode_set_pose(f, c);
+  odo::SetPose sp;
+  const bool ok = odo::protocol::decode_set_pose(f, sp);
+  const odo::Pose2& c = sp.pose;
   if (f.len != 0 && f.len != 8)
     require(!ok, "accepted a set-pose frame of a length other than 0/8");
   if (ok) {
@@ -35,10 +36,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             "position outside +-8388.608 m");
     require(c.theta > -std::numbers::pi - 1e-4 && c.theta <= std::numbers::pi + 1e-4,
             "theta outside (-pi, pi] beyond one step");
-    require(c.reset == (f.len == 0), "reset flag does not match DLC 0");
-    if (c.reset) require(c.x == 0 && c.y == 0 && c.theta == 0, "reset is not (0, 0, 0)");
+    if (f.len == 0) require(c.x == 0 && c.y == 0 && c.theta == 0, "reset is not (0, 0, 0)");
     odo::CanFrame g;
-    odo::protocol::encode_set_pose(f.id, c, g);
+    if (f.len == 0)
+      odo::protocol::encode_set_pose_reset(f.id, g);
+    else
+      odo::protocol::encode_set_pose(f.id, sp, g);
     require(g.len == f.len, "re-encoded length differs");
     // Raw theta -31416 decodes to -pi-ish and re-encodes as +31416 (the wire's +pi): the only
     // byte pattern that does not survive unchanged.

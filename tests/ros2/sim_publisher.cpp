@@ -27,8 +27,9 @@ int main(int argc, char** argv) {
   odo::ros2::test::SimLoop loop(loop_hz);
   auto b = odo::ros2::Bridge::create(
       c, loop_hz, [&](odo::ros2::OdomSample& s) { return loop.read(s); },
-      [](const odo::ros2::SetPose& p) {
-        std::printf("set_pose %.17g %.17g %.17g\n", p.x, p.y, p.theta);
+      [](const odo::ros2::PoseWithCovarianceFields& p) {
+        const odo::Pose2& q = p.set_pose.pose;
+        std::printf("set_pose %.17g %.17g %.17g\n", q.x, q.y, q.theta);
       });
   if (!b) {
     std::fprintf(stderr, "%s\n", b.error().message.c_str());

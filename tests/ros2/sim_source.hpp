@@ -20,7 +20,7 @@ namespace odo::ros2::test {
 // sample_k: the state published at tick k (any k >= 0); x encodes k exactly (k / 1024).
 inline OdomSample sample_k(std::int64_t k, TimeNs t) {
   OdomSample s;
-  s.sample_time = t;
+  s.stamp = t;
   const double kd = static_cast<double>(k);
   s.x = kd / 1024.0;
   s.y = -kd / 2048.0;

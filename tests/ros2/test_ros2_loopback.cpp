@@ -61,7 +61,7 @@ class Ros2Loopback : public ::testing::Test {
     test::SimLoop loop(1000);
     auto b = Bridge::create(
         c, 1000, [&](OdomSample& s) { return loop.read(s); },
-        [&](const SetPose& p) {
+        [&](const PoseWithCovarianceFields& p) {
           std::lock_guard g(m_);
           set_poses_.push_back(p);
         });
@@ -154,10 +154,10 @@ class Ros2Loopback : public ::testing::Test {
     std::lock_guard g(m_);
     ASSERT_FALSE(set_poses_.empty()) << "no set_pose reached the sink";
     EXPECT_EQ(stats_.set_pose_received, set_poses_.size());
-    for (const SetPose& p : set_poses_) {
-      EXPECT_EQ(p.x, 1.5);
-      EXPECT_EQ(p.y, -2.5);
-      EXPECT_NEAR(p.theta, 0.7, 1e-12);
+    for (const PoseWithCovarianceFields& p : set_poses_) {
+      EXPECT_EQ(p.set_pose.pose.x, 1.5);
+      EXPECT_EQ(p.set_pose.pose.y, -2.5);
+      EXPECT_NEAR(p.set_pose.pose.theta, 0.7, 1e-12);
       EXPECT_EQ(p.cov[0], 0.01);
       EXPECT_EQ(p.cov[4], 0.01);
       EXPECT_EQ(p.cov[8], 0.01);
@@ -169,7 +169,7 @@ class Ros2Loopback : public ::testing::Test {
   BridgeStats stats_;
   TimeNs start_ = 0;
   std::mutex m_;
-  std::vector<SetPose> set_poses_;
+  std::vector<PoseWithCovarianceFields> set_poses_;
 };
 
 int test_domain(int offset) {
@@ -273,7 +273,7 @@ TEST(Ros2Bridge, EarlyWakeUpKeepsTheRateAndStillSendsTheLastSampleAtStop) {
   EXPECT_GE(st.free_run_published, 1u);  // the first write
   EXPECT_GT(st.spin_count, 0u);
   EXPECT_GT(st.spin_wait_sum_ns, 0);
-  EXPECT_EQ(st.last_published, final_sample.sample_time);
+  EXPECT_EQ(st.last_published, final_sample.stamp);
   EXPECT_EQ(st.write_errors, 0u);
 }
 

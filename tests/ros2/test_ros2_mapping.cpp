@@ -123,7 +123,7 @@ TEST(Ros2Mapping, WallClockStepMovesTheNextStampByTheStep) {
 
 TEST(Ros2Mapping, OdometryFields) {
   OdomSample s;
-  s.sample_time = 2 * kNsPerSecond + 5;
+  s.stamp = 2 * kNsPerSecond + 5;
   s.x = 1.25;
   s.y = -0.5;
   s.theta = M_PI;  // wraps to pi (in (-pi, pi]): q = (0, 0, 1, cos(pi/2) ~ 6e-17)
@@ -166,9 +166,9 @@ TEST(Ros2Mapping, SetPoseFromFields) {
   auto p = set_pose_from_fields({7, 8}, 1.5, -2.5, {0, 0, std::sin(0.35), std::cos(0.35)}, c);
   ASSERT_TRUE(p.ok());
   EXPECT_EQ(p->stamp.sec, 7);
-  EXPECT_EQ(p->x, 1.5);
-  EXPECT_EQ(p->y, -2.5);
-  EXPECT_NEAR(p->theta, 0.7, 1e-15);
+  EXPECT_EQ(p->set_pose.pose.x, 1.5);
+  EXPECT_EQ(p->set_pose.pose.y, -2.5);
+  EXPECT_NEAR(p->set_pose.pose.theta, 0.7, 1e-15);
   EXPECT_EQ(p->cov[0], 0.01);
   EXPECT_EQ(p->cov[4], 0.02);
   EXPECT_EQ(p->cov[8], 0.03);

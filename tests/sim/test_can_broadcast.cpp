@@ -285,8 +285,11 @@ TEST(CanBroadcast, FullTransmitQueueDropsCountsAndNeverBlocks) {
 
 CanFrame set_pose_frame(int node, double x, double y, double th, bool reset = false) {
   CanFrame f;
-  protocol::encode_set_pose(protocol::frame_id(0x400, node, Msg::kSetPose),
-                            protocol::SetPoseCmd{reset, x, y, th}, f);
+  const std::uint32_t id = protocol::frame_id(0x400, node, Msg::kSetPose);
+  if (reset)
+    protocol::encode_set_pose_reset(id, f);
+  else
+    protocol::encode_set_pose(id, SetPose{{x, y, th}}, f);
   return f;
 }
 

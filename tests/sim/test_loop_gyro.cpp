@@ -63,7 +63,7 @@ TEST(LoopGyro, BumpsOnALegAreRejectedInTheLoop) {
   EXPECT_TRUE(st.enabled);
   EXPECT_TRUE(st.bias_valid);
   EXPECT_EQ(st.fusion.disagreements, g->counters().disagreements);
-  EXPECT_GT(st.fusion.flagged_ticks, 0u);
+  EXPECT_GT(st.fusion.gyro_used_ticks, 0u);
   // The heading's variance grew over the flagged intervals from the gyro's noise: positive and
   // finite (not the wheels' alone: set-pose below makes it zero again).
   EXPECT_GT(fused->loop().odometry().covariance()[8], 0.0);
@@ -79,7 +79,7 @@ TEST(LoopGyro, SmoothLegIsOdometryBitForBit) {
   auto fused = leg.run(nullptr, true);
   plain->drive(0.0);
   fused->drive(0.0);
-  EXPECT_EQ(fused->loop().fusion()->counters().flagged_ticks, 0u);
+  EXPECT_EQ(fused->loop().fusion()->counters().gyro_used_ticks, 0u);
   EXPECT_EQ(fused->loop().odometry().pose().x, plain->loop().odometry().pose().x);
   EXPECT_EQ(fused->loop().odometry().pose().y, plain->loop().odometry().pose().y);
   EXPECT_EQ(fused->loop().odometry().pose().theta, plain->loop().odometry().pose().theta);

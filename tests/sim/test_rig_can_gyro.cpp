@@ -64,8 +64,8 @@ TEST(RigCanGyro, SameFusionAsTheSimulatedGyroReadDirectly) {
   ASSERT_TRUE(b.gyro.enabled);
   EXPECT_GT(b.gyro.gyro.samples, kTicks - 10);  // a 1 kHz gyro read at 1 kHz
   EXPECT_EQ(b.gyro.gyro.samples, a.gyro.gyro.samples);
-  EXPECT_GT(b.gyro.fusion.flagged_ticks, 0u);
-  EXPECT_EQ(b.gyro.fusion.flagged_ticks, a.gyro.fusion.flagged_ticks);
+  EXPECT_GT(b.gyro.fusion.gyro_used_ticks, 0u);
+  EXPECT_EQ(b.gyro.fusion.gyro_used_ticks, a.gyro.fusion.gyro_used_ticks);
   EXPECT_EQ(b.gyro.fusion.accel_events, a.gyro.fusion.accel_events);
   EXPECT_EQ(b.gyro.bias, a.gyro.bias);
   EXPECT_EQ(b.pose.x, a.pose.x);

@@ -177,7 +177,7 @@ TEST(Soak, ODO_SOAK_NAME) {
     const loop::LoopSnapshot& s = loop->snapshot();
     const loop::LoopStats& st = loop->stats();
     ASSERT_TRUE(std::isfinite(s.pose.x) && std::isfinite(s.pose.y) && std::isfinite(s.pose.theta) &&
-                std::isfinite(s.v) && std::isfinite(s.w) && std::isfinite(s.distance))
+                std::isfinite(s.v) && std::isfinite(s.omega) && std::isfinite(s.distance))
         << "tick " << s.tick;
 
     // Flags: exactly the injected read errors, nothing else (frozen and glitched readings are

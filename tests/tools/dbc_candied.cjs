@@ -41,7 +41,7 @@ for (const name of ['PoseX', 'PoseYTheta', 'Velocity', 'Uncertainty', 'Status', 
 // Every signal of every message is decoded (candied 2.2.0 dropped those whose factor was
 // written 1e-05 or 1e-06).
 const signals = {
-  PoseX: ['x', 'seq'], PoseYTheta: ['y', 'theta', 'seq'], Velocity: ['v', 'w', 'seq'],
+  PoseX: ['x', 'seq'], PoseYTheta: ['y', 'theta', 'seq'], Velocity: ['v', 'omega', 'seq'],
   Uncertainty: ['sigma_x', 'sigma_y', 'sigma_theta', 'rho_xy', 'seq'],
   Status: ['encoder_flags', 'calibration_state', 'stopping', 'set_pose_ack', 'missed_deadlines',
            'uptime'],

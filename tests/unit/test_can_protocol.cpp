@@ -184,12 +184,12 @@ TEST(CanVelocity, RoundTripAndSaturation) {
   VelocityMsg v;
   ASSERT_TRUE(decode_velocity(f, v));
   EXPECT_NEAR(v.v, 0.200, 1e-12);
-  EXPECT_NEAR(v.w, -1.235, 1e-12);
+  EXPECT_NEAR(v.omega, -1.235, 1e-12);
   EXPECT_EQ(v.seq, 9);
   encode_velocity(kId + 2, VelocityMsg{100.0, -100.0, 0}, f);
   ASSERT_TRUE(decode_velocity(f, v));
   EXPECT_DOUBLE_EQ(v.v, 32.767);
-  EXPECT_DOUBLE_EQ(v.w, -32.768);
+  EXPECT_DOUBLE_EQ(v.omega, -32.768);
 }
 
 TEST(CanUncertainty, RoundTripUnknownAndSaturation) {
@@ -278,25 +278,27 @@ TEST(CanEncoderFaults, OneByteEachInOrderSaturating) {
 
 TEST(CanSetPose, SetResetAndRejects) {
   CanFrame f;
-  encode_set_pose(kId + 8, SetPoseCmd{false, 12.3456, -7.0004, 1.0}, f);
+  encode_set_pose(kId + 8, SetPose{{12.3456, -7.0004, 1.0}}, f);
   EXPECT_EQ(f.len, 8);
-  SetPoseCmd c;
+  SetPose c;
   ASSERT_TRUE(decode_set_pose(f, c));
-  EXPECT_FALSE(c.reset);
-  EXPECT_NEAR(c.x, 12.346, 1e-9);
-  EXPECT_NEAR(c.y, -7.000, 1e-9);
-  EXPECT_NEAR(c.theta, 1.0, 1e-12);
+  EXPECT_NEAR(c.pose.x, 12.346, 1e-9);
+  EXPECT_NEAR(c.pose.y, -7.000, 1e-9);
+  EXPECT_NEAR(c.pose.theta, 1.0, 1e-12);
   // Limits of the command: +-8388.607 m, saturating.
-  encode_set_pose(kId + 8, SetPoseCmd{false, 1e6, -1e6, 0}, f);
+  encode_set_pose(kId + 8, SetPose{{1e6, -1e6, 0}}, f);
   ASSERT_TRUE(decode_set_pose(f, c));
-  EXPECT_DOUBLE_EQ(c.x, 8388.607);
-  EXPECT_DOUBLE_EQ(c.y, -8388.608);
-  // Reset: DLC 0.
-  encode_set_pose(kId + 8, SetPoseCmd{true, 5, 5, 1}, f);
+  EXPECT_DOUBLE_EQ(c.pose.x, 8388.607);
+  EXPECT_DOUBLE_EQ(c.pose.y, -8388.608);
+  // Reset: DLC 0, decoded as the pose (0, 0, 0) whatever c held.
+  encode_set_pose_reset(kId + 8, f);
+  EXPECT_EQ(f.id, kId + 8);
   EXPECT_EQ(f.len, 0);
+  c = SetPose{{5, 5, 1}};
   ASSERT_TRUE(decode_set_pose(f, c));
-  EXPECT_TRUE(c.reset);
-  EXPECT_EQ(c.x, 0.0);
+  EXPECT_EQ(c.pose.x, 0.0);
+  EXPECT_EQ(c.pose.y, 0.0);
+  EXPECT_EQ(c.pose.theta, 0.0);
   // Rejected: other lengths, theta beyond pi.
   for (std::uint8_t len : {1, 4, 7}) {
     f.len = len;

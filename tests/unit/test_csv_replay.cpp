@@ -130,8 +130,8 @@ TEST(Replay, GyroColumnIsFusedExactlyAsTheLoopRule) {
   EXPECT_EQ(fused->pose.theta, odom.pose().theta);
   EXPECT_EQ(fused->fusion.disagreements, fusion.counters().disagreements);
   EXPECT_EQ(fused->fusion.accel_events, fusion.counters().accel_events);
-  EXPECT_EQ(fused->fusion.flagged_ticks, fusion.counters().flagged_ticks);
-  EXPECT_GE(fused->fusion.flagged_ticks, 20u);  // the whole bump came from the gyro
+  EXPECT_EQ(fused->fusion.gyro_used_ticks, fusion.counters().gyro_used_ticks);
+  EXPECT_GE(fused->fusion.gyro_used_ticks, 20u);  // the whole bump came from the gyro
   // Odometry alone turns by the bump: 20 ticks * 20 counts * 3.14159e-4 m / 0.3 m = 0.41888 rad
   // clockwise; the fusion removes it to within the window's quantisation and the bias residual.
   std::istringstream plain_log(bump_log(true));

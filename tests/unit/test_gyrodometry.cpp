@@ -182,7 +182,7 @@ TEST(Gyrodometry, BumpReplacedOverTheWholeInterval) {
   // (ticks 32..51) takes the gyro's increments, identical to odometry's on the 18 ticks before the
   // bump: 20 + 36 = 56 ticks of gyro heading.
   EXPECT_EQ(used, 37);
-  EXPECT_EQ(g.counters().flagged_ticks, 56u);
+  EXPECT_EQ(g.counters().gyro_used_ticks, 56u);
   EXPECT_FALSE(g.in_interval());
   // Heading variance of 56 gyro ticks, T = 0.28 s: N^2 T + b_res^2 T^2 (the per-tick bias terms
   // b_res^2 dt^2 (2k + 1) add up to b_res^2 (n dt)^2), b_res = 3.518499e-4 (learn_bias):

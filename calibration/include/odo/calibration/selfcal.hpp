@@ -144,7 +144,12 @@ enum class Verdict : std::uint8_t {
   kNoHeldOut = 3,     // nothing held out (hold_out_every = 0 or too few excursions)
 };
 
-// verdict_name: "accepted", "too-uncertain", "not-better", "no-held-out".
+inline constexpr Choice<Verdict> kVerdictNames[] = {{Verdict::kAccepted, "accepted"},
+                                                    {Verdict::kTooUncertain, "too-uncertain"},
+                                                    {Verdict::kNotBetter, "not-better"},
+                                                    {Verdict::kNoHeldOut, "no-held-out"}};
+
+// verdict_name: v's spelling in kVerdictNames ("accepted", "too-uncertain", ...).
 const char* verdict_name(Verdict v) noexcept;
 
 struct SelfCalResult {

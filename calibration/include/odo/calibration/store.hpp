@@ -20,7 +20,12 @@ enum class StoreStatus : std::uint8_t {
   kCorrupt = 2,       // the store held a record but no slot is valid: never use defaults silently
 };
 
-// status_name: "uncalibrated", "ok", "corrupt".
+inline constexpr Choice<StoreStatus> kStoreStatusNames[] = {
+    {StoreStatus::kUncalibrated, "uncalibrated"},
+    {StoreStatus::kOk, "ok"},
+    {StoreStatus::kCorrupt, "corrupt"}};
+
+// status_name: s's spelling in kStoreStatusNames ("uncalibrated", "ok", "corrupt").
 const char* status_name(StoreStatus s) noexcept;
 
 struct SlotInfo {

@@ -24,6 +24,9 @@
 namespace odo::calib {
 
 enum class Direction { kCw, kCcw };
+// How runs' directions are spelt (the runs CSV, messages, odomctl's prompts).
+inline constexpr Choice<Direction> kDirections[] = {{Direction::kCw, "cw"},
+                                                    {Direction::kCcw, "ccw"}};
 
 // One UMBmark run: the return error absolute minus calculated (Eq. 3.1) in the start frame.
 struct UmbmarkRun {

@@ -17,10 +17,9 @@
 
 namespace odo::loop {
 
-// SetPose: replace the pose; its covariance becomes zero (a set pose is taken as exact).
-struct SetPose {
-  Pose2 pose;
-};
+// SetPose: replace the pose; its covariance becomes zero (a set pose is taken as exact). The
+// type is odometry's (odo::SetPose), which protocol/ and ros2/ also see: one type, no copies.
+using odo::SetPose;
 
 // SetKinematics: new calibrated kinematics (e.g. re-read on SIGHUP) and the store's status they
 // came from; the next tick integrates with them, the pose is kept.

@@ -63,9 +63,9 @@ struct LoopSnapshot {
   TimeNs loop_time = 0;  // time since the loop started [ns]
   Pose2 pose;            // cumulative heading
   double v = 0.0;        // [m/s]
-  double w = 0.0;        // [rad/s]
+  double omega = 0.0;    // yaw rate [rad/s], CCW positive
   // What this tick measured (wheel travels, their interval, the wheelbase in use, the gyro's
-  // heading variance on a fused tick): consumers derive from it, never invert (v, w).
+  // heading variance on a fused tick): consumers derive from it, never invert (v, omega).
   TickMotion motion;
   double distance = 0.0;            // path length of the centre point [m]
   std::uint32_t encoder_flags = 0;  // EncoderFlag bits of the last sample

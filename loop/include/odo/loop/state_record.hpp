@@ -9,6 +9,7 @@
 #include <span>
 #include <string_view>
 
+#include "odo/hal/choice.hpp"
 #include "odo/hal/encoder.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/hal/time.hpp"
@@ -95,11 +96,21 @@ enum class ResumeReason : std::uint8_t {
   kControllerReset,   // the counting controller says it rebooted since (serial: booted flag)
 };
 
-inline constexpr std::string_view kResumeReasonNames[] = {
-    "resumed",           "disabled",        "no-record",      "corrupt",
-    "other-boot",        "other-clock",     "stale",          "other-kinematics",
-    "other-calibration", "other-backend",   "not-continuous", "encoder-not-ready",
-    "counter-jump",      "controller-reset"};
+inline constexpr Choice<ResumeReason> kResumeReasonNames[] = {
+    {ResumeReason::kResumed, "resumed"},
+    {ResumeReason::kDisabled, "disabled"},
+    {ResumeReason::kNoRecord, "no-record"},
+    {ResumeReason::kCorrupt, "corrupt"},
+    {ResumeReason::kOtherBoot, "other-boot"},
+    {ResumeReason::kOtherClock, "other-clock"},
+    {ResumeReason::kStale, "stale"},
+    {ResumeReason::kOtherKinematics, "other-kinematics"},
+    {ResumeReason::kOtherCalibration, "other-calibration"},
+    {ResumeReason::kOtherBackend, "other-backend"},
+    {ResumeReason::kNotContinuous, "not-continuous"},
+    {ResumeReason::kEncoderNotReady, "encoder-not-ready"},
+    {ResumeReason::kCounterJump, "counter-jump"},
+    {ResumeReason::kControllerReset, "controller-reset"}};
 
 // resume_reason_name: how logs, --json and odomctl spell `r`.
 std::string_view resume_reason_name(ResumeReason r) noexcept;

@@ -186,12 +186,12 @@ enum FusionFlag : std::uint32_t {
 
 // Events since start; they only grow.
 struct FusionCounters {
-  std::uint64_t disagreements = 0;  // flagged intervals started by gyro/odometry disagreement
-  std::uint64_t speed_events = 0;   // ... by a wheel speed beyond the limit
-  std::uint64_t accel_events = 0;   // ... by a wheel acceleration beyond the limit
-  std::uint64_t gyro_faults = 0;    // transitions of the gyro into a faulty state (a gyro still
-                                    // starting, kGyroStarting, is not faulty)
-  std::uint64_t flagged_ticks = 0;  // ticks whose heading came from the gyro
+  std::uint64_t disagreements = 0;    // flagged intervals started by gyro/odometry disagreement
+  std::uint64_t speed_events = 0;     // ... by a wheel speed beyond the limit
+  std::uint64_t accel_events = 0;     // ... by a wheel acceleration beyond the limit
+  std::uint64_t gyro_faults = 0;      // transitions of the gyro into a faulty state (a gyro still
+                                      // starting, kGyroStarting, is not faulty)
+  std::uint64_t gyro_used_ticks = 0;  // ticks whose heading came from the gyro
 };
 
 // One tick's input: the wheels' travels and the gyro's reading.

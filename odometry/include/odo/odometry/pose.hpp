@@ -17,6 +17,14 @@ struct Pose2 {
   double theta = 0.0;  // [rad], cumulative: two full CCW turns give 4*pi
 };
 
+// SetPose: a request to replace the pose estimate, the one set-pose type of every room (the
+// loop's command, the CAN SetPose frame's content, the ROS 2 set_pose topic's pose). Here, the
+// lowest room that the loop, protocol/ and ros2/ all see. Taken as exact: the loop zeroes the
+// pose covariance.
+struct SetPose {
+  Pose2 pose;
+};
+
 // Below this half-angle [rad] half_angle() uses Taylor series, exact to double precision: the
 // first dropped terms are h^9/9! < 6e-18 (sin) and h^10/10! < 3e-20 (cos) for |h| <= 0.05.
 inline constexpr double kHalfAngleSeriesLimit = 0.05;
@@ -188,7 +196,7 @@ class Odometry {
   double sin_theta() const noexcept { return integ_.sin_theta(); }  // sin of pose().theta
   double cos_theta() const noexcept { return integ_.cos_theta(); }  // cos of pose().theta
   double linear_velocity() const noexcept { return v_; }            // [m/s] of the centre point
-  double angular_velocity() const noexcept { return w_; }           // [rad/s]
+  double angular_velocity() const noexcept { return omega_; }       // [rad/s]
   double distance() const noexcept { return distance_; }            // path length of the centre [m]
   double last_d_left() const noexcept { return d_left_; }    // wheel travel of the last tick [m]
   double last_d_right() const noexcept { return d_right_; }  // [m]
@@ -204,7 +212,7 @@ class Odometry {
   PoseCovariance cov_;
   PoseIntegrator integ_;
   double v_ = 0.0;
-  double w_ = 0.0;
+  double omega_ = 0.0;
   double distance_ = 0.0;
   double d_left_ = 0.0;
   double d_right_ = 0.0;

@@ -8,6 +8,7 @@
 
 #include "odo/hal/can_bus.hpp"
 #include "odo/hal/encoder.hpp"
+#include "odo/odometry/pose.hpp"
 
 namespace odo::protocol {
 
@@ -19,7 +20,7 @@ constexpr int kMaxNodeId = 63;
 enum class Msg : std::uint8_t {
   kPoseX = 0,          // x, seq
   kPoseYTheta = 1,     // y, theta, seq
-  kVelocity = 2,       // v, w, seq
+  kVelocity = 2,       // v, omega, seq
   kUncertainty = 3,    // sigma_x, sigma_y, sigma_theta, rho_xy, seq
   kStatus = 4,         // encoder flags, calibration state, stopping, set-pose ack, missed, uptime
   kTiming = 5,         // wake-up latency p99/max, compute max, transmit drops
@@ -34,7 +35,7 @@ constexpr double kPosScale = 1e-4;            // x, y [m] (int32: +-214.7 km)
 constexpr double kThetaScale = 1e-4;          // theta [rad] (int16, raw -31415..31416)
 constexpr std::int32_t kThetaRawMax = 31416;  // raw for +pi (pi rounded to the resolution)
 constexpr double kVelScale = 1e-3;            // v [m/s] (int16: +-32.767 m/s)
-constexpr double kOmegaScale = 1e-3;          // w [rad/s] (int16: +-32.767 rad/s)
+constexpr double kOmegaScale = 1e-3;          // omega [rad/s] (int16: +-32.767 rad/s)
 constexpr double kSigmaPosScale = 1e-4;       // sigma_x, sigma_y [m] (uint16, 65535 = >= 6.5535 m)
 constexpr double kSigmaThetaScale = 1e-5;     // sigma_theta [rad] (uint16, 65535 = >= 0.65535 rad)
 constexpr double kRhoScale = 0.01;            // rho_xy [-] (int8, -100..100)
@@ -60,8 +61,8 @@ struct PoseMsg {
   std::uint8_t seq = 0;
 };
 struct VelocityMsg {
-  double v = 0.0;  // [m/s]
-  double w = 0.0;  // [rad/s]
+  double v = 0.0;      // [m/s]
+  double omega = 0.0;  // [rad/s], CCW positive
   std::uint8_t seq = 0;
 };
 struct UncertaintyMsg {
@@ -87,12 +88,6 @@ struct TimingMsg {
   double compute_max = 0.0;      // [s]
   std::uint32_t tx_dropped = 0;  // frames dropped by the transmit path; saturates at 65535
 };
-struct SetPoseCmd {
-  bool reset = false;  // DLC 0: pose to (0, 0, 0)
-  double x = 0.0;      // [m]
-  double y = 0.0;      // [m]
-  double theta = 0.0;  // [rad], (-pi, pi]
-};
 
 // FixMsg: an absolute pose fix for self-calibration, sent to the node as FixPose + FixSigma with
 // the same seq. age: how long before the FixSigma frame's reception the fix was true, so a
@@ -116,8 +111,10 @@ void encode_status(std::uint32_t id, const StatusMsg& s, CanFrame& f) noexcept;
 void encode_timing(std::uint32_t id, const TimingMsg& t, CanFrame& f) noexcept;
 // encode_encoder_faults: the backend's counters, each saturating at 255.
 void encode_encoder_faults(std::uint32_t id, const EncoderCounters& c, CanFrame& f) noexcept;
-// encode_set_pose: DLC 0 for a reset, else DLC 8 with x, y at 1 mm and theta at 1e-4 rad.
-void encode_set_pose(std::uint32_t id, const SetPoseCmd& c, CanFrame& f) noexcept;
+// encode_set_pose: DLC 8 with x, y at 1 mm and theta (wrapped to (-pi, pi]) at 1e-4 rad.
+void encode_set_pose(std::uint32_t id, const SetPose& c, CanFrame& f) noexcept;
+// encode_set_pose_reset: the short form of SetPose{} (pose to (0, 0, 0)): DLC 0.
+void encode_set_pose_reset(std::uint32_t id, CanFrame& f) noexcept;
 
 // Decoders: false when the length is wrong (the id is the caller's business).
 bool decode_pose_x(const CanFrame& f, double& x, std::uint8_t& seq) noexcept;
@@ -135,9 +132,9 @@ void encode_fix(std::uint32_t id_pose, std::uint32_t id_sigma, const FixMsg& m, 
 // the length is not 8, sigma_xy is 0 or theta is outside -31416..31416 raw.
 bool decode_fix_pose(const CanFrame& f, FixMsg& m) noexcept;
 bool decode_fix_sigma(const CanFrame& f, FixMsg& m) noexcept;
-// decode_set_pose: DLC 0 = reset; DLC 8 with |theta| <= pi (raw -31416..31416) = set; anything
-// else (other lengths, theta out of range) is rejected with false.
-bool decode_set_pose(const CanFrame& f, SetPoseCmd& c) noexcept;
+// decode_set_pose: DLC 0 = reset (SetPose{}); DLC 8 with |theta| <= pi (raw -31416..31416) =
+// set; anything else (other lengths, theta out of range) is rejected with false.
+bool decode_set_pose(const CanFrame& f, SetPose& c) noexcept;
 
 // divisor_for: loop_hz / rate_hz [Hz / Hz] when that is a whole number >= 1 (to 1e-9), 0 for
 // rate 0 (message off), -1 otherwise.

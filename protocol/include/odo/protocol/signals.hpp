@@ -43,7 +43,7 @@ inline constexpr Signal theta{"theta",      32,   16, kThetaScale, true, -(kThet
                               kThetaRawMax, "rad"};
 inline constexpr Signal seq{"seq", 56, 8, 1.0, false, 0, 255, ""};
 inline constexpr Signal v{"v", 0, 16, kVelScale, true, -32768, 32767, "m/s"};
-inline constexpr Signal w{"w", 16, 16, kOmegaScale, true, -32768, 32767, "rad/s"};
+inline constexpr Signal omega{"omega", 16, 16, kOmegaScale, true, -32768, 32767, "rad/s"};
 inline constexpr Signal sigma_x{"sigma_x", 0, 16, kSigmaPosScale, false, 0, 65535, "m"};
 inline constexpr Signal sigma_y{"sigma_y", 16, 16, kSigmaPosScale, false, 0, 65535, "m"};
 inline constexpr Signal sigma_theta{"sigma_theta", 32, 16,    kSigmaThetaScale,
@@ -87,7 +87,7 @@ inline constexpr Signal fix_seq{"fix_seq", 56, 8, 1.0, false, 0, 255, ""};
 
 inline constexpr const Signal* kPoseX[] = {&x, &seq};
 inline constexpr const Signal* kPoseYTheta[] = {&y, &theta, &seq};
-inline constexpr const Signal* kVelocity[] = {&v, &w, &seq};
+inline constexpr const Signal* kVelocity[] = {&v, &omega, &seq};
 inline constexpr const Signal* kUncertainty[] = {&sigma_x, &sigma_y, &sigma_theta, &rho_xy, &seq};
 inline constexpr const Signal* kStatus[] = {
     &encoder_flags, &calibration_state, &stopping,         &gyro_state,

@@ -21,7 +21,7 @@ namespace odo::ros2 {
 // or false when there is none yet. Must not block (e.g. read a triple buffer's front slot).
 using SampleSource = std::function<bool(OdomSample&)>;
 // Called on the bridge thread for every valid set_pose received (e.g. post it to the loop).
-using SetPoseSink = std::function<void(const SetPose&)>;
+using SetPoseSink = std::function<void(const PoseWithCovarianceFields&)>;
 
 struct BridgeStats {
   std::uint64_t odom_published = 0;     // rt/odom samples written

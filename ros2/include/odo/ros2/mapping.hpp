@@ -9,6 +9,7 @@
 #include "odo/hal/result.hpp"
 #include "odo/hal/time.hpp"
 #include "odo/odometry/error_model.hpp"
+#include "odo/odometry/pose.hpp"
 
 namespace odo::ros2 {
 
@@ -16,14 +17,14 @@ using Cov6 = std::array<double, 36>;  // row-major 6x6, as in geometry_msgs
 
 // One published state of the loop, as the DDS thread reads it from a snapshot.
 struct OdomSample {
-  TimeNs sample_time = 0;  // encoder sample time on CLOCK_MONOTONIC [ns]
-  double x = 0.0;          // [m] in the odometry frame
-  double y = 0.0;          // [m]
-  double theta = 0.0;      // [rad], cumulative (wrapped by the mapping)
-  Cov3 pose_cov{};         // row-major 3x3 over (x, y, theta) [m^2, m rad, rad^2]
-  double v = 0.0;          // forward speed of the base [m/s]
-  double omega = 0.0;      // turn rate [rad/s], CCW positive
-  Cov2 twist_cov{};        // row-major 2x2 over (v, omega)
+  TimeNs stamp = 0;    // encoder sample time on CLOCK_MONOTONIC [ns]
+  double x = 0.0;      // [m] in the odometry frame
+  double y = 0.0;      // [m]
+  double theta = 0.0;  // [rad], cumulative (wrapped by the mapping)
+  Cov3 pose_cov{};     // row-major 3x3 over (x, y, theta) [m^2, m rad, rad^2]
+  double v = 0.0;      // forward speed of the base [m/s]
+  double omega = 0.0;  // turn rate [rad/s], CCW positive
+  Cov2 twist_cov{};    // row-major 2x2 over (v, omega)
 };
 
 // builtin_interfaces/Time: sec over all int32, nanosec in [0, 1e9).
@@ -89,19 +90,19 @@ Result<RosTime> to_ros_time(TimeNs monotonic, TimeNs realtime_minus_monotonic);
 // odometry_fields: the whole mapping of one sample.
 Result<OdometryFields> odometry_fields(const OdomSample& s, TimeNs realtime_minus_monotonic);
 
-// A set_pose request as the loop's command path takes it.
-struct SetPose {
-  RosTime stamp;       // header.stamp as received (system time)
-  double x = 0.0;      // [m]
-  double y = 0.0;      // [m]
-  double theta = 0.0;  // [rad] in (-pi, pi]
-  Cov3 cov{};          // row-major 3x3 over (x, y, theta), taken from rows/columns (0, 1, 5)
+// The planar fields of a geometry_msgs/PoseWithCovarianceStamped received on set_pose: the
+// request itself is odometry's SetPose (the one set-pose type; the loop takes it as is), beside
+// what the message adds to it.
+struct PoseWithCovarianceFields {
+  RosTime stamp;     // header.stamp as received (system time)
+  SetPose set_pose;  // x, y [m], theta [rad] in (-pi, pi]
+  Cov3 cov{};        // row-major 3x3 over (x, y, theta), taken from rows/columns (0, 1, 5)
 };
 
-// set_pose_from_fields: a received PoseWithCovarianceStamped (position, orientation, 6x6) to a
-// SetPose; error naming the field if a value is not finite, the quaternion is zero or the 3x3
-// diagonal is negative.
-Result<SetPose> set_pose_from_fields(RosTime stamp, double x, double y, const Quaternion& q,
-                                     const Cov6& cov);
+// set_pose_from_fields: a received PoseWithCovarianceStamped (position, orientation, 6x6) to its
+// planar fields; error naming the field if a value is not finite, the quaternion is zero or the
+// 3x3 diagonal is negative.
+Result<PoseWithCovarianceFields> set_pose_from_fields(RosTime stamp, double x, double y,
+                                                      const Quaternion& q, const Cov6& cov);
 
 }  // namespace odo::ros2
