@@ -29,9 +29,9 @@
 #               (CMAKE_CROSSCOMPILING_EMULATOR), without the statistical studies of pure math
 #               (soft float under the emulator: they run natively in default only); the cli tier
 #               on armhf only (the 32-bit ABI; aarch64 is LP64 like amd64)
-# While the VMs (or soak, or mcu's QEMU) leave CPU idle, the later trees (sanitizers, fuzz, cross)
-# are built beside them in the background at nice 19 (prebuild); the kernel tier's two long
-# drives run in a second VM beside the first.
+# While the VMs (or soak, or mcu's QEMU) leave CPU idle, the sanitizer trees are built beside
+# them in the background at nice 19 (prebuild); the kernel tier's two long drives run in a
+# second VM beside the first.
 #   packages    the Debian package of default (amd64) and of each cross build, checked by
 #               tests/package/check_deb.sh; the amd64 one is installed, run, verified with
 #               systemd-analyze, removed and purged on this machine (CI is throw-away), and
@@ -162,7 +162,9 @@ prebuild() {
   done
   ((${#queue[@]} > 0)) || return 0
   mkdir -p build
-  rm -f build/prebuild.current
+  # Written before the builder starts, so that a stage coming at once finds its tree there and
+  # stops the builder (prebuild_stop) instead of building beside it.
+  echo "${queue[0]}" >build/prebuild.current
   # nice 19: a stage beside it keeps its CPU (the kernel tier's timing tests, e.g. the CAN
   # link-down gap, failed in a fresh-chroot run whose VM shared the machine with builds at nice
   # 0); the builds take only what that stage leaves idle.
@@ -471,13 +473,10 @@ main() {
     # The stages after default's and debug-asan's tiers leave CPU idle (the VM's one CPU, the
     # soak test): the sanitizer trees build beside them (about 8 min of CI's 66 at stop 36, on
     # one core until stop 40).
-    # Every later tree is queued: what the sanitizer trees leave of the idle CPU (the kernel
-    # tier's VMs, debug-asan's kernel tier) goes to fuzz and the cross trees, which were built
-    # in the foreground on both cores until stop 43.
-    case $c in
-      default) prebuild debug-asan tsan fuzz cross-aarch64 cross-armhf ;;
-      *) prebuild_resume ;;
-    esac
+    # Only the sanitizer trees: their builds do not finish in the idle windows as it is (stop
+    # 43's fresh-chroot run stopped both). Fuzz and the cross trees queued behind them were
+    # resumed just before their own stage, which then built the same tree beside the builder.
+    case $c in default) prebuild debug-asan tsan ;; *) prebuild_resume ;; esac
     if [[ $c == default ]]; then
       if [[ ${ODO_RULES:-1} == 1 ]]; then stage_rules; fi
       if [[ ${ODO_SOAK:-1} == 1 ]]; then stage_soak; fi
