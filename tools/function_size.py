@@ -5,18 +5,24 @@ closing brace minus the line of the opening one. Function extents come from univ
 import json, subprocess, sys
 
 def body_open(lines, start, end):
-    # The opening brace of the body: the first '{' from the definition's line on that is not
-    # inside the parameter list's parentheses (default arguments may hold braces).
+    # The body's opening brace: the one matching the last '}' of the definition's end line,
+    # found backwards. (Forwards, the first '{' outside the parameters could be a member's
+    # brace initializer in a constructor's list, before the body.) The project's sources hold
+    # no brace in a string or character literal (checked when this was written).
     depth = 0
-    for i in range(start - 1, end):
-        for ch in lines[i]:
-            if ch == '(':
+    for i in range(end - 1, start - 2, -1):
+        line = lines[i]
+        if i == end - 1:
+            line = line[:line.rfind('}') + 1]
+        for ch in reversed(line):
+            if ch == '}':
                 depth += 1
-            elif ch == ')':
+            elif ch == '{':
                 depth -= 1
-            elif ch == '{' and depth == 0:
-                return i + 1
+                if depth == 0:
+                    return i + 1
     return start
+
 
 def run_ctags(files):
     """The ctags JSON lines of every function definition (lambdas included) in files."""
