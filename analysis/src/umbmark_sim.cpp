@@ -222,8 +222,8 @@ SkidTrackReport skid_report(const Driver& drv, double found) {
       const double vr = radius > 0.0 ? kArcSpeed * (radius + c) / radius : kArcSpeed;
       const sim::SkidSolution s = sim::solve_skid_twist(q, vl, vr);
       if (!s.converged) ++r.unconverged;
-      const double w = s.twist.omega;
-      r.arcs.push_back({com_x, radius, std::hypot(s.twist.vx, s.twist.vy) / w, (vr - vl) / w});
+      r.arcs.push_back({com_x, radius, std::hypot(s.twist.vx, s.twist.vy) / s.twist.omega,
+                        sim::effective_track(s, vl, vr)});
     }
   }
   return r;

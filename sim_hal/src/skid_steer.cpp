@@ -158,9 +158,12 @@ SkidSolution solve_skid_twist(const SkidSteerParams& p, double v_left, double v_
   return out;
 }
 
-double skid_effective_track(const SkidSteerParams& p, double v_left, double v_right) noexcept {
-  const SkidSolution s = solve_skid_twist(p, v_left, v_right);
+double effective_track(const SkidSolution& s, double v_left, double v_right) noexcept {
   return s.twist.omega != 0.0 ? (v_right - v_left) / s.twist.omega : 0.0;
+}
+
+double skid_effective_track(const SkidSteerParams& p, double v_left, double v_right) noexcept {
+  return effective_track(solve_skid_twist(p, v_left, v_right), v_left, v_right);
 }
 
 Pose2 twist_step(const Pose2& pose, const BodyTwist& q, double dt) noexcept {

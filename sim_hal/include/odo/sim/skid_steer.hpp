@@ -80,8 +80,10 @@ struct SkidSolution {
 SkidSolution solve_skid_twist(const SkidSteerParams& p, double v_left, double v_right,
                               const BodyTwist& warm = {}) noexcept;
 
-// skid_effective_track: (v_right - v_left) / omega [m] of the quasi-static twist; 0 when the
-// commands do not turn the body (omega == 0).
+// effective_track: (v_right - v_left) / omega [m] of the solved twist s for rim speeds v_left,
+// v_right [m/s]; 0 when the body does not turn (omega == 0).
+double effective_track(const SkidSolution& s, double v_left, double v_right) noexcept;
+// skid_effective_track: effective_track of the quasi-static twist for rim speeds v_left, v_right.
 double skid_effective_track(const SkidSteerParams& p, double v_left, double v_right) noexcept;
 
 // twist_step: the pose after moving with the body twist q held constant for dt [s] (exact
