@@ -2,19 +2,11 @@
 
 namespace odo::fw {
 
-void CanCommandReceiver::receive(TimeNs stamp) noexcept {
-  // The first receive is made here: on nearly every tick it finds nothing, and the command loop
-  // (take_commands) is not entered.
-  if ((o_.set_pose || fixes_ != nullptr) && o_.max_rx_per_tick > 0) {
-    rx_stamp_ = stamp;
-    CanFrame f;
-    if (bus_->receive(f)) take_commands(f);
-  }
-}
-
-void CanCommandReceiver::take_commands(CanFrame& f) noexcept {
+void CanCommandReceiver::take_commands(TimeNs stamp) noexcept {
+  rx_stamp_ = stamp;
+  const CanFrame& f = rx_;
   for (std::size_t i = 0; i < o_.max_rx_per_tick; ++i) {
-    if (i > 0 && !bus_->receive(f)) break;
+    if (i > 0 && !bus_->receive(rx_)) break;
     int node = 0;
     protocol::Msg m{};
     if (!protocol::split_id(o_.base_id, f, node, m) || node != o_.node_id) continue;

@@ -32,7 +32,8 @@ class CanBus {
   virtual ~CanBus() = default;
   // send: queues one frame without ever blocking; the result says whether it was dropped.
   virtual CanTx send(const CanFrame& f) noexcept = 0;
-  // receive: takes the oldest received frame without blocking; false when none is waiting.
+  // receive: takes the oldest received frame without blocking (every field of `out` written);
+  // false when none is waiting (`out` then unspecified).
   virtual bool receive(CanFrame& out) noexcept = 0;
 };
 

@@ -29,18 +29,23 @@
 
 namespace odo::loop {
 
-// Timing figures of the loop; updated every tick without allocation.
-struct LoopStats {
+// The loop's timing figures that change on every tick.
+struct LoopTickStats {
   std::uint64_t ticks = 0;
   std::uint64_t missed_deadlines = 0;  // periods skipped because a tick overran
   TimeNs wakeup_latency_last = 0;      // wake-up time minus deadline [ns]
   TimeNs wakeup_latency_max = 0;       // [ns]
   TimeNs wakeup_latency_sum = 0;       // [ns], for the mean
   TimeNs compute_max = 0;              // tick body duration, worst [ns]
+};
+
+// Timing figures of the loop; updated every tick without allocation.
+struct LoopStats : LoopTickStats {
   // Histogram summaries (min, mean, p99, p99.9, max [ns]) of the wake-up latency and of the
   // compute time; refreshed every kSummaryTicks ticks and when run() returns.
   TimingSummary wakeup_latency;
   TimingSummary compute_time;
+  std::uint64_t summary_refreshes = 0;  // how often the two summaries were refreshed
 };
 
 // The gyro and its fusion as of one tick (all zero when the loop runs without a gyro).
@@ -200,6 +205,10 @@ class OdometryLoop {
   void fill_gyro_status(LoopSnapshot& snap) const noexcept;
   // record_compute: the tick's compute time from `woke` to `done` [ns] into the statistics.
   void record_compute(LoopSnapshot& snap, TimeNs latency, TimeNs woke, TimeNs done) noexcept;
+  // refresh_summaries: the histograms' summaries into the statistics (every kSummaryTicks).
+  void refresh_summaries() noexcept;
+  // copy_summaries: the statistics' summaries and their refresh count into `to`.
+  void copy_summaries(LoopStats& to) const noexcept;
   // schedule_next: the next deadline; after an overrun the missed periods are skipped.
   void schedule_next(LoopSnapshot& snap, TimeNs done) noexcept;
   // scale_estimation_wanted: whether the fusion should estimate the gyro's scale now.
