@@ -446,6 +446,47 @@ void print_skid_score(const analysis::FixDrive& d, const calib::Factors& estimat
   std::cout << m.str();
 }
 
+// print_open: the open scenario's outcome (--json or text): the estimate against the drive's
+// truth, and with k (--robot skid4) the tracks and the square's return errors.
+void print_open(const SelfcalOpts& o, const analysis::FixDrive& d, const calib::SelfCalConfig& c,
+                const calib::SelfCalResult& r, const SkidScore* k) {
+  const int corrupted = static_cast<int>(std::count(d.corrupted.begin(), d.corrupted.end(), true));
+  if (o.json) {
+    nlohmann::json j{{"scenario", "open"},
+                     {"excursions", o.excursions},
+                     {"fixes", d.fixes.size()},
+                     {"corrupted", corrupted},
+                     {"rejected", r.rejected},
+                     {"c_l", r.estimate.c_l},
+                     {"c_r", r.estimate.c_r},
+                     {"wheelbase", r.estimate.wheelbase},
+                     {"sigma", r.sigma},
+                     {"scale_learnt", r.scale_learnt},
+                     {"truth_c_l", d.truth.c_l},
+                     {"truth_c_r", d.truth.c_r},
+                     {"truth_wheelbase", d.truth.wheelbase},
+                     {"verdict", calib::verdict_name(r.verdict)}};
+    if (k) j["skid"] = skid_score_json(d, r.estimate, *k);
+    std::cout << j.dump() << "\n";
+  } else {
+    std::cout << "excursions  " << o.excursions << " open, fixes " << d.fixes.size() << " ("
+              << corrupted << " corrupted, " << r.fixes_rejected << " rejected)\n"
+              << "c_l         " << r.estimate.c_l << " (sigma " << r.sigma[0] << ", truth "
+              << d.truth.c_l << ")\n"
+              << "c_r         " << r.estimate.c_r << " (sigma " << r.sigma[1] << ", truth "
+              << d.truth.c_r << ")\n"
+              << "wheelbase   " << r.estimate.wheelbase << " m (sigma " << r.sigma[2]
+              << " m, truth " << d.truth.wheelbase << " m)\n"
+              << "scale       " << std::lround(100.0 * r.scale_learnt)
+              << " % of its information from the fixes\n"
+              << "verdict     " << calib::verdict_name(r.verdict)
+              << (r.too_uncertain >= 0 ? ": " + failed_bound(r, c) : std::string()) << "\n";
+    if (k) print_skid_score(d, r.estimate, *k);
+    if (!o.ticks_out.empty() && !o.fixes_out.empty())
+      std::cout << "fit them    " << fit_fixes_command(o, d, c) << "\n";
+  }
+}
+
 // run_open: --scenario open: a random robot (c_L, c_R up to 0.6 % off, b 1.5 %) drives open
 // excursions with a fix where each ends; the fixes are fit as `calib fit-fixes` would, and
 // --ticks-out / --fixes-out write the files it reads.
@@ -475,47 +516,13 @@ void run_open(const SelfcalOpts& o, int& exit_code) {
     exit_code = kExitFailed;
     return;
   }
-  const int corrupted = static_cast<int>(std::count(d.corrupted.begin(), d.corrupted.end(), true));
   const bool skid = o.robot == analysis::UmbmarkRobot::kSkid4;
   SkidScore k;
   if (skid && !skid_score(d, r->estimate, k)) {
     exit_code = kExitFailed;
     return;
   }
-  if (o.json) {
-    nlohmann::json j{{"scenario", "open"},
-                     {"excursions", o.excursions},
-                     {"fixes", d.fixes.size()},
-                     {"corrupted", corrupted},
-                     {"rejected", r->rejected},
-                     {"c_l", r->estimate.c_l},
-                     {"c_r", r->estimate.c_r},
-                     {"wheelbase", r->estimate.wheelbase},
-                     {"sigma", r->sigma},
-                     {"scale_learnt", r->scale_learnt},
-                     {"truth_c_l", d.truth.c_l},
-                     {"truth_c_r", d.truth.c_r},
-                     {"truth_wheelbase", d.truth.wheelbase},
-                     {"verdict", calib::verdict_name(r->verdict)}};
-    if (skid) j["skid"] = skid_score_json(d, r->estimate, k);
-    std::cout << j.dump() << "\n";
-  } else {
-    std::cout << "excursions  " << o.excursions << " open, fixes " << d.fixes.size() << " ("
-              << corrupted << " corrupted, " << r->fixes_rejected << " rejected)\n"
-              << "c_l         " << r->estimate.c_l << " (sigma " << r->sigma[0] << ", truth "
-              << d.truth.c_l << ")\n"
-              << "c_r         " << r->estimate.c_r << " (sigma " << r->sigma[1] << ", truth "
-              << d.truth.c_r << ")\n"
-              << "wheelbase   " << r->estimate.wheelbase << " m (sigma " << r->sigma[2]
-              << " m, truth " << d.truth.wheelbase << " m)\n"
-              << "scale       " << std::lround(100.0 * r->scale_learnt)
-              << " % of its information from the fixes\n"
-              << "verdict     " << calib::verdict_name(r->verdict)
-              << (r->too_uncertain >= 0 ? ": " + failed_bound(*r, c) : std::string()) << "\n";
-    if (skid) print_skid_score(d, r->estimate, k);
-    if (!o.ticks_out.empty() && !o.fixes_out.empty())
-      std::cout << "fit them    " << fit_fixes_command(o, d, c) << "\n";
-  }
+  print_open(o, d, c, *r, skid ? &k : nullptr);
   exit_code = kExitOk;
 }
 
@@ -599,6 +606,28 @@ void run_simulate(const SelfcalOpts& o, int& exit_code) {
   exit_code = kExitOk;
 }
 
+// simulate_choices: --scenario and --robot parsed into o; --robot skid4 drives the open scenario
+// (the dock scenario runs the daemon's loop on the LabMate), refused with --scenario dock.
+// False (said, exit code set) on bad input.
+bool simulate_choices(SelfcalOpts& o, bool scenario_given, int& exit_code) {
+  const char* cmd = "selfcal simulate";
+  if (!take_choice(parse_choice_of<analysis::SelfCalScenario>(analysis::kSelfCalScenarios,
+                                                              "--scenario", o.scenario_text),
+                   o.scenario, cmd, exit_code) ||
+      !take_choice(parse_choice_of<analysis::UmbmarkRobot>(analysis::kUmbmarkRobots, "--robot",
+                                                           o.robot_text),
+                   o.robot, cmd, exit_code))
+    return false;
+  if (o.robot != analysis::UmbmarkRobot::kSkid4) return true;
+  if (scenario_given && o.scenario != analysis::SelfCalScenario::kOpen) {
+    std::cerr << "odomctl selfcal simulate: --robot skid4 needs --scenario open\n";
+    exit_code = kExitBadInput;
+    return false;
+  }
+  o.scenario = analysis::SelfCalScenario::kOpen;
+  return true;
+}
+
 }  // namespace
 
 void add_selfcal(CLI::App& app, int& exit_code) {
@@ -646,24 +675,7 @@ void add_selfcal(CLI::App& app, int& exit_code) {
   c->add_option("--ticks-out", o->ticks_out, "open: write the count log (calib fit-fixes --ticks)");
   c->add_option("--fixes-out", o->fixes_out, "open: write the fixes (calib fit-fixes --fixes)");
   c->callback([o, c, &exit_code] {
-    const char* cmd = "selfcal simulate";
-    if (!take_choice(parse_choice_of<analysis::SelfCalScenario>(analysis::kSelfCalScenarios,
-                                                                "--scenario", o->scenario_text),
-                     o->scenario, cmd, exit_code) ||
-        !take_choice(parse_choice_of<analysis::UmbmarkRobot>(analysis::kUmbmarkRobots, "--robot",
-                                                             o->robot_text),
-                     o->robot, cmd, exit_code))
-      return;
-    if (o->robot == analysis::UmbmarkRobot::kSkid4) {
-      // The dock scenario runs the daemon's loop on the LabMate; skid4 drives open excursions.
-      if (c->count("--scenario") > 0 && o->scenario != analysis::SelfCalScenario::kOpen) {
-        std::cerr << "odomctl selfcal simulate: --robot skid4 needs --scenario open\n";
-        exit_code = kExitBadInput;
-        return;
-      }
-      o->scenario = analysis::SelfCalScenario::kOpen;
-    }
-    run_simulate(*o, exit_code);
+    if (simulate_choices(*o, c->count("--scenario") > 0, exit_code)) run_simulate(*o, exit_code);
   });
 }
 
