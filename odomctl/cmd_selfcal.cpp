@@ -188,8 +188,10 @@ struct SelfcalOpts {
   std::string plot;                    // SVG of the convergence, empty: none
   std::string scenario_text = "dock";  // as typed; parsed into `scenario`
   analysis::SelfCalScenario scenario = analysis::SelfCalScenario::kDock;
-  bool direct_drive = false;         // open: encoders on the wheels (else geared)
-  std::string ticks_out, fixes_out;  // open: the count log and fixes fit-fixes reads
+  bool direct_drive = false;           // open: encoders on the wheels (else geared)
+  std::string ticks_out, fixes_out;    // open: the count log and fixes fit-fixes reads
+  std::string robot_text = "labmate";  // as typed; parsed into `robot`
+  analysis::UmbmarkRobot robot = analysis::UmbmarkRobot::kLabmate;
 };
 
 // SimDrive: the random excursions as one scenario and the fix moments (ticks in the final
@@ -378,11 +380,111 @@ std::string fit_fixes_command(const SelfcalOpts& o, const analysis::FixDrive& d,
                               const calib::SelfCalConfig& c) {
   std::ostringstream m;
   m << "odomctl calib fit-fixes --ticks " << o.ticks_out << " --fixes " << o.fixes_out
-    << " --wheel-diameter " << analysis::kSelfCalDn << " --counts-per-rev "
+    << " --wheel-diameter " << d.nominal.wheel_diameter << " --counts-per-rev "
     << d.geometry.counts_per_rev << " --gear-ratio " << d.geometry.gear_ratio << " --wheelbase "
-    << analysis::kSelfCalBn << " --k-left " << c.odometry_noise.k_left << " --k-right "
+    << d.nominal.wheelbase << " --k-left " << c.odometry_noise.k_left << " --k-right "
     << c.odometry_noise.k_right;
   return m.str();
+}
+
+// SkidScore: --robot skid4: the square's return error with the guessed and the self-calibrated
+// track, and the friction model's tracks of the drive's and the squares' spot turns.
+struct SkidScore {
+  analysis::UmbmarkSquares guess, selfcal;
+  double drive_spot_turn = 0.0;  // [m]
+};
+
+// skid_score: one cw and one ccw square (noiseless runs are identical) of 4 m on skid4 with the
+// geometric track x 1.5 and with the estimate; false (said) when a square failed.
+bool skid_score(const analysis::FixDrive& d, const calib::Factors& estimate, SkidScore& out) {
+  analysis::UmbmarkSimOptions uo;
+  uo.robot = analysis::UmbmarkRobot::kSkid4;
+  uo.runs = 1;
+  auto guess = analysis::score_umbmark_factors(uo, {1.0, 1.0, d.nominal.wheelbase});
+  auto cal = analysis::score_umbmark_factors(uo, estimate);
+  for (const auto* r : {&guess, &cal}) {
+    if (!*r) {
+      std::cerr << "odomctl selfcal simulate: " << r->error().message << "\n";
+      return false;
+    }
+  }
+  out.guess = std::move(guess).value();
+  out.selfcal = std::move(cal).value();
+  out.drive_spot_turn = d.spot_turn_angle > 0.0 ? d.spot_turn_rim / d.spot_turn_angle : 0.0;
+  return true;
+}
+
+nlohmann::json skid_score_json(const analysis::FixDrive& d, const calib::Factors& estimate,
+                               const SkidScore& k) {
+  const double before = k.guess.set.e_max_syst, after = k.selfcal.set.e_max_syst;
+  return {{"geometric_track", d.geometry.wheelbase},
+          {"guessed_track", d.nominal.wheelbase},
+          {"found_track", estimate.wheelbase},
+          {"drive_spot_turn_track", k.drive_spot_turn},
+          {"square_spot_turn_track", k.selfcal.spot_turn},
+          {"e_max_syst_guess", before},
+          {"e_max_syst_selfcal", after},
+          {"improvement", after > 0.0 ? before / after : 0.0},
+          {"unconverged", d.unconverged + k.guess.unconverged + k.selfcal.unconverged}};
+}
+
+void print_skid_score(const analysis::FixDrive& d, const calib::Factors& estimate,
+                      const SkidScore& k) {
+  const double found = estimate.wheelbase, spot = k.selfcal.spot_turn;
+  const double before = k.guess.set.e_max_syst, after = k.selfcal.set.e_max_syst;
+  std::ostringstream m;
+  m << std::fixed << std::setprecision(1) << "track [mm] geometric " << d.geometry.wheelbase * 1e3
+    << ", guess x" << analysis::kSkidTrackMultiplier << " " << d.nominal.wheelbase * 1e3
+    << ", self-calibration found " << found * 1e3 << "; friction model in the drive's spot turns "
+    << k.drive_spot_turn * 1e3 << ", in the square's " << spot * 1e3 << std::setprecision(2)
+    << " (found " << std::showpos << 100.0 * (found - spot) / spot << std::noshowpos << " %)\n"
+    << "square      E_max,syst (4 m, 1 + 1 squares) " << before * 1e3
+    << " mm with the guessed track, " << after * 1e3 << " mm self-calibrated ("
+    << std::setprecision(1) << (after > 0.0 ? before / after : 0.0) << "x)\n";
+  const std::uint64_t bad = d.unconverged + k.guess.unconverged + k.selfcal.unconverged;
+  if (bad > 0) m << "unconverged friction solves: " << bad << "\n";
+  std::cout << m.str();
+}
+
+// print_open: the open scenario's outcome (--json or text): the estimate against the drive's
+// truth, and with k (--robot skid4) the tracks and the square's return errors.
+void print_open(const SelfcalOpts& o, const analysis::FixDrive& d, const calib::SelfCalConfig& c,
+                const calib::SelfCalResult& r, const SkidScore* k) {
+  const int corrupted = static_cast<int>(std::count(d.corrupted.begin(), d.corrupted.end(), true));
+  if (o.json) {
+    nlohmann::json j{{"scenario", "open"},
+                     {"excursions", o.excursions},
+                     {"fixes", d.fixes.size()},
+                     {"corrupted", corrupted},
+                     {"rejected", r.rejected},
+                     {"c_l", r.estimate.c_l},
+                     {"c_r", r.estimate.c_r},
+                     {"wheelbase", r.estimate.wheelbase},
+                     {"sigma", r.sigma},
+                     {"scale_learnt", r.scale_learnt},
+                     {"truth_c_l", d.truth.c_l},
+                     {"truth_c_r", d.truth.c_r},
+                     {"truth_wheelbase", d.truth.wheelbase},
+                     {"verdict", calib::verdict_name(r.verdict)}};
+    if (k) j["skid"] = skid_score_json(d, r.estimate, *k);
+    std::cout << j.dump() << "\n";
+  } else {
+    std::cout << "excursions  " << o.excursions << " open, fixes " << d.fixes.size() << " ("
+              << corrupted << " corrupted, " << r.fixes_rejected << " rejected)\n"
+              << "c_l         " << r.estimate.c_l << " (sigma " << r.sigma[0] << ", truth "
+              << d.truth.c_l << ")\n"
+              << "c_r         " << r.estimate.c_r << " (sigma " << r.sigma[1] << ", truth "
+              << d.truth.c_r << ")\n"
+              << "wheelbase   " << r.estimate.wheelbase << " m (sigma " << r.sigma[2]
+              << " m, truth " << d.truth.wheelbase << " m)\n"
+              << "scale       " << std::lround(100.0 * r.scale_learnt)
+              << " % of its information from the fixes\n"
+              << "verdict     " << calib::verdict_name(r.verdict)
+              << (r.too_uncertain >= 0 ? ": " + failed_bound(r, c) : std::string()) << "\n";
+    if (k) print_skid_score(d, r.estimate, *k);
+    if (!o.ticks_out.empty() && !o.fixes_out.empty())
+      std::cout << "fit them    " << fit_fixes_command(o, d, c) << "\n";
+  }
 }
 
 // run_open: --scenario open: a random robot (c_L, c_R up to 0.6 % off, b 1.5 %) drives open
@@ -396,6 +498,7 @@ void run_open(const SelfcalOpts& o, int& exit_code) {
   fo.outliers = o.outliers;
   fo.direct_drive = o.direct_drive;
   fo.seed = o.seed;
+  fo.robot = o.robot;
   const analysis::FixDrive d = analysis::simulate_fix_drive(fo);
   const calib::SelfCalConfig c = analysis::fix_drive_config(d, fo);
   const char* cmd = "selfcal simulate";
@@ -413,39 +516,13 @@ void run_open(const SelfcalOpts& o, int& exit_code) {
     exit_code = kExitFailed;
     return;
   }
-  const int corrupted = static_cast<int>(std::count(d.corrupted.begin(), d.corrupted.end(), true));
-  if (o.json) {
-    nlohmann::json j{{"scenario", "open"},
-                     {"excursions", o.excursions},
-                     {"fixes", d.fixes.size()},
-                     {"corrupted", corrupted},
-                     {"rejected", r->rejected},
-                     {"c_l", r->estimate.c_l},
-                     {"c_r", r->estimate.c_r},
-                     {"wheelbase", r->estimate.wheelbase},
-                     {"sigma", r->sigma},
-                     {"scale_learnt", r->scale_learnt},
-                     {"truth_c_l", d.truth.c_l},
-                     {"truth_c_r", d.truth.c_r},
-                     {"truth_wheelbase", d.truth.wheelbase},
-                     {"verdict", calib::verdict_name(r->verdict)}};
-    std::cout << j.dump() << "\n";
-  } else {
-    std::cout << "excursions  " << o.excursions << " open, fixes " << d.fixes.size() << " ("
-              << corrupted << " corrupted, " << r->fixes_rejected << " rejected)\n"
-              << "c_l         " << r->estimate.c_l << " (sigma " << r->sigma[0] << ", truth "
-              << d.truth.c_l << ")\n"
-              << "c_r         " << r->estimate.c_r << " (sigma " << r->sigma[1] << ", truth "
-              << d.truth.c_r << ")\n"
-              << "wheelbase   " << r->estimate.wheelbase << " m (sigma " << r->sigma[2]
-              << " m, truth " << d.truth.wheelbase << " m)\n"
-              << "scale       " << std::lround(100.0 * r->scale_learnt)
-              << " % of its information from the fixes\n"
-              << "verdict     " << calib::verdict_name(r->verdict)
-              << (r->too_uncertain >= 0 ? ": " + failed_bound(*r, c) : std::string()) << "\n";
-    if (!o.ticks_out.empty() && !o.fixes_out.empty())
-      std::cout << "fit them    " << fit_fixes_command(o, d, c) << "\n";
+  const bool skid = o.robot == analysis::UmbmarkRobot::kSkid4;
+  SkidScore k;
+  if (skid && !skid_score(d, r->estimate, k)) {
+    exit_code = kExitFailed;
+    return;
   }
+  print_open(o, d, c, *r, skid ? &k : nullptr);
   exit_code = kExitOk;
 }
 
@@ -500,6 +577,12 @@ void run_simulate(const SelfcalOpts& o, int& exit_code) {
     exit_code = kExitBadInput;
     return;
   }
+  if (o.robot == analysis::UmbmarkRobot::kSkid4 && (o.direct_drive || o.smooth)) {
+    std::cerr << "odomctl selfcal simulate: --direct-drive and --smooth-floor are the LabMate's; "
+                 "--robot skid4 has its own encoders and a smooth floor\n";
+    exit_code = kExitBadInput;
+    return;
+  }
   if (o.scenario == analysis::SelfCalScenario::kOpen) {
     run_open(o, exit_code);
     return;
@@ -521,6 +604,28 @@ void run_simulate(const SelfcalOpts& o, int& exit_code) {
   }
   print_dock(o, r, fin, sc);
   exit_code = kExitOk;
+}
+
+// simulate_choices: --scenario and --robot parsed into o; --robot skid4 drives the open scenario
+// (the dock scenario runs the daemon's loop on the LabMate), refused with --scenario dock.
+// False (said, exit code set) on bad input.
+bool simulate_choices(SelfcalOpts& o, bool scenario_given, int& exit_code) {
+  const char* cmd = "selfcal simulate";
+  if (!take_choice(parse_choice_of<analysis::SelfCalScenario>(analysis::kSelfCalScenarios,
+                                                              "--scenario", o.scenario_text),
+                   o.scenario, cmd, exit_code) ||
+      !take_choice(parse_choice_of<analysis::UmbmarkRobot>(analysis::kUmbmarkRobots, "--robot",
+                                                           o.robot_text),
+                   o.robot, cmd, exit_code))
+    return false;
+  if (o.robot != analysis::UmbmarkRobot::kSkid4) return true;
+  if (scenario_given && o.scenario != analysis::SelfCalScenario::kOpen) {
+    std::cerr << "odomctl selfcal simulate: --robot skid4 needs --scenario open\n";
+    exit_code = kExitBadInput;
+    return false;
+  }
+  o.scenario = analysis::SelfCalScenario::kOpen;
+  return true;
 }
 
 }  // namespace
@@ -562,14 +667,15 @@ void add_selfcal(CLI::App& app, int& exit_code) {
                 "dock: the LabMate from a dock through the daemon; open: a random robot, a fix "
                 "where each excursion ends")
       ->capture_default_str();
+  c->add_option("--robot", o->robot_text,
+                "labmate; skid4: the Jackal-sized 4WD skid-steer base, open scenario (its track "
+                "found against the geometric track x 1.5)")
+      ->capture_default_str();
   c->add_flag("--direct-drive", o->direct_drive, "open: 4096-count encoders on the wheels");
   c->add_option("--ticks-out", o->ticks_out, "open: write the count log (calib fit-fixes --ticks)");
   c->add_option("--fixes-out", o->fixes_out, "open: write the fixes (calib fit-fixes --fixes)");
-  c->callback([o, &exit_code] {
-    if (take_choice(parse_choice_of<analysis::SelfCalScenario>(analysis::kSelfCalScenarios,
-                                                               "--scenario", o->scenario_text),
-                    o->scenario, "selfcal simulate", exit_code))
-      run_simulate(*o, exit_code);
+  c->callback([o, c, &exit_code] {
+    if (simulate_choices(*o, c->count("--scenario") > 0, exit_code)) run_simulate(*o, exit_code);
   });
 }
 

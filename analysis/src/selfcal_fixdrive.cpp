@@ -5,9 +5,11 @@
 #include <cmath>
 #include <iomanip>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "odo/analysis/selfcal_tools.hpp"
+#include "odo/sim/skid_steer.hpp"
 #include "odo/sim/wheel_noise.hpp"
 
 namespace odo::analysis {
@@ -17,27 +19,27 @@ constexpr TimeNs kTick = 10'000'000;  // 100 Hz
 constexpr double kStop = 0.5;         // [s] the robot stands still at every fix
 
 // piece: wheel angular velocities [rad/s] for centre speed v [m/s] and turn rate w [rad/s], as
-// the robot commands them (nominal geometry).
-sim::Segment piece(double duration, double v, double w) {
-  return {duration, (v - w * kSelfCalBn / 2) / (kSelfCalDn / 2),
-          (v + w * kSelfCalBn / 2) / (kSelfCalDn / 2)};
+// the robot commands them (its nominal wheel diameter and wheelbase n).
+sim::Segment piece(double duration, double v, double w, const KinematicParams& n) {
+  return {duration, (v - w * n.wheelbase / 2) / (n.wheel_diameter / 2),
+          (v + w * n.wheelbase / 2) / (n.wheel_diameter / 2)};
 }
 
 // open_excursion: 4 to 9 pieces: turns on the spot (0.3-3 rad at 0.5 rad/s), straights (1-4 m
 // at 0.2 m/s) and arcs (radius 0.5-2 m, 0.8-2.4 rad at 0.2 m/s), then the stop.
-sim::Scenario open_excursion(std::mt19937_64& rng) {
+sim::Scenario open_excursion(std::mt19937_64& rng, const KinematicParams& nominal) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   sim::Scenario s;
   const int n = 4 + static_cast<int>(6 * u(rng));
   for (int i = 0; i < n; ++i) {
     const double kind = u(rng), sign = u(rng) < 0.5 ? -1.0 : 1.0;
     if (kind < 0.3) {
-      s.push_back(piece((0.3 + 2.7 * u(rng)) / 0.5, 0.0, sign * 0.5));
+      s.push_back(piece((0.3 + 2.7 * u(rng)) / 0.5, 0.0, sign * 0.5, nominal));
     } else if (kind < 0.65) {
-      s.push_back(piece((1.0 + 3.0 * u(rng)) / 0.2, 0.2, 0.0));
+      s.push_back(piece((1.0 + 3.0 * u(rng)) / 0.2, 0.2, 0.0, nominal));
     } else {
       const double radius = 0.5 + 1.5 * u(rng), angle = 0.8 + 1.6 * u(rng);
-      s.push_back(piece(angle * radius / 0.2, 0.2, sign * 0.2 / radius));
+      s.push_back(piece(angle * radius / 0.2, 0.2, sign * 0.2 / radius, nominal));
     }
   }
   s.push_back({kStop, 0.0, 0.0});
@@ -74,14 +76,15 @@ TimeNs stop_middle(const sim::Scenario& s) {
   return static_cast<TimeNs>(std::llround(mid * 100.0)) * kTick;  // on a tick
 }
 
-Plan plan(const FixDriveOptions& o, const sim::RobotGeometry& g, std::mt19937_64& rng) {
+Plan plan(const FixDriveOptions& o, const sim::RobotGeometry& g, const KinematicParams& nominal,
+          std::mt19937_64& rng) {
   Plan p;
   p.scenario.push_back({kStop, 0.0, 0.0});
   p.fix_times.push_back(stop_middle(p.scenario));
   Pose2 pose;
   for (int e = 0; e < o.excursions; ++e) {
     // Dock excursions are planned from the noise-free pose (the planner's view).
-    const sim::Scenario ex = o.dock ? random_excursion(rng, pose) : open_excursion(rng);
+    const sim::Scenario ex = o.dock ? random_excursion(rng, pose) : open_excursion(rng, nominal);
     p.scenario.insert(p.scenario.end(), ex.begin(), ex.end());
     if (o.dock) p.scenario.push_back({kStop, 0.0, 0.0});
     p.fix_times.push_back(stop_middle(p.scenario));
@@ -115,17 +118,33 @@ calib::PoseFix make_fix(const FixDriveOptions& o, const Pose2& truth, TimeNs t, 
   return f;
 }
 
+// skid_body: the friction body of a kSkid4 drive (none for the LabMate).
+std::optional<sim::SkidSteerBody> skid_body(const FixDriveOptions& o) {
+  if (o.robot != UmbmarkRobot::kSkid4) return std::nullopt;
+  return *sim::SkidSteerBody::create(sim::jackal_skid_params());  // valid by construction
+}
+
 }  // namespace
 
 FixDrive simulate_fix_drive(const FixDriveOptions& o) {
   std::mt19937_64 rng(o.seed);
   FixDrive d;
-  d.geometry = draw_truth(o, rng);
-  d.truth = {d.geometry.wheel_diameter_left / kSelfCalDn,
-             d.geometry.wheel_diameter_right / kSelfCalDn, d.geometry.wheelbase};
-  d.nominal = sim::nominal_params(kSelfCalDn, kSelfCalBn, d.geometry);
-  const Plan p = plan(o, d.geometry, rng);
+  std::optional<sim::SkidSteerBody> body = skid_body(o);
+  if (body) {
+    // The wheels as built; the track is what the floor makes of it (centre speed 0.2 m/s).
+    d.geometry = sim::skid4_geometry();
+    const double dn = d.geometry.wheel_diameter_left, t = d.geometry.wheelbase;
+    d.truth = {1.0, 1.0, sim::skid_effective_track(body->params(), -0.2, 0.2)};
+    d.nominal = sim::nominal_params(dn, kSkidTrackMultiplier * t, d.geometry);
+  } else {
+    d.geometry = draw_truth(o, rng);
+    d.truth = {d.geometry.wheel_diameter_left / kSelfCalDn,
+               d.geometry.wheel_diameter_right / kSelfCalDn, d.geometry.wheelbase};
+    d.nominal = sim::nominal_params(kSelfCalDn, kSelfCalBn, d.geometry);
+  }
+  const Plan p = plan(o, d.geometry, d.nominal, rng);
   auto robot = *sim::SimRobot::create(d.geometry, p.scenario);
+  if (body) robot.set_skid_body(&*body);
   sim::WheelNoise noise(o.wheel_noise.k_left, o.wheel_noise.k_right, o.seed * 7919 + 1);
   robot.set_travel_perturbation(&noise);
   calib::CountRecorder rec(*calib::recorder_limits(*Kinematics::create(d.nominal)));
@@ -151,6 +170,11 @@ FixDrive simulate_fix_drive(const FixDriveOptions& o) {
     }
   }
   if (rec.flush(seg)) d.segments.push_back(seg);
+  if (body) {
+    d.spot_turn_rim = body->spot_turn_rim();
+    d.spot_turn_angle = body->spot_turn_angle();
+    d.unconverged = body->unconverged();
+  }
   return d;
 }
 
@@ -158,7 +182,7 @@ calib::SelfCalConfig fix_drive_config(const FixDrive& d, const FixDriveOptions& 
                                       calib::SelfCalConfig base) {
   KinematicParams k = d.nominal;
   base.metres_per_count = Kinematics::create(k)->metres_per_count();
-  base.in_use = {1.0, 1.0, kSelfCalBn};
+  base.in_use = {1.0, 1.0, d.nominal.wheelbase};
   base.odometry_noise = o.wheel_noise;
   return base;
 }

@@ -257,6 +257,17 @@ Status check_umbmark_sim_options(const UmbmarkSimOptions& o) {
   return Ok{};
 }
 
+Result<UmbmarkSquares> score_umbmark_factors(const UmbmarkSimOptions& o, const calib::Factors& f) {
+  if (auto s = check_umbmark_sim_options(o); !s) return std::move(s).error();
+  const std::function<void(int, int)> none;
+  Driver drv{o, sim_base(o.robot), 0, 0, 2 * o.runs, none};
+  auto set = drv.set(f, false);
+  if (!set) return std::move(set).error();
+  return UmbmarkSquares{std::move(set).value(),
+                        drv.turn_angle > 0.0 ? drv.turn_rim / drv.turn_angle : 0.0,
+                        drv.unconverged};
+}
+
 Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
                                                 const std::function<void(int, int)>& progress) {
   if (auto s = check_umbmark_sim_options(o); !s) return std::move(s).error();

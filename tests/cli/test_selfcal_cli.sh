@@ -76,15 +76,47 @@ grep -q "^verdict     too-uncertain: sigma(b | scale) = " "$tmp/out"
 rc_=$?
 check "too-uncertain text names the bound: $(grep verdict "$tmp/out")" $rc_
 
+# refused NAME PATTERN ARGS...: `selfcal simulate ARGS` exits 2 with PATTERN on stderr.
+refused() {
+  local name=$1 pattern=$2 rc rc_
+  shift 2
+  run "$ODOMCTL" selfcal simulate "$@" >"$tmp/out" 2>"$tmp/err"
+  rc=$?; [ $rc = 2 ] && grep -q -- "$pattern" "$tmp/err"
+  rc_=$?
+  check "$name exit 2 (got $rc): $(cat "$tmp/err")" $rc_
+}
 # The dock scenario writes no files; an unknown scenario is named.
-run "$ODOMCTL" selfcal simulate --ticks-out "$tmp/x.csv" >"$tmp/out" 2>"$tmp/err"
-rc=$?; [ $rc = 2 ] && grep -q "need --scenario open" "$tmp/err"
+refused "dock with --ticks-out" "need --scenario open" --ticks-out "$tmp/x.csv"
+refused "unknown scenario" "--scenario = 'park' must be dock or open" --scenario park
+
+# The skid-steer base (issue 38): --robot skid4 drives open excursions and reports the track found
+# against the guess; its figures come from sim_selfcal_skid4, here the command's contract.
+run "$ODOMCTL" selfcal simulate --robot skid4 --excursions 8 --seed 3 --json >"$tmp/skid.json" \
+  2>"$tmp/err"
 rc_=$?
-check "dock with --ticks-out exit 2 (got $rc): $(cat "$tmp/err")" $rc_
-run "$ODOMCTL" selfcal simulate --scenario park >"$tmp/out" 2>"$tmp/err"
-rc=$?; [ $rc = 2 ] && grep -q "\-\-scenario = 'park' must be dock or open" "$tmp/err"
+check "skid4 exit 0 ($(cat "$tmp/err"))" $rc_
+python3 - "$tmp/skid.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+k = j["skid"]
+assert j["scenario"] == "open" and k["unconverged"] == 0, j
+assert abs(k["guessed_track"] - 1.5 * k["geometric_track"]) < 1e-12, k
+assert abs(k["found_track"] / k["square_spot_turn_track"] - 1) < 0.02, k
+assert abs(k["e_max_syst_guess"] / k["e_max_syst_selfcal"] - k["improvement"]) < 1e-9, k
+assert j["truth_wheelbase"] == k["drive_spot_turn_track"] or \
+    abs(j["truth_wheelbase"] - k["drive_spot_turn_track"]) < 1e-6, (j, k)
+PY
+check "skid4 --json: the tracks and the square's improvement" $?
+run "$ODOMCTL" selfcal simulate --robot skid4 --excursions 8 --seed 3 >"$tmp/out" 2>"$tmp/err"
 rc_=$?
-check "unknown scenario exit 2 (got $rc): $(cat "$tmp/err")" $rc_
+check "skid4 text exit 0 ($(cat "$tmp/err"))" $rc_
+grep -q "^track \[mm\] geometric 375.6, guess x1.5 563.4, self-calibration found " "$tmp/out" &&
+  grep -q "^square      E_max,syst (4 m, 1 + 1 squares) .* mm with the guessed track" "$tmp/out"
+rc_=$?
+check "skid4 text: the track and the square lines: $(cat "$tmp/out")" $rc_
+refused "skid4 with the dock scenario" "--robot skid4 needs --scenario open" --robot skid4 \
+  --scenario dock
+refused "unknown robot" "--robot = 'husky' must be labmate or skid4" --robot husky
 
 echo "selfcal cli: $pass passed, $fail failed"
 [ "$fail" = 0 ]

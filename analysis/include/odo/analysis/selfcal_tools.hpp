@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "odo/analysis/umbmark_tools.hpp"
 #include "odo/calibration/count_recorder.hpp"
 #include "odo/calibration/selfcal.hpp"
 #include "odo/hal/choice.hpp"
@@ -112,6 +113,10 @@ struct FixDriveOptions {
                                        // 2048 counts/rev through a 16:1 gear)
   ErrorModelParams wheel_noise{};      // the true robot's k_L, k_R [m^(1/2)]
   std::uint64_t seed = 1;
+  // kSkid4 (issue 38): the Jackal-sized skid-steer base of sim::jackal_skid_params instead of a
+  // random LabMate: wheels as built (c_L = c_R = 1), the track the friction model decides, the
+  // robot believing the geometric track x kSkidTrackMultiplier; open excursions only (dock false).
+  UmbmarkRobot robot = UmbmarkRobot::kLabmate;
 };
 
 // A count log row at 100 Hz: `t,left,right` as `odomctl replay` / `calib fit-fixes` read it.
@@ -129,9 +134,15 @@ struct FixDrive {
   std::vector<calib::PoseFix> fixes;
   std::vector<Pose2> true_poses;  // at every fix
   std::vector<bool> corrupted;    // per fix
+  // kSkid4: the drive's spot turns from the truth, sum |d_right - d_left| rim travel [m] over
+  // sum |turned angle| [rad] (their ratio: the track the friction model gave those turns), and
+  // friction solves that did not converge.
+  double spot_turn_rim = 0.0, spot_turn_angle = 0.0;
+  std::uint64_t unconverged = 0;
 };
 
-// simulate_fix_drive: the drive of `o` (repeatable for a seed).
+// simulate_fix_drive: the drive of `o` (repeatable for a seed). With robot kSkid4 the truth's b
+// is the friction model's spot-turn track (equal to its arcs' with the load centred).
 FixDrive simulate_fix_drive(const FixDriveOptions& o);
 
 // fix_drive_config: the estimator's configuration for a drive: nominal values in use, the

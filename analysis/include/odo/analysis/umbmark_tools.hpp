@@ -155,6 +155,17 @@ Status check_umbmark_sim_options(const UmbmarkSimOptions& o);
 Result<UmbmarkSimResult> run_umbmark_simulation(const UmbmarkSimOptions& o,
                                                 const std::function<void(int, int)>& progress = {});
 
+// UmbmarkSquares: one set of squares driven with given factors (score_umbmark_factors).
+struct UmbmarkSquares {
+  UmbmarkRunSet set;
+  double spot_turn = 0.0;  // skid-steer base: the squares' spot turns' track from the truth [m]
+  std::uint64_t unconverged = 0;  // skid-steer base: friction solves that did not converge
+};
+// score_umbmark_factors: o.runs cw + o.runs ccw squares of o.side on o.robot with the factors f
+// (c_L, c_R, b [m]), as run_umbmark_simulation drives its sets (floor and reference of o.noise,
+// seeds from o.seed): how a calibration found elsewhere (e.g. from fixes) does on the square.
+Result<UmbmarkSquares> score_umbmark_factors(const UmbmarkSimOptions& o, const calib::Factors& f);
+
 // umbmark_svg: two ex-ey panels [mm], each on its own equal-scale frame with ticks and a grid:
 // the first "before" set with its bump runs, and every pass's verification set (a marker shape
 // of its own for each of up to 10 passes); cw and ccw, and the centres of gravity.
