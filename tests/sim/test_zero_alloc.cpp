@@ -349,23 +349,29 @@ TEST(ZeroAlloc, SlipIntervalsWithAndWithoutAGyroAllocateNothing) {
     const double w = 0.3 / 0.075;
     auto run = sim::SimRun::create(geo, k, sim::Scenario{{45.0, w, 0.9 * w}}, o).value();
     sim::SideWheelsSim& m = run->side_wheels()->model();
-    for (int i = 0; i < 20; ++i) {
-      const TimeNs at = from_seconds(2.0 + 2.0 * i);
-      m.inject(i % 2, i % 4 < 2 ? 0 : 1,
-               i == 7 ? sim::WheelFault::kCounter : sim::WheelFault::kUnloaded, at,
-               at + from_seconds(0.5));
-    }
     loop::OdometryLoop& loop = run->loop();
     loop.start();
     AllocWindow win;
-    for (int t = 0; t < 44'000; ++t) loop.tick();
+    for (int t = 0; t < 44'000; ++t) {
+      // Fault i over [2 + 2i, 2.5 + 2i) s, injected (one per wheel at a time) just before.
+      if (t % 2000 == 1900 && t / 2000 < 20) {
+        const int i = t / 2000;
+        const TimeNs at = from_seconds(2.0 + 2.0 * i);
+        m.inject(i % 2, i % 4 < 2 ? 0 : 1,
+                 i == 7 ? sim::WheelFault::kCounter : sim::WheelFault::kUnloaded, at,
+                 at + from_seconds(0.5));
+      }
+      loop.tick();
+    }
     win.disarm();
     EXPECT_EQ(g_allocs.load(), 0u) << (gyro ? "with the gyro" : "odometry alone");
     EXPECT_EQ(g_frees.load(), 0u);
     const EncoderCounters& c = loop.snapshot().encoder_counters;
     EXPECT_EQ(c.slip_events, 19u) << (gyro ? "with the gyro" : "odometry alone");  // the path ran
     EXPECT_EQ(c.wheel_drops, 1u);
-    if (gyro) EXPECT_GE(loop.fusion()->counters().slip_events, 1u);
+    // With the gyro the flagged ticks took the fused slip path (the gyro's own disagreement
+    // usually opens the interval first, so it counts the event).
+    if (gyro) EXPECT_GT(loop.fusion()->counters().gyro_used_ticks, 0u);
   }
 }
 
