@@ -94,6 +94,15 @@ nlohmann::json report_json(const loop::LoopSnapshot& s, const loop::LoopStats& s
   return j;
 }
 
+nlohmann::json side_wheels_json(const loop::LoopSnapshot& s, int wheels_per_side) {
+  // The gyro's intervals opened by a slip are here, not in "gyro": with one encoder per side
+  // the --json object stays as it was.
+  return {{"wheels_per_side", wheels_per_side},
+          {"slip_events", s.encoder_counters.slip_events},
+          {"wheel_drops", s.encoder_counters.wheel_drops},
+          {"gyro_slip_events", s.gyro.fusion.slip_events}};
+}
+
 nlohmann::json resume_json(const ResumeWiring& resume, const loop::OdometryLoop& loop) {
   const loop::ResumeReason why = resume_reason(resume, loop);
   return {

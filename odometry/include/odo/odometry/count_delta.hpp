@@ -3,20 +3,12 @@
 
 #include <cstdint>
 
+#include "odo/hal/encoder.hpp"
 #include "odo/hal/result.hpp"
 
 namespace odo {
 
-// wrap_delta: signed difference cur - prev of two readings of a `bits`-wide counter, taking the
-// shortest way round the wrap (|delta| < 2^(bits-1)). Readings may be given signed or unsigned;
-// only their low `bits` bits are used. bits must be in [16, 64] (checked by the caller once).
-constexpr std::int64_t wrap_delta(std::int64_t prev, std::int64_t cur, int bits) noexcept {
-  // Unsigned arithmetic wraps modulo 2^64 without UB; shifting the difference up to the top of
-  // the word and back down (arithmetic shift) sign-extends it from `bits` bits.
-  const std::uint64_t diff = static_cast<std::uint64_t>(cur) - static_cast<std::uint64_t>(prev);
-  const int shift = 64 - bits;
-  return static_cast<std::int64_t>(diff << shift) >> shift;
-}
+// wrap_delta: hal/encoder.hpp (the counters' own arithmetic; backends use it too).
 
 // counter_value: reported + rejected modulo 2^bits, sign-extended: the counter's own value when a
 // backend reports `reported` after leaving out `rejected` counts of implausible jumps [counts].
