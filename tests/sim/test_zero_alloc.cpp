@@ -371,7 +371,9 @@ TEST(ZeroAlloc, SlipIntervalsWithAndWithoutAGyroAllocateNothing) {
     EXPECT_EQ(c.wheel_drops, 1u);
     // With the gyro the flagged ticks took the fused slip path (the gyro's own disagreement
     // usually opens the interval first, so it counts the event).
-    if (gyro) EXPECT_GT(loop.fusion()->counters().gyro_used_ticks, 0u);
+    if (gyro) {
+      EXPECT_GT(loop.fusion()->counters().gyro_used_ticks, 0u);
+    }
   }
 }
 
