@@ -128,12 +128,108 @@ void read_gpio(TableReader t, GpioSection& s) {
   t.finish();
 }
 
+// read_side_list: the side's key `key`, an integer (one wheel) or a list of 1..kMaxWheelsPerSide
+// in [lo, hi]; wheel 1 into `first`, wheels 2.. into `more`; returns the number of wheels.
+template <class T, class U>
+int read_side_list(TableReader& t, std::string_view key, T& first,
+                   std::array<U, kMaxWheelsPerSide - 1>& more, std::int64_t lo, std::int64_t hi) {
+  const std::vector<std::int64_t> v =
+      t.integers(key, {static_cast<std::int64_t>(first)}, lo, hi, kMaxWheelsPerSide);
+  first = static_cast<T>(v.front());
+  for (std::size_t k = 1; k < v.size(); ++k) more[k - 1] = static_cast<U>(v[k]);
+  return static_cast<int>(v.size());
+}
+
+// same_count: both sides list as many wheels (reported at `right_key`); returns that count.
+int same_count(TableReader& t, std::string_view left_key, int left, std::string_view right_key,
+               int right) {
+  if (left != right)
+    t.reject(right_key, "lists " + std::to_string(right) + " wheel(s) but " +
+                            std::string(left_key) + " lists " + std::to_string(left) +
+                            ": both sides need the same number of wheels");
+  return left;
+}
+
+// wheel_of: wheel k (0-based) of side `right` of a [can_encoder] list field.
+template <class T>
+T wheel_of(const T& first_left, const T& first_right,
+           const std::array<T, kMaxWheelsPerSide - 1>& more_left,
+           const std::array<T, kMaxWheelsPerSide - 1>& more_right, bool right, int k) {
+  if (k == 0) return right ? first_right : first_left;
+  return right ? more_right[static_cast<std::size_t>(k - 1)]
+               : more_left[static_cast<std::size_t>(k - 1)];
+}
+
+// read_can_odrive_nodes: node_left / node_right, one node id per wheel, all different.
+void read_can_odrive_nodes(TableReader& t, CanEncoderSection& s, bool used) {
+  const int nl = read_side_list(t, "node_left", s.node_left, s.more_node_left, 0, 63);
+  const int nr = read_side_list(t, "node_right", s.node_right, s.more_node_right, 0, 63);
+  if (!used) return;
+  s.wheels_per_side = same_count(t, "node_left", nl, "node_right", nr);
+  if (s.wheels_per_side == 1 && s.node_left == s.node_right) {
+    t.reject("node_right", "= " + std::to_string(s.node_right) +
+                               " is the left wheel's node id too (they must differ)");
+    return;
+  }
+  for (int i = 1; i < 2 * s.wheels_per_side; ++i) {
+    const int id =
+        wheel_of(s.node_left, s.node_right, s.more_node_left, s.more_node_right, i % 2 == 1, i / 2);
+    for (int j = 0; j < i; ++j) {
+      if (wheel_of(s.node_left, s.node_right, s.more_node_left, s.more_node_right, j % 2 == 1,
+                   j / 2) == id) {
+        t.reject(i % 2 == 1 ? "node_right" : "node_left",
+                 "gives node id " + std::to_string(id) +
+                     " to two wheels (each wheel needs its own axis)");
+        return;
+      }
+    }
+  }
+}
+
+// read_can_generic_ids: left_id / right_id (a list: one frame per wheel) and the offsets (one
+// for the side's wheels, or a list as long); no two wheels on the same bytes of one frame.
+void read_can_generic_ids(TableReader& t, CanEncoderSection& s, bool used) {
+  const std::int64_t max_id = s.extended ? 0x1FFFFFFF : 0x7FF;
+  const int il = read_side_list(t, "left_id", s.left_id, s.more_left_id, 0, max_id);
+  const int ir = read_side_list(t, "right_id", s.right_id, s.more_right_id, 0, max_id);
+  const int max_offset = 8 - s.width / 8;
+  const int ol = read_side_list(t, "left_offset", s.left_offset, s.more_left_offset, 0, max_offset);
+  const int orr =
+      read_side_list(t, "right_offset", s.right_offset, s.more_right_offset, 0, max_offset);
+  if (!used) return;
+  s.wheels_per_side = same_count(t, "left_id", il, "right_id", ir);
+  const int n = s.wheels_per_side;
+  // One offset: every wheel of the side uses it.
+  if (ol == 1) s.more_left_offset.fill(s.left_offset);
+  if (orr == 1) s.more_right_offset.fill(s.right_offset);
+  if (ol != 1) same_count(t, "left_id", n, "left_offset", ol);
+  if (orr != 1) same_count(t, "right_id", n, "right_offset", orr);
+  for (int i = 1; i < 2 * n; ++i) {
+    const bool right = i % 2 == 1;
+    const auto at = [&](int w) {
+      return std::pair{
+          wheel_of(s.left_id, s.right_id, s.more_left_id, s.more_right_id, w % 2 == 1, w / 2),
+          wheel_of(s.left_offset, s.right_offset, s.more_left_offset, s.more_right_offset,
+                   w % 2 == 1, w / 2)};
+    };
+    for (int j = 0; j < i; ++j) {
+      if (at(i) != at(j)) continue;
+      t.reject(right ? "right_offset" : "left_offset",
+               n == 1
+                   ? "= " + std::to_string(s.right_offset) +
+                         ": both wheels would read the same bytes of frame " +
+                         std::to_string(s.left_id)
+                   : "puts two wheels on the same bytes of frame " + std::to_string(at(i).first));
+      return;
+    }
+  }
+}
+
 void read_can_encoder(TableReader t, CanEncoderSection& s) {
   s.bus = t.choice("bus", s.bus);
   s.interface = t.string("interface", s.interface);
   s.protocol = t.choice("protocol", s.protocol);
-  s.node_left = static_cast<int>(t.integer("node_left", s.node_left, 0, 63));
-  s.node_right = static_cast<int>(t.integer("node_right", s.node_right, 0, 63));
+  read_can_odrive_nodes(t, s, s.protocol == CanEncoderProtocol::kOdrive);
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
   s.reverse_right = t.boolean("reverse_right", s.reverse_right);
   s.timeout = t.number("timeout", s.timeout, 0.005, 10.0, "s");
@@ -142,29 +238,20 @@ void read_can_encoder(TableReader t, CanEncoderSection& s) {
   s.max_frames_per_read =
       static_cast<int>(t.integer(s.max_frames_per_read, drivers::kCanMaxFramesPerRead));
   s.extended = t.boolean("extended", s.extended);
-  const std::int64_t max_id = s.extended ? 0x1FFFFFFF : 0x7FF;
-  s.left_id = t.integer("left_id", s.left_id, 0, max_id);
-  s.right_id = t.integer("right_id", s.right_id, 0, max_id);
   s.width = static_cast<int>(t.integer("width", s.width, 16, 64));
   if (s.width % 8 != 0)
     t.reject("width",
              "= " + std::to_string(s.width) + " must be a whole number of bytes (16, 24, ..., 64)");
-  const int bytes = s.width / 8;
-  s.left_offset = static_cast<int>(t.integer("left_offset", s.left_offset, 0, 8 - bytes));
-  s.right_offset = static_cast<int>(t.integer("right_offset", s.right_offset, 0, 8 - bytes));
+  read_can_generic_ids(t, s, s.protocol == CanEncoderProtocol::kGeneric);
   s.is_signed = t.boolean("signed", s.is_signed);
   s.byte_order = t.choice("byte_order", s.byte_order);
-  if (s.protocol == CanEncoderProtocol::kGeneric && s.left_id == s.right_id &&
-      s.left_offset == s.right_offset)
-    t.reject("right_offset", "= " + std::to_string(s.right_offset) +
-                                 ": both wheels would read the same bytes of frame " +
-                                 std::to_string(s.left_id));
-  if (s.protocol == CanEncoderProtocol::kOdrive && s.node_left == s.node_right)
-    t.reject("node_right", "= " + std::to_string(s.node_right) +
-                               " is the left wheel's node id too (they must differ)");
   s.sim_period = t.number("sim_period", s.sim_period, 0.001, 1.0, "s");
   s.sim_stop_left_after = t.number("sim_stop_left_after", s.sim_stop_left_after, -1.0, 1e6, "s");
   s.sim_stop_right_after = t.number("sim_stop_right_after", s.sim_stop_right_after, -1.0, 1e6, "s");
+  if (s.bus == CanEncoderBus::kSim && s.wheels_per_side > 1)
+    t.reject("bus",
+             "= \"sim\" simulates one ODrive axis per side: " + std::to_string(s.wheels_per_side) +
+                 " wheels per side need bus = \"socketcan\"");
   t.finish();
 }
 

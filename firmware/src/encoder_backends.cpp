@@ -138,14 +138,32 @@ std::string layout_text(const drivers::CanCountLayout& l) {
   return b;
 }
 
+// side_text: the side's wheels' layouts, "id 0x00A bytes 0..3" or "[id 0x00A ..., id 0x04A ...]".
+std::string side_text(const drivers::CanEncoderConfig& c, int side) {
+  const int n = c.wheels.wheels_per_side;
+  std::string t = n > 1 ? "[" : "";
+  for (int k = 0; k < n; ++k)
+    t += (k > 0 ? ", " : "") + layout_text(drivers::can_wheel_layout(c, 2 * k + side));
+  return t + (n > 1 ? "]" : "");
+}
+
 std::string can_text(const CanEncoderSection& s, const drivers::CanEncoderConfig& c) {
   std::ostringstream d;
-  if (s.protocol == CanEncoderProtocol::kOdrive)
-    d << "ODrive CAN Simple encoder counts (nodes " << s.node_left << "/" << s.node_right << ", ";
-  else
+  if (s.protocol == CanEncoderProtocol::kOdrive) {
+    d << "ODrive CAN Simple encoder counts (nodes ";
+    for (int k = 0; k < 2 * s.wheels_per_side; ++k)
+      d << (k == s.wheels_per_side ? "/" : (k > 0 ? "," : ""))
+        << (drivers::can_wheel_layout(
+                c, k < s.wheels_per_side ? 2 * k : 2 * (k - s.wheels_per_side) + 1)
+                .id >>
+            5);
+    d << ", ";
+  } else {
     d << "generic CAN counts (";
-  d << "left " << layout_text(c.left) << ", right " << layout_text(c.right) << ", "
-    << c.left.width_bits << "-bit " << (c.left.is_signed ? "signed" : "unsigned") << " "
+  }
+  if (s.wheels_per_side > 1) d << s.wheels_per_side << " wheels per side, ";
+  d << "left " << side_text(c, 0) << ", right " << side_text(c, 1) << ", " << c.left.width_bits
+    << "-bit " << (c.left.is_signed ? "signed" : "unsigned") << " "
     << (c.left.big_endian ? "big" : "little") << " endian), stale after " << s.timeout * 1e3
     << " ms, jump limit " << c.max_counts_per_s << " counts/s"
     << (s.request_rate > 0 ? ", requests at " + std::to_string(s.request_rate) + " Hz" : "");
@@ -284,15 +302,24 @@ Result<std::unique_ptr<EncoderBackend>> make_serial_sim_backend(const Config& cf
 
 drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const KinematicParams& p) {
   drivers::CanEncoderConfig c;
-  if (s.protocol == CanEncoderProtocol::kOdrive) {
-    c.left = drivers::odrive_count_layout(static_cast<std::uint32_t>(s.node_left));
-    c.right = drivers::odrive_count_layout(static_cast<std::uint32_t>(s.node_right));
-  } else {
-    for (int i = 0; i < 2; ++i) {
-      drivers::CanCountLayout& l = i == 0 ? c.left : c.right;
-      l.id = static_cast<std::uint32_t>(i == 0 ? s.left_id : s.right_id);
+  c.wheels.wheels_per_side = s.wheels_per_side;
+  for (int k = 0; k < s.wheels_per_side; ++k) {
+    const auto m = static_cast<std::size_t>(k > 0 ? k - 1 : 0);
+    for (int side = 0; side < 2; ++side) {
+      drivers::CanCountLayout& l =
+          k == 0 ? (side == 0 ? c.left : c.right) : (side == 0 ? c.more_left[m] : c.more_right[m]);
+      if (s.protocol == CanEncoderProtocol::kOdrive) {
+        const int node = k == 0 ? (side == 0 ? s.node_left : s.node_right)
+                                : (side == 0 ? s.more_node_left[m] : s.more_node_right[m]);
+        l = drivers::odrive_count_layout(static_cast<std::uint32_t>(node));
+        continue;
+      }
+      l.id =
+          static_cast<std::uint32_t>(k == 0 ? (side == 0 ? s.left_id : s.right_id)
+                                            : (side == 0 ? s.more_left_id[m] : s.more_right_id[m]));
       l.extended = s.extended;
-      l.byte_offset = i == 0 ? s.left_offset : s.right_offset;
+      l.byte_offset = k == 0 ? (side == 0 ? s.left_offset : s.right_offset)
+                             : (side == 0 ? s.more_left_offset[m] : s.more_right_offset[m]);
       l.width_bits = s.width;
       l.is_signed = s.is_signed;
       l.big_endian = s.byte_order == ByteOrder::kBig;
@@ -313,9 +340,10 @@ Result<std::unique_ptr<EncoderBackend>> make_can_socketcan_backend(const Config&
   const drivers::CanEncoderConfig c = can_encoder_config(s, k.params());
   drivers::SocketCanOptions o;
   o.interface = s.interface;
-  for (const drivers::CanCountLayout* l : {&c.left, &c.right}) {
+  for (int i = 0; i < drivers::can_wheel_count(c); ++i) {
     // Exact-id filters: every other frame is dropped by the kernel.
-    o.filters.push_back({l->id, l->extended ? 0x1FFFFFFFu : 0x7FFu, l->extended});
+    const drivers::CanCountLayout& l = drivers::can_wheel_layout(c, i);
+    o.filters.push_back({l.id, l.extended ? 0x1FFFFFFFu : 0x7FFu, l.extended});
   }
   auto bus = drivers::SocketCanBus::open(o);
   if (!bus) return in_file(cfg, "can_encoder", std::move(bus).error());

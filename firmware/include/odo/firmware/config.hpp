@@ -2,6 +2,7 @@
 // the line, the field and the allowed range.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -16,6 +17,7 @@
 #include "odo/hal/field_range.hpp"
 #include "odo/hal/nv_storage.hpp"
 #include "odo/hal/result.hpp"
+#include "odo/hal/side_wheels.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/gyrodometry.hpp"
 #include "odo/odometry/kinematics.hpp"
@@ -216,6 +218,16 @@ struct CanEncoderSection {
   int width = 32;         // [bits] 16, 24, ..., 64
   bool is_signed = true;  // key "signed"
   ByteOrder byte_order = ByteOrder::kLittle;
+  // Several wheels per side (issue 38): node_left = [0, 2] (odrive) or left_id = [0x100, 0x102]
+  // (generic, with left_offset one offset for all or a list as long) gives the side's wheels;
+  // the fields above are wheel 1 of each side, more_*[k - 2] wheel k. Both sides alike.
+  int wheels_per_side = 1;  // the lists' length, 1..kMaxWheelsPerSide
+  std::array<int, kMaxWheelsPerSide - 1> more_node_left{};
+  std::array<int, kMaxWheelsPerSide - 1> more_node_right{};
+  std::array<std::int64_t, kMaxWheelsPerSide - 1> more_left_id{};
+  std::array<std::int64_t, kMaxWheelsPerSide - 1> more_right_id{};
+  std::array<int, kMaxWheelsPerSide - 1> more_left_offset{};
+  std::array<int, kMaxWheelsPerSide - 1> more_right_offset{};
   // bus = "sim" only
   double sim_period = 0.01;           // [s] cyclic message period of the simulated controllers
   double sim_stop_left_after = -1.0;  // [s] the left axis stops sending after this; < 0 never
