@@ -142,7 +142,7 @@ Result<CanEncoderSource> CanEncoderSource::create(CanBus& bus, const CanEncoderC
 void CanEncoderSource::accept(int i, std::int64_t value, TimeNs stamp,
                               std::uint32_t& flags) noexcept {
   Wheel& w = wheel_[static_cast<std::size_t>(i)];
-  const int bits = counter_bits();
+  const int bits = cfg_.left.width_bits;  // each wheel's own counter (counter_bits() may be 64)
   // Stamps of one socket never go back; a clock conversion could by a few ns: held.
   if (w.primed && stamp < w.last_stamp) stamp = w.last_stamp;
   const bool reverse = i % 2 == 0 ? cfg_.reverse_left : cfg_.reverse_right;
@@ -178,7 +178,7 @@ std::int64_t CanEncoderSource::count_at(const Wheel& w, TimeNs t) const noexcept
     if (f.stamp <= t) {
       if (k == 0) return f.count;  // t at or after the newest frame: its count
       const Stamped& g = w.history[after];
-      const int bits = counter_bits();
+      const int bits = cfg_.left.width_bits;  // each wheel's own counter (counter_bits() may be 64)
       const double frac = static_cast<double>(t - f.stamp) / static_cast<double>(g.stamp - f.stamp);
       const double step = static_cast<double>(wrap_sub(g.count, f.count, bits));
       return wrap_add(f.count, std::llround(frac * step), bits);

@@ -140,15 +140,16 @@ int read_side_list(TableReader& t, std::string_view key, T& first,
   return static_cast<int>(v.size());
 }
 
-// same_count: both sides list as many wheels (reported at `right_key`); returns that count.
-int same_count(TableReader& t, std::string_view left_key, int left, std::string_view right_key,
-               int right) {
-  if (left != right)
-    t.reject(right_key, "lists " + std::to_string(right) + " wheel(s) but " +
-                            std::string(left_key) + " lists " + std::to_string(left) +
-                            ": both sides need the same number of wheels");
-  return left;
+// same_count: `key` lists as many wheels as `ref_key` (else reported at `key`, with `why`);
+// returns the reference count.
+int same_count(TableReader& t, std::string_view ref_key, int ref, std::string_view key, int n,
+               std::string_view why) {
+  if (n != ref)
+    t.reject(key, "lists " + std::to_string(n) + " wheel(s) but " + std::string(ref_key) +
+                      " lists " + std::to_string(ref) + ": " + std::string(why));
+  return ref;
 }
+constexpr std::string_view kBothSides = "both sides need the same number of wheels";
 
 // wheel_of: wheel k (0-based) of side `right` of a [can_encoder] list field.
 template <class T>
@@ -165,7 +166,7 @@ void read_can_odrive_nodes(TableReader& t, CanEncoderSection& s, bool used) {
   const int nl = read_side_list(t, "node_left", s.node_left, s.more_node_left, 0, 63);
   const int nr = read_side_list(t, "node_right", s.node_right, s.more_node_right, 0, 63);
   if (!used) return;
-  s.wheels_per_side = same_count(t, "node_left", nl, "node_right", nr);
+  s.wheels_per_side = same_count(t, "node_left", nl, "node_right", nr, kBothSides);
   if (s.wheels_per_side == 1 && s.node_left == s.node_right) {
     t.reject("node_right", "= " + std::to_string(s.node_right) +
                                " is the left wheel's node id too (they must differ)");
@@ -197,13 +198,14 @@ void read_can_generic_ids(TableReader& t, CanEncoderSection& s, bool used) {
   const int orr =
       read_side_list(t, "right_offset", s.right_offset, s.more_right_offset, 0, max_offset);
   if (!used) return;
-  s.wheels_per_side = same_count(t, "left_id", il, "right_id", ir);
+  s.wheels_per_side = same_count(t, "left_id", il, "right_id", ir, kBothSides);
   const int n = s.wheels_per_side;
   // One offset: every wheel of the side uses it.
   if (ol == 1) s.more_left_offset.fill(s.left_offset);
   if (orr == 1) s.more_right_offset.fill(s.right_offset);
-  if (ol != 1) same_count(t, "left_id", n, "left_offset", ol);
-  if (orr != 1) same_count(t, "right_id", n, "right_offset", orr);
+  constexpr std::string_view kOffsets = "give one offset for all, or one per wheel";
+  if (ol != 1) same_count(t, "left_id", n, "left_offset", ol, kOffsets);
+  if (orr != 1) same_count(t, "right_id", n, "right_offset", orr, kOffsets);
   for (int i = 1; i < 2 * n; ++i) {
     const bool right = i % 2 == 1;
     const auto at = [&](int w) {
@@ -214,12 +216,15 @@ void read_can_generic_ids(TableReader& t, CanEncoderSection& s, bool used) {
     };
     for (int j = 0; j < i; ++j) {
       if (at(i) != at(j)) continue;
-      t.reject(right ? "right_offset" : "left_offset",
-               n == 1
-                   ? "= " + std::to_string(s.right_offset) +
-                         ": both wheels would read the same bytes of frame " +
-                         std::to_string(s.left_id)
-                   : "puts two wheels on the same bytes of frame " + std::to_string(at(i).first));
+      if (n == 1)
+        t.reject("right_offset", "= " + std::to_string(s.right_offset) +
+                                     ": both wheels would read the same bytes of frame " +
+                                     std::to_string(s.left_id));
+      else
+        t.reject(right ? "right_id" : "left_id",
+                 "puts two wheels on the same bytes (frame " + std::to_string(at(i).first) +
+                     ", offset " + std::to_string(at(i).second) +
+                     "): give each wheel its own frame id or offset");
       return;
     }
   }
