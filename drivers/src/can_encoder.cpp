@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "odo/drivers/count_plausibility.hpp"
@@ -247,29 +248,53 @@ int CanEncoderSource::drain(TimeNs now, std::uint32_t& flags) noexcept {
   return n;
 }
 
+void CanEncoderSource::mark_lagging() noexcept {
+  const int n = can_wheel_count(cfg_);
+  TimeNs horizon = 0;  // the newest among the fresh wheels' oldest kept frames
+  for (int i = 0; i < n; ++i) {
+    const Wheel& w = wheel_[static_cast<std::size_t>(i)];
+    if (w.stale || w.kept == 0) continue;
+    horizon = std::max(horizon, w.history[(w.newest + kHistory - (w.kept - 1)) % kHistory].stamp);
+  }
+  std::array<int, 2> fresh{}, lagging{};
+  for (int i = 0; i < n; ++i) {
+    Wheel& w = wheel_[static_cast<std::size_t>(i)];
+    w.lagging = !w.stale && w.last_stamp < horizon;
+    fresh[static_cast<std::size_t>(i % 2)] += w.stale ? 0 : 1;
+    lagging[static_cast<std::size_t>(i % 2)] += w.lagging ? 1 : 0;
+  }
+  // A side whose every fresh wheel lags (a slower sender than the other side's) is held back as
+  // with one wheel per side, never dropped for it.
+  for (int i = 0; i < n; ++i) {
+    const auto side = static_cast<std::size_t>(i % 2);
+    if (lagging[side] == fresh[side]) wheel_[static_cast<std::size_t>(i)].lagging = false;
+  }
+}
+
 TimeNs CanEncoderSource::sample_time(TimeNs now, std::uint32_t& flags) noexcept {
   const int n = can_wheel_count(cfg_);
   std::array<bool, 2> side_fresh{false, false};
-  TimeNs oldest = 0;
-  bool any = false;
   for (int i = 0; i < n; ++i) {
     Wheel& w = wheel_[static_cast<std::size_t>(i)];
     const bool stale = !w.primed || now - w.last_stamp > cfg_.timeout;
     // Several wheels per side: a wheel going stale is a wheel drop, a side going stale an event
     // (both counted by the combiner).
-    if (stale && !w.stale && w.primed && cfg_.wheels.wheels_per_side == 1) ++counters_.stale_events;
+    if (stale && !w.stale && w.primed && !combiner_) ++counters_.stale_events;
     w.stale = stale;
-    if (stale) continue;
-    side_fresh[static_cast<std::size_t>(i % 2)] = true;
-    oldest = any ? std::min(oldest, w.last_stamp) : w.last_stamp;
-    any = true;
+    if (!stale) side_fresh[static_cast<std::size_t>(i % 2)] = true;
   }
+  if (combiner_) mark_lagging();
   // A side is stale when none of its wheels is fresh (with one wheel per side: that wheel).
   if (!side_fresh[0]) flags |= kEncoderStaleLeft;
   if (!side_fresh[1]) flags |= kEncoderStaleRight;
   // One instant for all wheels: the oldest newest frame of the fresh wheels (the others
-  // interpolated to it); with a stale side there is none, and the read time is used as before.
-  // Never back in time.
+  // interpolated to it; lagging ones left out); with a stale side there is none, and the read
+  // time is used as before. Never back in time.
+  TimeNs oldest = std::numeric_limits<TimeNs>::max();  // a frame may be stamped after `now`
+  for (int i = 0; i < n; ++i) {
+    const Wheel& w = wheel_[static_cast<std::size_t>(i)];
+    if (!w.stale && !w.lagging) oldest = std::min(oldest, w.last_stamp);
+  }
   TimeNs t = side_fresh[0] && side_fresh[1] ? oldest : now;
   if (t < last_sample_) t = last_sample_;
   last_sample_ = t;
@@ -284,8 +309,8 @@ void CanEncoderSource::combine(TimeNs t, EncoderSample& s) noexcept {
     SideReadings& r = side[static_cast<std::size_t>(i % 2)];
     const int k = i / 2;
     r.counts[static_cast<std::size_t>(k)] = w.primed ? count_at(w, t) : 0;
-    // A stale wheel's count is its last frame's, not this instant's: dropped from the mean.
-    if (w.stale) r.faulted = static_cast<std::uint8_t>(r.faulted | (1u << k));
+    // A stale or lagging wheel's count is not this instant's: dropped from the mean.
+    if (w.stale || w.lagging) r.faulted = static_cast<std::uint8_t>(r.faulted | (1u << k));
   }
   const SideStep step = combiner_->step(side[0], side[1]);
   s.left = step.left;

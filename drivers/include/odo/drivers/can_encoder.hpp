@@ -44,7 +44,9 @@
 // wheel of a 4WD base): every wheel is read as above on its own layout (its own frames, stamps,
 // jump check and wrap); a wheel is stale on its own and is then dropped from its side (faulted),
 // the side is stale only when all its wheels are; the instant is the oldest newest frame of the
-// fresh wheels; the side's count is SideCombiner's (hal/side_wheels.hpp: wrap-aware per wheel,
+// fresh wheels, except that a wheel silent for longer than the others' kept frames (kHistory)
+// is dropped at once rather than holding the instant back until it is stale (mark_lagging); the
+// side's count is SideCombiner's (hal/side_wheels.hpp: wrap-aware per wheel,
 // 64-bit, never wraps), so counter_bits() is 64. N = 1 is exactly the two-wheel source above.
 #pragma once
 
@@ -167,6 +169,7 @@ class CanEncoderSource final : public EncoderSource {
     TimeNs last_stamp = 0;      // receive time of the newest frame [ns]
     bool primed = false;        // a frame has arrived
     bool stale = true;          // flagged stale at the last read
+    bool lagging = false;       // N > 1: left out of the last read (mark_lagging)
     std::array<Stamped, kHistory> history{};  // ring; newest at `newest`
     std::size_t newest = 0;
     std::size_t kept = 0;  // valid entries, 0..kHistory
@@ -178,6 +181,11 @@ class CanEncoderSource final : public EncoderSource {
   // count_at: wheel `w`'s reported count at `t` [ns]: interpolated between the frames around t,
   // the newest count after the newest frame, the oldest kept before the oldest.
   std::int64_t count_at(const Wheel& w, TimeNs t) const noexcept;
+  // mark_lagging: N > 1 wheels per side: a fresh wheel whose newest frame is older than another
+  // fresh wheel's oldest kept frame would hold the instant where that wheel's count is clamped
+  // (its travel half-weighted in its side's mean until the silent wheel is stale): it is left
+  // out of this read (faulted: dropped) unless every fresh wheel of its side lags.
+  void mark_lagging() noexcept;
   // sample_time: the instant of this read (see the header comment); marks stale wheels.
   TimeNs sample_time(TimeNs now, std::uint32_t& flags) noexcept;
   // combine: N > 1 wheels per side: each wheel's count at `t` into SideCombiner.
