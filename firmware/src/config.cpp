@@ -53,8 +53,26 @@ void read_robot(TableReader t, KinematicParams& p) {
   t.finish();
 }
 
-void read_encoder(TableReader t, EncoderSection& s) {
+// The [encoder] keys of several encoders per side, from the combiner's own table
+// (side_wheels_range at this loop's tick): the whole wheels_per_side, then the numbers.
+constexpr double SideWheelsConfig::*kSideNumbers[kSideConfigParams] = {
+    nullptr, &SideWheelsConfig::slip_window, &SideWheelsConfig::slip_counts,
+    &SideWheelsConfig::slip_fraction};
+
+void read_encoder(TableReader t, EncoderSection& s, double loop_hz) {
   s.backend = t.choice("backend", s.backend);
+  SideWheelsConfig& w = s.side;
+  w.read_period = 1.0 / loop_hz;
+  w.wheels_per_side = static_cast<int>(
+      t.integer(w.wheels_per_side, side_wheels_range(SideParam::kWheelsPerSide, w.read_period)));
+  w.combine = t.choice("combine", w.combine);
+  for (std::size_t i = 1; i < kSideConfigParams; ++i)
+    w.*kSideNumbers[i] =
+        t.number(w.*kSideNumbers[i], side_wheels_range(static_cast<SideParam>(i), w.read_period));
+  if (w.wheels_per_side > 1 && !backend_carries_side_wheels(s.backend))
+    t.reject("wheels_per_side", "= " + std::to_string(w.wheels_per_side) + " needs a backend " +
+                                    "that reads several counters per side; backend \"" +
+                                    std::string(name_of(s.backend)) + "\" reads one");
   t.finish();
 }
 
@@ -502,7 +520,7 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   TableReader root(&parsed, "", source, &error);
   read_loop(root.sub("loop"), c.loop);
   read_robot(root.sub("robot"), c.robot);
-  read_encoder(root.sub("encoder"), c.encoder);
+  read_encoder(root.sub("encoder"), c.encoder, c.loop.rate_hz);
   read_sim(root.sub("sim"), c.sim);
   read_realtime(root.sub("realtime"), c.realtime);
   read_calibration(root.sub("calibration"), c.calibration);

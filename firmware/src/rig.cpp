@@ -6,6 +6,7 @@
 #include "gyro_backend.hpp"
 #include "odo/drivers/monotonic_clock.hpp"
 #include "odo/sim/robot.hpp"
+#include "odo/sim/side_wheels_sim.hpp"
 #include "odo/sim/sim_encoder.hpp"
 #include "odo/sim/truth.hpp"
 #include "odo/sim/virtual_clock.hpp"
@@ -36,7 +37,7 @@ sim::Scenario make_scenario(const SimSection& s, const Kinematics& k) {
 struct Rig::Impl {
   std::unique_ptr<Clock> clock;
   std::unique_ptr<sim::SimRobot> robot;
-  std::unique_ptr<sim::SimEncoderSource> sim_encoder;
+  std::unique_ptr<EncoderSource> sim_encoder;  // SimEncoderSource or SimSideWheelsSource
   std::unique_ptr<EncoderSource> encoder_wrapper;
   EncoderSource* encoder = nullptr;
   std::unique_ptr<sim::TruthRecorder> truth;
@@ -107,6 +108,32 @@ Status Rig::add_gyro(const Config& cfg, Impl& impl, bool virtual_time) {
 
 namespace {
 
+// sim_encoder: the simulated robot's counters: one per side (SimEncoderSource) or, with
+// encoder.wheels_per_side > 1, that many wheels per side combined (SimSideWheelsSource, the
+// wheel model's documented defaults).
+Result<std::unique_ptr<EncoderSource>> sim_encoder(const Config& cfg, sim::SimRobot& robot) {
+  const SideWheelsConfig& w = cfg.encoder.side;
+  if (w.wheels_per_side == 1)
+    return std::unique_ptr<EncoderSource>(
+        std::make_unique<sim::SimEncoderSource>(robot, cfg.sim.counter_bits));
+  sim::SideWheelsSimParams p;
+  p.wheels_per_side = w.wheels_per_side;
+  auto model = sim::SideWheelsSim::create(p, robot.geometry());
+  if (!model) return std::move(model).error();
+  auto src =
+      sim::SimSideWheelsSource::create(robot, std::move(model).value(), w, cfg.sim.counter_bits);
+  if (!src) return std::move(src).error();
+  return std::unique_ptr<EncoderSource>(
+      std::make_unique<sim::SimSideWheelsSource>(std::move(src).value()));
+}
+
+// wheels_text: "N wheels per side (combine), " with several; "" with one (as before).
+std::string wheels_text(const SideWheelsConfig& w) {
+  if (w.wheels_per_side == 1) return {};
+  return std::to_string(w.wheels_per_side) + " wheels per side (" +
+         std::string(choice_name(kSideCombineNames, w.combine)) + "), ";
+}
+
 // hardware_backend: the real encoder backend named in the config (not simulated; a virtual
 // clock is refused).
 Result<std::unique_ptr<EncoderBackend>> hardware_backend(const Config& cfg, const Kinematics& k,
@@ -153,7 +180,9 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
   auto robot = sim::SimRobot::create(g, std::move(scenario));
   if (!robot) return std::move(robot).error();
   impl->robot = std::make_unique<sim::SimRobot>(std::move(robot).value());
-  impl->sim_encoder = std::make_unique<sim::SimEncoderSource>(*impl->robot, cfg.sim.counter_bits);
+  auto enc = sim_encoder(cfg, *impl->robot);
+  if (!enc) return std::move(enc).error();
+  impl->sim_encoder = std::move(enc).value();
   if (virtual_time) {
     impl->clock = std::make_unique<sim::VirtualClock>();
     impl->encoder = impl->sim_encoder.get();
@@ -179,7 +208,7 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
   d << "simulated robot '" << name_of(cfg.sim.robot) << "' (true wheelbase " << g.wheelbase * 1e3
     << " mm, D_R/D_L " << g.wheel_diameter_right / g.wheel_diameter_left << "), scenario '"
     << name_of(cfg.sim.scenario) << "' (" << impl->scenario_duration << " s), "
-    << cfg.sim.counter_bits << "-bit counters, "
+    << cfg.sim.counter_bits << "-bit counters, " << wheels_text(cfg.encoder.side)
     << (modelled ? impl->backend->describe() + ", " : std::string())
     << (virtual_time ? "virtual time" : "real time (CLOCK_MONOTONIC)");
   impl->description = d.str();

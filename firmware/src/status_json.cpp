@@ -44,6 +44,7 @@ nlohmann::json gyro_json(const loop::LoopGyroStatus& g) {
   j["disagreements"] = g.fusion.disagreements;
   j["speed_events"] = g.fusion.speed_events;
   j["accel_events"] = g.fusion.accel_events;
+  j["slip_events"] = g.fusion.slip_events;
   j["gyro_used_ticks"] = g.fusion.gyro_used_ticks;
   j["faults"] = g.fusion.gyro_faults;
   j["bias"] = g.bias;
@@ -92,6 +93,12 @@ nlohmann::json report_json(const loop::LoopSnapshot& s, const loop::LoopStats& s
     j["position_error"] = truth->position_error();
   }
   return j;
+}
+
+nlohmann::json side_wheels_json(const EncoderCounters& c, int wheels_per_side) {
+  return {{"wheels_per_side", wheels_per_side},
+          {"slip_events", c.slip_events},
+          {"wheel_drops", c.wheel_drops}};
 }
 
 nlohmann::json resume_json(const ResumeWiring& resume, const loop::OdometryLoop& loop) {

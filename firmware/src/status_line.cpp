@@ -35,8 +35,9 @@ struct Count {
   std::uint64_t value;
 };
 
-// counts_text: " (name=value ...)" of four event counters, "" while all are 0.
-std::string counts_text(const std::array<Count, 4>& counts) {
+// counts_text: " (name=value ...)" of N event counters, "" while all are 0.
+template <std::size_t N>
+std::string counts_text(const std::array<Count, N>& counts) {
   if (std::all_of(counts.begin(), counts.end(), [](const Count& c) { return c.value == 0; }))
     return {};
   std::string s = " (";
@@ -57,24 +58,26 @@ std::string gyro_text(const loop::LoopGyroStatus& g) {
   else
     s += g.bias_valid ? "fusing" : "learning-bias";
   const FusionCounters& c = g.fusion;
-  return s + counts_text({{{"disagreements", c.disagreements},
-                           {"speed", c.speed_events},
-                           {"accel", c.accel_events},
-                           {"faults", c.gyro_faults}}});
+  return s + counts_text<4>({{{"disagreements", c.disagreements},
+                              {"speed", c.speed_events},
+                              {"accel", c.accel_events},
+                              {"faults", c.gyro_faults}}});
 }
 
 // counters_text: the cumulative encoder fault counters, once there is something to count (a
 // fault between two status lines would otherwise be invisible in the per-sample flags).
 std::string counters_text(const EncoderCounters& c) {
-  return counts_text({{{"invalid", c.invalid_transitions},
-                       {"jumps", c.implausible_jumps},
-                       {"stale", c.stale_events},
-                       {"read_errors", c.read_errors}}}) +
+  return counts_text<4>({{{"invalid", c.invalid_transitions},
+                          {"jumps", c.implausible_jumps},
+                          {"stale", c.stale_events},
+                          {"read_errors", c.read_errors}}}) +
          // The serial link's (all 0 for the other backends: then nothing is printed).
-         counts_text({{{"link_errors", c.link_errors},
-                       {"gaps", c.sequence_gaps},
-                       {"resets", c.controller_resets},
-                       {"reconnects", c.reconnects}}});
+         counts_text<4>({{{"link_errors", c.link_errors},
+                          {"gaps", c.sequence_gaps},
+                          {"resets", c.controller_resets},
+                          {"reconnects", c.reconnects}}}) +
+         // Several encoders per side (hal/side_wheels.hpp; 0 with one: nothing is printed).
+         counts_text<2>({{{"slips", c.slip_events}, {"wheel_drops", c.wheel_drops}}});
 }
 
 }  // namespace

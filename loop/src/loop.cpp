@@ -182,8 +182,10 @@ TimeNs OdometryLoop::wait_for_deadline() noexcept {
   const std::int64_t dr = wrap_delta(prev_right_, s.right, bits_);
   const double dt = to_seconds(s.stamp - prev_stamp_);
   last_dt_ = dt;
-  if (fusion_) {
-    integrate_fused(dl, dr, dt, s.stamp);
+  if ((s.flags & (kEncoderSlipLeft | kEncoderSlipRight)) != 0) [[unlikely]] {
+    integrate_slip(s, dl, dr, dt);
+  } else if (fusion_) {
+    integrate_fused(dl, dr, dt, s.stamp, nullptr);
   } else {
     odom_.advance(dl, dr, dt);
   }
@@ -207,8 +209,8 @@ void OdometryLoop::take_reference(const EncoderSample& s) noexcept {
   }
 }
 
-[[gnu::always_inline]] inline void OdometryLoop::integrate_fused(std::int64_t dl, std::int64_t dr,
-                                                                 double dt, TimeNs stamp) noexcept {
+[[gnu::always_inline]] inline void OdometryLoop::integrate_fused(
+    std::int64_t dl, std::int64_t dr, double dt, TimeNs stamp, const SlipVariance* slip) noexcept {
   FusionInput& in = fused_in_;
   gyro_->read_into(stamp, in.gyro);
   const Kinematics& k = odom_.kinematics();
@@ -216,10 +218,14 @@ void OdometryLoop::take_reference(const EncoderSample& s) noexcept {
   in.d_left = static_cast<double>(dl) * k.metres_per_count_left();
   in.d_right = static_cast<double>(dr) * k.metres_per_count_right();
   in.wheelbase = k.wheelbase();
+  in.slip = slip != nullptr;
   const FusedTick f = fusion_->step(in);
   last_fusion_flags_ = f.flags;
   last_var_heading_ = f.var_heading;
-  if ((f.flags & kFusionGyroUsed) == 0) {
+  if (slip != nullptr) {
+    odom_.advance_slip(in.d_left, in.d_right, dt, f.dtheta, f.ds, (f.flags & kFusionGyroUsed) != 0,
+                       f.var_heading, slip->left, slip->right);
+  } else if ((f.flags & kFusionGyroUsed) == 0) {
     // Odometry's own increment and no travel correction: the plain path, which computes exactly
     // what advance_fused would for it (Odometry::update_fused's contract), at the plain cost,
     // from the travels already converted for the fusion (the counts are converted once).
@@ -227,6 +233,30 @@ void OdometryLoop::take_reference(const EncoderSample& s) noexcept {
   } else {
     odom_.advance_fused(in.d_left, in.d_right, dt, f.dtheta, f.ds, true, f.var_heading);
   }
+}
+
+[[gnu::noinline]] void OdometryLoop::integrate_slip(const EncoderSample& s, std::int64_t dl,
+                                                    std::int64_t dr, double dt) noexcept {
+  // A side's interval starts on the first tick it is flagged (the tick before was no slip tick
+  // of that side): its spread so far restarts from the window's (SideStep::spread).
+  const std::uint32_t before = slip_tick_ + 1 == stats_.ticks ? slip_flags_ : 0u;
+  if ((before & kEncoderSlipLeft) == 0) slip_spread_left_ = 0.0;
+  if ((before & kEncoderSlipRight) == 0) slip_spread_right_ = 0.0;
+  slip_tick_ = stats_.ticks;
+  slip_flags_ = s.flags;
+  const Kinematics& k = odom_.kinematics();
+  SlipVariance v;
+  v.left = slip_travel_variance(slip_spread_left_,
+                                static_cast<double>(s.spread_left) * k.metres_per_count_left());
+  v.right = slip_travel_variance(slip_spread_right_,
+                                 static_cast<double>(s.spread_right) * k.metres_per_count_right());
+  if (fusion_) {
+    integrate_fused(dl, dr, dt, s.stamp, &v);
+    return;
+  }
+  const double d_l = static_cast<double>(dl) * k.metres_per_count_left();
+  const double d_r = static_cast<double>(dr) * k.metres_per_count_right();
+  odom_.advance_slip(d_l, d_r, dt, (d_r - d_l) / k.wheelbase(), 0.0, false, 0.0, v.left, v.right);
 }
 
 void OdometryLoop::record_wakeup(TimeNs latency) noexcept {

@@ -39,6 +39,21 @@
 //   J_cx = I_c^2/2, J_cy = I_ss/phi, J_sy = I_s^2/2, J_sx = I_c I_s - J_cy.
 // Several of them cancel catastrophically as phi -> 0 (J_yy ~ 2 phi^2/15 out of O(1) terms), so
 // below |phi| = 1 the seven basic functions are evaluated from their Taylor series instead.
+//
+// Slip (several encoders per side, hal/side_wheels.hpp). While the wheels of a side disagree
+// beyond the slip threshold, the side's travel (their mean) is uncertain by about their spread:
+// a spinning wheel over-counts by up to the spread, and which wheel is right is not known. That
+// error is not white: a wheel that spins errs the same way on every tick of the interval, so
+// over an interval of total spread S the side's travel is off by up to S, variance ~S^2, not the
+// sum of the ticks' squares (which would shrink it by the number of ticks). Each tick k of the
+// interval adds the extra variance v_k = S_k^2 - S_(k-1)^2 = s_k (2 S_(k-1) + s_k) to its side's
+// wheel (S_k the spread up to and including tick k, s_k its own): the sum over the interval
+// telescopes to S^2, the variance of a fully correlated error, whatever the ticks' lengths.
+// Within a tick the extra variance is spread along the arc as the wheel noise is: it adds to
+// w_L (w_R) in Cov(U) above, which is linear in w_L, w_R. The first tick of an interval carries
+// the spread the wheels built up over the detection window before the flag rose (the combiner's
+// SideStep::spread), so the disturbance before detection is covered too. Between intervals
+// nothing is added: a one-encoder-per-side base never takes this path.
 
 namespace odo {
 namespace {
@@ -252,14 +267,10 @@ ArcTerms arc_terms(double phi) noexcept {
 
 namespace {
 
-// local_input_covariance: Cov(U) in the arc's start frame plus the arc's displacement there.
-inline Mat3 local_input_covariance(double d_left, double d_right, double inv_b,
-                                   const ErrorModelParams& k, const ArcTerms& t) noexcept {
-  // Not as a pair (-2 instructions on x86-64): where the compiler contracts a multiply and an
-  // add into one fused operation (aarch64), w_l + w_r and w_l - w_r become fma(k_L^2, |d_L|, ..)
-  // from scalars but not from a pair's lanes, which changes the bits there.
-  const double w_l = k.k_left * k.k_left * std::fabs(d_left);
-  const double w_r = k.k_right * k.k_right * std::fabs(d_right);
+// input_covariance_w: Cov(U) in the arc's start frame from the wheels' noise intensities w_l,
+// w_r [m^2] (Chong-Kleeman's k^2 |d|, plus a slip's extra variance).
+inline Mat3 input_covariance_w(double w_l, double w_r, double d_left, double d_right, double inv_b,
+                               const ArcTerms& t) noexcept {
   const double wp = w_l + w_r, wm = w_l - w_r;
   // a = D / b through the reciprocal the caller keeps (a division is ~570 instructions on a
   // Cortex-M4; the product differs from D / b by at most an ulp).
@@ -272,6 +283,17 @@ inline Mat3 local_input_covariance(double d_left, double d_right, double inv_b,
   q(0, 2) = q(2, 0) = -(wp * a * t.j_y + 0.5 * wm * t.i_c) * inv_b;
   q(1, 2) = q(2, 1) = (wp * a * t.j_x - 0.5 * wm * t.i_s) * inv_b;
   return q;
+}
+
+// local_input_covariance: Cov(U) in the arc's start frame plus the arc's displacement there.
+inline Mat3 local_input_covariance(double d_left, double d_right, double inv_b,
+                                   const ErrorModelParams& k, const ArcTerms& t) noexcept {
+  // Not as a pair (-2 instructions on x86-64): where the compiler contracts a multiply and an
+  // add into one fused operation (aarch64), w_l + w_r and w_l - w_r become fma(k_L^2, |d_L|, ..)
+  // from scalars but not from a pair's lanes, which changes the bits there.
+  const double w_l = k.k_left * k.k_left * std::fabs(d_left);
+  const double w_r = k.k_right * k.k_right * std::fabs(d_right);
+  return input_covariance_w(w_l, w_r, d_left, d_right, inv_b, t);
 }
 
 }  // namespace
@@ -386,6 +408,22 @@ void propagate_arc_known(Cov3& cov, double sin_theta0, double cos_theta0, double
   }
   propagate_arc_terms(cov, sin_theta0, cos_theta0, d_left, d_right, inv_b, k,
                       arc_terms_of(phi, z, narrow_basic_functions(phi, z)));
+}
+
+void propagate_arc_slip(Cov3& cov, double sin_theta0, double cos_theta0, double d_left,
+                        double d_right, double b, const ErrorModelParams& k, double var_left,
+                        double var_right) noexcept {
+  const bool finite =
+      all_finite(d_left, d_right, b, sin_theta0, cos_theta0) && std::isfinite(var_left + var_right);
+  if (!(finite && b > 0.0)) return;  // a non-finite step would poison the covariance for good
+  const double inv_b = 1.0 / b;
+  const ArcTerms t = arc_terms((d_right - d_left) * inv_b);
+  const double w_l = k.k_left * k.k_left * std::fabs(d_left) + var_left;
+  const double w_r = k.k_right * k.k_right * std::fabs(d_right) + var_right;
+  const Mat3 q = input_covariance_w(w_l, w_r, d_left, d_right, inv_b, t);
+  const double d = 0.5 * (d_left + d_right);
+  propagate_local_impl(cov, sin_theta0, cos_theta0, d * t.i_c, d * t.i_s, q(0, 0), q(0, 1), q(0, 2),
+                       q(1, 1), q(1, 2), q(2, 2));
 }
 
 void PoseCovariance::merge(double sin_theta0, double cos_theta0, double d_left, double d_right,

@@ -415,7 +415,8 @@ FusedTick Gyrodometry::step(const FusionInput& in) noexcept {
   }
   if (scale_estimation_ && !in_interval_ && fresh.err_ok)
     update_scale(fresh.odo_cmp, one_minus_g_ * fresh.raw + g_ * at(1).raw, dt);
-  const std::uint32_t limits = limit_flags(abs_left, abs_right);
+  const std::uint32_t limits =
+      limit_flags(abs_left, abs_right) | (in.slip ? kFusionWheelSlip : std::uint32_t{0});
   const std::uint32_t why = limits | disagree_flag();
   // Outside an interval hold_ is 0 (it is set with one and an interval ends only once it ran
   // out), so a quiet tick there changes nothing: the common case, decided first.
@@ -462,6 +463,7 @@ void Gyrodometry::open_interval(std::uint32_t why, double odo, double dt, FusedT
   counters_.disagreements += (why & kFusionDisagree) != 0 ? 1 : 0;
   counters_.speed_events += (why & kFusionSpeedLimit) != 0 ? 1 : 0;
   counters_.accel_events += (why & kFusionAccelLimit) != 0 ? 1 : 0;
+  counters_.slip_events += (why & kFusionWheelSlip) != 0 ? 1 : 0;
   const double c = begin_interval();
   out.dtheta = odo + c;
   interval_c_ = interval_ds_ = 0.0;
@@ -526,10 +528,11 @@ void propagate_gyro_arc(Cov3& cov, double sin_theta0, double cos_theta0, double 
 }
 
 void PoseCovariance::step_gyro_sc(double sin_theta0, double cos_theta0, double d_left,
-                                  double d_right, double dtheta, double var_heading) noexcept {
+                                  double d_right, double dtheta, double var_heading,
+                                  double extra_var_ds) noexcept {
   flush();  // the merged wheel ticks came before this one
   propagate_gyro_arc(cov_, sin_theta0, cos_theta0, 0.5 * (d_left + d_right), dtheta,
-                     along_track_variance(d_left, d_right, k_), var_heading);
+                     along_track_variance(d_left, d_right, k_) + extra_var_ds, var_heading);
 }
 
 }  // namespace odo

@@ -72,6 +72,19 @@ void Odometry::advance_fused(double d_l, double d_r, double dt, double dtheta, d
   }
 }
 
+void Odometry::advance_slip(double d_l, double d_r, double dt, double dtheta, double ds_correction,
+                            bool gyro_heading, double var_heading, double var_left,
+                            double var_right) noexcept {
+  const double s0 = sin_theta(), c0 = cos_theta();
+  integrate(d_l, d_r, 0.5 * (d_l + d_r) + ds_correction, dtheta, dt);
+  if (gyro_heading) {
+    cov_.step_gyro_sc(s0, c0, d_left_, d_right_, dtheta, var_heading,
+                      0.25 * (var_left + var_right));
+  } else {
+    cov_.step_slip_sc(s0, c0, d_left_, d_right_, k_.wheelbase(), var_left, var_right);
+  }
+}
+
 void Odometry::integrate(double d_l, double d_r, double ds, double dth, double dt) noexcept {
   d_left_ = d_l;
   d_right_ = d_r;

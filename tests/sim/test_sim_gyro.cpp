@@ -16,6 +16,7 @@
 #include "odo/sim/robot.hpp"
 #include "odo/sim/sim_gyro.hpp"
 #include "odo/sim/ziggurat.hpp"
+#include "random_drive.hpp"
 
 namespace odo::sim {
 namespace {
@@ -376,40 +377,6 @@ TEST(SimGyrodometry, CoarseDirectDriveEncodersToo) {
     EXPECT_EQ(smooth.events, 0u) << seed;
     EXPECT_EQ(smooth.fused_error, smooth.odo_error) << seed;
   }
-}
-
-// Ramped random driving: stops, on-the-spot turns and arcs (0.05-0.5 m/s, up to 0.5 rad/s;
-// turns up to 1 rad/s), each held 1-10 s, wheel speeds ramped at 1 m/s^2 in 10 ms steps (a real
-// base accelerates; a velocity step would be an infinite acceleration and rightly flagged).
-Scenario random_drive(double seconds, std::uint64_t seed, const RobotGeometry& g) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  const double r = g.wheel_diameter_left / 2.0, b = g.wheelbase;
-  Scenario sc{{2.0, 0.0, 0.0}};
-  double vl = 0.0, vr = 0.0, t = 2.0;
-  while (t < seconds) {
-    double tl = 0.0, tr = 0.0;
-    const double pick = u(rng);
-    if (pick < 0.2) {         // stop
-    } else if (pick < 0.4) {  // on the spot
-      tr = (2.0 * u(rng) - 1.0) * b / 2.0;
-      tl = -tr;
-    } else {
-      const double v = 0.05 + 0.45 * u(rng), w = (2.0 * u(rng) - 1.0) * 0.5;
-      tl = v - w * b / 2.0;
-      tr = v + w * b / 2.0;
-    }
-    while (vl != tl || vr != tr) {
-      vl += std::clamp(tl - vl, -0.01, 0.01);
-      vr += std::clamp(tr - vr, -0.01, 0.01);
-      sc.push_back({0.01, vl / r, vr / r});
-      t += 0.01;
-    }
-    const double hold = 1.0 + 9.0 * u(rng);
-    sc.push_back({hold, vl / r, vr / r});
-    t += hold;
-  }
-  return sc;
 }
 
 // Slip: one wheel turns faster than the ground moves it (ground travel = wheel travel / (1+s)).

@@ -104,7 +104,8 @@ inline constexpr std::tuple kChoiceTables{
     std::span<const Choice<GyroBackend>>(kGyroBackends),
     std::span<const Choice<GyroAxis>>(kGyroAxes),
     std::span<const Choice<GyroMode>>(kGyroModes),
-    std::span<const Choice<GyroModelKind>>(kGyroModelKinds)};
+    std::span<const Choice<GyroModelKind>>(kGyroModelKinds),
+    std::span<const Choice<SideCombine>>(kSideCombineNames)};
 
 // choices: the table of enum E's choices.
 template <class E>
@@ -278,7 +279,17 @@ inline constexpr SectionNumber<SerialSection> kSerialNumbers[] = {
 
 struct EncoderSection {
   EncoderKind backend = EncoderKind::kSim;
+  // Several encoders per side (hal/side_wheels.hpp): wheels_per_side, combine and the slip
+  // threshold from the [encoder] keys; read_period is the loop's tick, counter_bits the
+  // backend's. wheels_per_side = 1: the backend reads one counter per side as before.
+  SideWheelsConfig side;
 };
+
+// backend_carries_side_wheels: whether encoder backend `be` reads several counters per side
+// (encoder.wheels_per_side > 1 is refused for the others).
+constexpr bool backend_carries_side_wheels(EncoderKind be) {
+  return be == EncoderKind::kSim;
+}
 
 // [realtime]: how the loop thread is made real-time at start (each part reported at start).
 struct RealtimeSection {

@@ -108,6 +108,13 @@ struct LoopConfig {
   TimeNs start_wait = 0;
 };
 
+// SlipVariance: the extra variances [m^2] of the sides' travels on one tick of a within-side
+// slip interval (slip_travel_variance).
+struct SlipVariance {
+  double left = 0.0;
+  double right = 0.0;
+};
+
 class OdometryLoop {
  public:
   static constexpr std::size_t kMaxObservers = 8;
@@ -190,7 +197,13 @@ class OdometryLoop {
   void take_reference(const EncoderSample& s) noexcept;
   // integrate_fused: one interval of count deltas dl, dr over dt [s] with the gyro's reading up to
   // `stamp` [ns].
-  void integrate_fused(std::int64_t dl, std::int64_t dr, double dt, TimeNs stamp) noexcept;
+  // slip: the extra travel variances of a tick inside a within-side slip interval (null: none).
+  void integrate_fused(std::int64_t dl, std::int64_t dr, double dt, TimeNs stamp,
+                       const SlipVariance* slip) noexcept;
+  // integrate_slip: integrate() of a sample flagged kEncoderSlipLeft/Right (several encoders per
+  // side): the sides' extra travel variances grow the covariance and, with a gyro, force its
+  // heading (out of line: the one-encoder path never comes here).
+  void integrate_slip(const EncoderSample& s, std::int64_t dl, std::int64_t dr, double dt) noexcept;
   // record_wakeup: the wake-up latency [ns] into the statistics.
   void record_wakeup(TimeNs latency) noexcept;
   // fill_snapshot: this tick's snapshot in the back slot (every field that changes).
@@ -223,6 +236,11 @@ class OdometryLoop {
   std::uint32_t last_fusion_flags_ = 0;
   double last_dt_ = 0.0;           // [s] interval of the last integrated tick (TickMotion::dt)
   double last_var_heading_ = 0.0;  // [rad^2] its fused heading increment's variance
+  // Within-side slip intervals (integrate_slip): each side's spread so far [m] and the tick
+  // (stats_.ticks before it) and flags of the last slip tick, to tell an interval's first tick.
+  double slip_spread_left_ = 0.0, slip_spread_right_ = 0.0;
+  std::uint64_t slip_tick_ = ~std::uint64_t{0};
+  std::uint32_t slip_flags_ = 0;
   std::array<TickObserver*, kMaxObservers> observers_{};
   std::size_t n_observers_ = 0;
 

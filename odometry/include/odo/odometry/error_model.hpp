@@ -100,6 +100,23 @@ void propagate_arc_known(Cov3& cov, double sin_theta0, double cos_theta0, double
                          double d_right, double b, double inv_b, double phi,
                          const ErrorModelParams& k) noexcept;
 
+// propagate_arc_slip: propagate_arc of a tick whose wheel travels carry, besides the
+// Chong-Kleeman noise k^2 |d|, the extra variances var_left, var_right [m^2] of a within-side
+// slip (slip_travel_variance), spread along the arc as the wheel noise is.
+void propagate_arc_slip(Cov3& cov, double sin_theta0, double cos_theta0, double d_left,
+                        double d_right, double b, const ErrorModelParams& k, double var_left,
+                        double var_right) noexcept;
+
+// slip_travel_variance: the extra variance [m^2] of a side's travel on one tick of a slip
+// interval (the wheels of the side disagree, hal/side_wheels.hpp): with S the interval's spread
+// so far [m] (updated here) and `spread` this tick's [m, >= 0], S'^2 - S^2 (derivation in
+// error_model.cpp).
+inline double slip_travel_variance(double& interval_spread, double spread) noexcept {
+  const double before = interval_spread;
+  interval_spread += spread;
+  return spread * (2.0 * before + spread);
+}
+
 // propagate_local: cov <- F cov F^T + R q R^T for any step whose displacement in the frame of
 // its start heading (sin_theta0, cos_theta0) is (lx, ly) [m] and whose input covariance in that
 // frame is q (e.g. a tick whose heading came from a gyro, odometry/gyrodometry.hpp).
@@ -147,9 +164,17 @@ class PoseCovariance {
     propagate_known(sin_theta0, cos_theta0, d_left, d_right, b, phi);
   }
   // step_gyro_sc: a tick whose heading change dtheta [rad] came from the gyro, with heading
-  // variance var_heading [rad^2] (gyrodometry.hpp propagate_gyro_arc; defined there).
+  // variance var_heading [rad^2] (gyrodometry.hpp propagate_gyro_arc; defined there);
+  // extra_var_ds [m^2] adds to the along-track variance (a slip tick's, (var_L + var_R) / 4).
   void step_gyro_sc(double sin_theta0, double cos_theta0, double d_left, double d_right,
-                    double dtheta, double var_heading) noexcept;
+                    double dtheta, double var_heading, double extra_var_ds = 0.0) noexcept;
+  // step_slip_sc: step_sc of a tick whose wheel travels carry the extra variances var_left,
+  // var_right [m^2] of a within-side slip (propagate_arc_slip).
+  void step_slip_sc(double sin_theta0, double cos_theta0, double d_left, double d_right, double b,
+                    double var_left, double var_right) noexcept {
+    flush();
+    propagate_arc_slip(cov_, sin_theta0, cos_theta0, d_left, d_right, b, k_, var_left, var_right);
+  }
   // flush: propagate the ticks merged so far (none: nothing), so that cov() includes them.
   void flush() noexcept;
   // pending_ticks: ticks merged but not yet in cov() (0 with covariance_ticks = 1).

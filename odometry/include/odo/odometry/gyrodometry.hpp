@@ -182,6 +182,7 @@ enum FusionFlag : std::uint32_t {
   kFusionNoBias = 1u << 5,      // no bias estimate yet: odometry only, no detection
   kFusionStill = 1u << 6,       // the encoders say the robot stands still
   kFusionEventStart = 1u << 7,  // a flagged interval started on this tick
+  kFusionWheelSlip = 1u << 8,   // the encoders flag a within-side slip (FusionInput::slip)
 };
 
 // Events since start; they only grow.
@@ -189,6 +190,7 @@ struct FusionCounters {
   std::uint64_t disagreements = 0;    // flagged intervals started by gyro/odometry disagreement
   std::uint64_t speed_events = 0;     // ... by a wheel speed beyond the limit
   std::uint64_t accel_events = 0;     // ... by a wheel acceleration beyond the limit
+  std::uint64_t slip_events = 0;      // ... by a within-side slip of several encoders per side
   std::uint64_t gyro_faults = 0;      // transitions of the gyro into a faulty state (a gyro still
                                       // starting, kGyroStarting, is not faulty)
   std::uint64_t gyro_used_ticks = 0;  // ticks whose heading came from the gyro
@@ -201,6 +203,9 @@ struct FusionInput {
   double d_right = 0.0;    // right wheel travel [m]
   double wheelbase = 0.0;  // b [m]
   GyroSample gyro;         // rate_z: mean rate over the tick [rad/s]
+  // The wheels of a side disagree (hal/side_wheels.hpp, kEncoderSlipLeft/Right): the tick is
+  // flagged like one beyond the kinematic limits, so the heading is the gyro's (both cues).
+  bool slip = false;
 };
 
 // One tick's output.

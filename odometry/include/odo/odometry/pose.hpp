@@ -185,6 +185,13 @@ class Odometry {
   // var_heading [rad^2] instead of the wheels' differential noise (propagate_gyro_arc).
   void advance_fused(double d_l, double d_r, double dt, double dtheta, double ds_correction,
                      bool gyro_heading, double var_heading) noexcept;
+  // advance_slip: advance_fused of a tick inside a within-side slip interval: the wheels' travels
+  // carry the extra variances var_left, var_right [m^2] (slip_travel_variance): added to the
+  // wheels' noise (propagate_arc_slip), or, on a gyro tick, to the along-track variance only
+  // (the heading is the gyro's). Without a gyro: dtheta = (d_r - d_l) / b, ds_correction 0.
+  void advance_slip(double d_l, double d_r, double dt, double dtheta, double ds_correction,
+                    bool gyro_heading, double var_heading, double var_left,
+                    double var_right) noexcept;
   // flush_covariance: propagate the ticks the covariance still has merged
   // (ErrorModelParams::covariance_ticks > 1), so that covariance() is the pose's.
   void flush_covariance() noexcept { cov_.flush(); }
