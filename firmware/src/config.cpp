@@ -248,7 +248,9 @@ void read_can_generic_ids(TableReader& t, CanEncoderSection& s, bool used) {
   }
 }
 
-void read_can_encoder(TableReader t, CanEncoderSection& s) {
+// read_can_encoder: [can_encoder]; `wheels`: encoder.wheels_per_side when the CAN backend is
+// the encoder (its lists must be that long), 0 otherwise.
+void read_can_encoder(TableReader t, CanEncoderSection& s, int wheels) {
   s.bus = t.choice("bus", s.bus);
   s.interface = t.string("interface", s.interface);
   s.protocol = t.choice("protocol", s.protocol);
@@ -271,6 +273,11 @@ void read_can_encoder(TableReader t, CanEncoderSection& s) {
   s.sim_period = t.number("sim_period", s.sim_period, 0.001, 1.0, "s");
   s.sim_stop_left_after = t.number("sim_stop_left_after", s.sim_stop_left_after, -1.0, 1e6, "s");
   s.sim_stop_right_after = t.number("sim_stop_right_after", s.sim_stop_right_after, -1.0, 1e6, "s");
+  if (wheels > 0 && s.wheels_per_side != wheels)
+    t.reject(s.protocol == CanEncoderProtocol::kOdrive ? "node_left" : "left_id",
+             "lists " + std::to_string(s.wheels_per_side) +
+                 " wheel(s) but encoder.wheels_per_side = " + std::to_string(wheels) +
+                 ": give one per wheel of the side");
   if (s.bus == CanEncoderBus::kSim && s.wheels_per_side > 1)
     t.reject("bus",
              "= \"sim\" simulates one ODrive axis per side: " + std::to_string(s.wheels_per_side) +
@@ -526,7 +533,8 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_calibration(root.sub("calibration"), c.calibration);
   read_hctl1100(root.sub("hctl1100"), c.hctl1100);
   read_gpio(root.sub("gpio"), c.gpio);
-  read_can_encoder(root.sub("can_encoder"), c.can_encoder);
+  read_can_encoder(root.sub("can_encoder"), c.can_encoder,
+                   c.encoder.backend == EncoderKind::kCan ? c.encoder.side.wheels_per_side : 0);
   read_serial(root.sub("serial"), c.serial);
   read_error_model(root.sub("error_model"), c.error_model);
   read_can(root.sub("can"), c.can, root.sub("loop"), c.loop.rate_hz);

@@ -300,8 +300,10 @@ Result<std::unique_ptr<EncoderBackend>> make_serial_sim_backend(const Config& cf
   return std::unique_ptr<EncoderBackend>(new SerialSimBackend(cfg, k, robot, epoch, d.str()));
 }
 
-drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const KinematicParams& p) {
+drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const SideWheelsConfig& w,
+                                             const KinematicParams& p) {
   drivers::CanEncoderConfig c;
+  c.wheels = w;  // counter_bits: set by the source from the layouts
   c.wheels.wheels_per_side = s.wheels_per_side;
   for (int k = 0; k < s.wheels_per_side; ++k) {
     const auto m = static_cast<std::size_t>(k > 0 ? k - 1 : 0);
@@ -337,7 +339,7 @@ drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const K
 Result<std::unique_ptr<EncoderBackend>> make_can_socketcan_backend(const Config& cfg,
                                                                    const Kinematics& k) {
   const CanEncoderSection& s = cfg.can_encoder;
-  const drivers::CanEncoderConfig c = can_encoder_config(s, k.params());
+  const drivers::CanEncoderConfig c = can_encoder_config(s, cfg.encoder.side, k.params());
   drivers::SocketCanOptions o;
   o.interface = s.interface;
   for (int i = 0; i < drivers::can_wheel_count(c); ++i) {
@@ -363,7 +365,7 @@ Result<std::unique_ptr<EncoderBackend>> make_can_sim_backend(const Config& cfg, 
                       cfg.source +
                           ": [can_encoder] bus = \"sim\" simulates ODrive controllers: "
                           "set protocol = \"odrive\"");
-  const drivers::CanEncoderConfig c = can_encoder_config(s, k.params());
+  const drivers::CanEncoderConfig c = can_encoder_config(s, cfg.encoder.side, k.params());
   auto b = std::make_unique<CanSimBackend>(s, robot, epoch);
   auto enc = drivers::CanEncoderSource::create(b->port(), c);
   if (!enc) return in_file(cfg, "can_encoder", std::move(enc).error());

@@ -46,8 +46,10 @@ Result<std::unique_ptr<EncoderBackend>> make_hctl_sim_backend(const Config& cfg,
                                                               TimeNs epoch);
 
 // can_encoder_config: the driver configuration of [can_encoder] for this robot (layouts from
-// the protocol, jump limit from max_speed, request period from request_rate).
-drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const KinematicParams& p);
+// the protocol, jump limit from max_speed, request period from request_rate; the wheels per side
+// and their combination from [encoder], `w`).
+drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const SideWheelsConfig& w,
+                                             const KinematicParams& p);
 
 // make_can_socketcan_backend: [can_encoder] with bus = "socketcan": a raw socket on
 // `interface` with kernel filters for the two wheel ids.

@@ -154,7 +154,8 @@ reverse_left = true
 // Several wheels per side (issue 38): a list per side, one node id (or frame id) per wheel.
 TEST(ConfigEncoders, ReadsCanEncoderWheelListsPerSide) {
   auto c = parse_config(
-      "[encoder]\nbackend = \"can\"\n[can_encoder]\nnode_left = [0, 2]\nnode_right = [1, 3]\n",
+      "[encoder]\nbackend = \"can\"\nwheels_per_side = 2\n[can_encoder]\nnode_left = [0, 2]\n"
+      "node_right = [1, 3]\n",
       "c.toml");
   ASSERT_TRUE(c.ok()) << c.error().message;
   const CanEncoderSection& e = c->can_encoder;
@@ -362,6 +363,12 @@ INSTANTIATE_TEST_SUITE_P(
             "right_id = [0x101, 0x103]\n",
             "bad.toml:3: can_encoder.left_id puts two wheels on the same bytes (frame 256, offset "
             "0)"},
+        Bad{"[encoder]\nbackend = \"can\"\nwheels_per_side = 2\n[can_encoder]\nnode_left = 0\n",
+            "bad.toml:5: can_encoder.node_left lists 1 wheel(s) but encoder.wheels_per_side = 2: "
+            "give one per wheel of the side"},
+        Bad{"[encoder]\nbackend = \"can\"\nwheels_per_side = 2\n[can_encoder]\n"
+            "protocol = \"generic\"\nleft_id = [1, 2, 3]\nright_id = [4, 5, 6]\n",
+            "bad.toml:6: can_encoder.left_id lists 3 wheel(s) but encoder.wheels_per_side = 2"},
         Bad{"[can_encoder]\nbus = \"sim\"\nnode_left = [0, 2]\nnode_right = [1, 3]\n",
             "bad.toml:2: can_encoder.bus = \"sim\" simulates one ODrive axis per side: 2 wheels "
             "per side need bus = \"socketcan\""}));
