@@ -285,7 +285,9 @@ void read_can_encoder(TableReader t, CanEncoderSection& s, int wheels) {
   t.finish();
 }
 
-void read_serial(TableReader t, SerialSection& s) {
+// read_serial: [serial]; `wheels`: encoder.wheels_per_side when the serial backend is the
+// encoder, 0 otherwise.
+void read_serial(TableReader t, SerialSection& s, int wheels) {
   s.link = t.choice("link", s.link);
   s.device = t.string("device", s.device);
   s.device_where = t.location("device");
@@ -299,6 +301,10 @@ void read_serial(TableReader t, SerialSection& s) {
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
   s.reverse_right = t.boolean("reverse_right", s.reverse_right);
   for (const auto& n : kSerialNumbers) s.*n.member = t.number(s.*n.member, n.row);
+  if (wheels > 1 && s.protocol == SerialProtocol::kArduinoBridge)
+    t.reject("protocol",
+             "= \"arduino-bridge\" carries one count per side: encoder.wheels_per_side = " +
+                 std::to_string(wheels) + " needs protocol = \"diffodom\" (version 2 records)");
   t.finish();
 }
 
@@ -535,7 +541,8 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_gpio(root.sub("gpio"), c.gpio);
   read_can_encoder(root.sub("can_encoder"), c.can_encoder,
                    c.encoder.backend == EncoderKind::kCan ? c.encoder.side.wheels_per_side : 0);
-  read_serial(root.sub("serial"), c.serial);
+  read_serial(root.sub("serial"), c.serial,
+              c.encoder.backend == EncoderKind::kSerial ? c.encoder.side.wheels_per_side : 0);
   read_error_model(root.sub("error_model"), c.error_model);
   read_can(root.sub("can"), c.can, root.sub("loop"), c.loop.rate_hz);
   ros2::Config ros2_cfg;

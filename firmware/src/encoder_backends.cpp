@@ -190,12 +190,12 @@ class SerialSimBackend final : public EncoderBackend, public EncoderSource, publ
  public:
   SerialSimBackend(const Config& cfg, const Kinematics& k, sim::SimRobot& robot, TimeNs epoch,
                    std::string d)
-      : model_(cfg.serial.protocol),
+      : model_(cfg.serial.protocol, cfg.encoder.side.wheels_per_side),
         protocol_(cfg.serial.protocol),
         robot_(robot),
         epoch_(epoch),
         period_(from_seconds(cfg.serial.sim_period)),
-        source_(*this, serial_source_config(cfg.serial, k.params())),
+        source_(*this, serial_source_config(cfg.serial, cfg.encoder.side, k.params())),
         desc_(std::move(d)) {}
   EncoderSample read(TimeNs now) noexcept override {
     now_ = now;
@@ -256,9 +256,10 @@ std::string serial_text(const SerialSection& s) {
 
 }  // namespace
 
-protocol::SerialSourceConfig serial_source_config(const SerialSection& s,
+protocol::SerialSourceConfig serial_source_config(const SerialSection& s, const SideWheelsConfig& w,
                                                   const KinematicParams& p) {
   protocol::SerialSourceConfig c;
+  c.wheels = w;
   c.protocol = s.protocol == SerialProtocol::kDiffodom ? protocol::SerialProtocol::kDiffodom
                                                        : protocol::SerialProtocol::kArduinoBridge;
   c.bits_left = s.bits_left;
@@ -284,8 +285,8 @@ Result<std::unique_ptr<EncoderBackend>> make_serial_tty_backend(const Config& cf
   }
   std::ostringstream d;
   d << serial_text(s) << " on " << s.device << " at " << s.baud << " baud";
-  return std::unique_ptr<EncoderBackend>(
-      new SerialTtyBackend(std::move(port).value(), serial_source_config(s, k.params()), d.str()));
+  return std::unique_ptr<EncoderBackend>(new SerialTtyBackend(
+      std::move(port).value(), serial_source_config(s, cfg.encoder.side, k.params()), d.str()));
 }
 
 Result<std::unique_ptr<EncoderBackend>> make_serial_sim_backend(const Config& cfg,

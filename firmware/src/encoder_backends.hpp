@@ -62,9 +62,11 @@ Result<std::unique_ptr<EncoderBackend>> make_can_socketcan_backend(const Config&
 Result<std::unique_ptr<EncoderBackend>> make_can_sim_backend(const Config& cfg, const Kinematics& k,
                                                              sim::SimRobot& robot, TimeNs epoch);
 
-// serial_source_config: the source configuration of [serial] for this robot (jump limit from
+// serial_source_config: the source configuration of [serial] for this robot (wheels per side
+// from [encoder], `w`) (jump limit from
 // max_speed, poll period from poll_rate).
-protocol::SerialSourceConfig serial_source_config(const SerialSection& s, const KinematicParams& p);
+protocol::SerialSourceConfig serial_source_config(const SerialSection& s, const SideWheelsConfig& w,
+                                                  const KinematicParams& p);
 
 // make_serial_tty_backend: [serial] with link = "tty": the device in raw mode; a missing device,
 // one that is not a tty, an unsupported baud rate: an error naming file, line and key.

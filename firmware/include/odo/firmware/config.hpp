@@ -288,7 +288,7 @@ struct EncoderSection {
 // backend_carries_side_wheels: whether encoder backend `be` reads several counters per side
 // (encoder.wheels_per_side > 1 is refused for the others).
 constexpr bool backend_carries_side_wheels(EncoderKind be) {
-  return be == EncoderKind::kSim || be == EncoderKind::kCan;
+  return be == EncoderKind::kSim || be == EncoderKind::kCan || be == EncoderKind::kSerial;
 }
 
 // [realtime]: how the loop thread is made real-time at start (each part reported at start).
