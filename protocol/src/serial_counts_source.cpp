@@ -179,6 +179,11 @@ void SerialCountsSource::accept_wheels(const SerialCounts& c, TimeNs stamp,
     // the combiner re-references the wheel when it is clean again. A flagged wheel's count is
     // not judged (garbage is what a fault looks like).
     const bool board_fault = (c.wheel_faults & bit) != 0;
+    // The first clean record after a flagged one is the wheel's new start, not a step from the
+    // garbage it reported.
+    const bool restart = w.faulted && !board_fault;
+    w.faulted = board_fault;
+    if (restart) continue;
     const bool jump = !board_fault && std::llabs(step) > limit;
     if (jump) ++counters_.implausible_jumps;
     if (jump) flags |= kEncoderImplausibleJump;

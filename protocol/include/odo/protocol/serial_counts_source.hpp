@@ -109,6 +109,7 @@ class SerialCountsSource final : public EncoderSource {
     std::int64_t count = 0;     // unwrapped, reported
     std::int64_t last_raw = 0;  // last reading (after reverse), `bits` wide
     int bits = 32;
+    bool faulted = false;  // several wheels: the board flagged it in the last record
   };
 
   ByteLink* link_;
