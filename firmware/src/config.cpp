@@ -129,23 +129,6 @@ void read_hctl1100(TableReader t, Hctl1100Section& s) {
   t.finish();
 }
 
-void read_gpio(TableReader t, GpioSection& s) {
-  s.chip = t.string("chip", s.chip);
-  s.left_a = static_cast<int>(t.integer("left_a", s.left_a, 0, 1023));
-  s.left_b = static_cast<int>(t.integer("left_b", s.left_b, 0, 1023));
-  s.left_index = static_cast<int>(t.integer("left_index", s.left_index, -1, 1023));
-  s.right_a = static_cast<int>(t.integer("right_a", s.right_a, 0, 1023));
-  s.right_b = static_cast<int>(t.integer("right_b", s.right_b, 0, 1023));
-  s.right_index = static_cast<int>(t.integer("right_index", s.right_index, -1, 1023));
-  s.active_low = t.boolean("active_low", s.active_low);
-  s.reverse_left = t.boolean("reverse_left", s.reverse_left);
-  s.reverse_right = t.boolean("reverse_right", s.reverse_right);
-  s.batch = static_cast<int>(t.integer(s.batch, drivers::kGpioBatch));
-  s.reorder_window = t.number("reorder_window", s.reorder_window, 0.0, 0.1, "s");
-  s.idle_check = t.number("idle_check", s.idle_check, 0.01, 10.0, "s");
-  t.finish();
-}
-
 // read_side_list: the side's key `key`, an integer (one wheel) or a list of 1..kMaxWheelsPerSide
 // in [lo, hi]; wheel 1 into `first`, wheels 2.. into `more`; returns the number of wheels.
 template <class T, class U>
@@ -246,6 +229,34 @@ void read_can_generic_ids(TableReader& t, CanEncoderSection& s, bool used) {
       return;
     }
   }
+}
+
+// read_gpio: [gpio]; `wheels`: encoder.wheels_per_side when GPIO is the encoder, 0 otherwise.
+void read_gpio(TableReader t, GpioSection& s, int wheels) {
+  s.chip = t.string("chip", s.chip);
+  const std::array<int, 4> n{read_side_list(t, "left_a", s.left_a, s.more_left_a, 0, 1023),
+                             read_side_list(t, "left_b", s.left_b, s.more_left_b, 0, 1023),
+                             read_side_list(t, "right_a", s.right_a, s.more_right_a, 0, 1023),
+                             read_side_list(t, "right_b", s.right_b, s.more_right_b, 0, 1023)};
+  constexpr std::array<const char*, 4> kKeys{"left_a", "left_b", "right_a", "right_b"};
+  s.wheels_per_side = n[0];
+  for (std::size_t i = 1; i < n.size(); ++i)
+    same_count(t, kKeys[0], n[0], kKeys[i], n[i], "one A/B pair per wheel, both sides alike");
+  if (wheels > 0 && n[0] != wheels)
+    t.reject("left_a", "lists " + std::to_string(n[0]) +
+                           " wheel(s) but encoder.wheels_per_side = " + std::to_string(wheels) +
+                           ": give one line per wheel of the side");
+  s.left_index = static_cast<int>(t.integer("left_index", s.left_index, -1, 1023));
+  s.right_a = static_cast<int>(t.integer("right_a", s.right_a, 0, 1023));
+  s.right_b = static_cast<int>(t.integer("right_b", s.right_b, 0, 1023));
+  s.right_index = static_cast<int>(t.integer("right_index", s.right_index, -1, 1023));
+  s.active_low = t.boolean("active_low", s.active_low);
+  s.reverse_left = t.boolean("reverse_left", s.reverse_left);
+  s.reverse_right = t.boolean("reverse_right", s.reverse_right);
+  s.batch = static_cast<int>(t.integer(s.batch, drivers::kGpioBatch));
+  s.reorder_window = t.number("reorder_window", s.reorder_window, 0.0, 0.1, "s");
+  s.idle_check = t.number("idle_check", s.idle_check, 0.01, 10.0, "s");
+  t.finish();
 }
 
 // read_can_encoder: [can_encoder]; `wheels`: encoder.wheels_per_side when the CAN backend is
@@ -538,7 +549,8 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_realtime(root.sub("realtime"), c.realtime);
   read_calibration(root.sub("calibration"), c.calibration);
   read_hctl1100(root.sub("hctl1100"), c.hctl1100);
-  read_gpio(root.sub("gpio"), c.gpio);
+  read_gpio(root.sub("gpio"), c.gpio,
+            c.encoder.backend == EncoderKind::kGpio ? c.encoder.side.wheels_per_side : 0);
   read_can_encoder(root.sub("can_encoder"), c.can_encoder,
                    c.encoder.backend == EncoderKind::kCan ? c.encoder.side.wheels_per_side : 0);
   read_serial(root.sub("serial"), c.serial,

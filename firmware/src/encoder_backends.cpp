@@ -389,6 +389,14 @@ Result<std::unique_ptr<EncoderBackend>> make_gpio_backend(const Config& cfg) {
             s.reverse_left};
   c.right = {static_cast<unsigned>(s.right_a), static_cast<unsigned>(s.right_b), s.right_index,
              s.reverse_right};
+  c.wheels = cfg.encoder.side;
+  c.wheels.wheels_per_side = s.wheels_per_side;
+  for (std::size_t k = 0; k + 1 < static_cast<std::size_t>(s.wheels_per_side); ++k) {
+    c.more_left[k] = {static_cast<unsigned>(s.more_left_a[k]),
+                      static_cast<unsigned>(s.more_left_b[k]), -1, s.reverse_left};
+    c.more_right[k] = {static_cast<unsigned>(s.more_right_a[k]),
+                       static_cast<unsigned>(s.more_right_b[k]), -1, s.reverse_right};
+  }
   c.active_low = s.active_low;
   c.batch = s.batch;
   c.reorder_window = from_seconds(s.reorder_window);

@@ -193,6 +193,13 @@ struct GpioSection {
   int batch = 64;                // events per read, 1..1024
   double reorder_window = 0.02;  // [s] 0..0.1
   double idle_check = 0.05;      // [s] 0.01..10
+  // Several wheels per side (issue 38): left_a = [17, 5] etc. give one A/B pair per wheel; the
+  // fields above are wheel 1 of each side (the index lines too), more_*[k - 2] wheel k.
+  int wheels_per_side = 1;  // the lists' length
+  std::array<int, kMaxWheelsPerSide - 1> more_left_a{};
+  std::array<int, kMaxWheelsPerSide - 1> more_left_b{};
+  std::array<int, kMaxWheelsPerSide - 1> more_right_a{};
+  std::array<int, kMaxWheelsPerSide - 1> more_right_b{};
 };
 
 // [can_encoder]: wheel encoder counts that motor controllers publish on CAN. bus = "socketcan":
@@ -288,7 +295,8 @@ struct EncoderSection {
 // backend_carries_side_wheels: whether encoder backend `be` reads several counters per side
 // (encoder.wheels_per_side > 1 is refused for the others).
 constexpr bool backend_carries_side_wheels(EncoderKind be) {
-  return be == EncoderKind::kSim || be == EncoderKind::kCan || be == EncoderKind::kSerial;
+  return be == EncoderKind::kSim || be == EncoderKind::kCan || be == EncoderKind::kSerial ||
+         be == EncoderKind::kGpio;
 }
 
 // [realtime]: how the loop thread is made real-time at start (each part reported at start).
