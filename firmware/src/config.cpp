@@ -247,8 +247,6 @@ void read_gpio(TableReader t, GpioSection& s, int wheels) {
                            " wheel(s) but encoder.wheels_per_side = " + std::to_string(wheels) +
                            ": give one line per wheel of the side");
   s.left_index = static_cast<int>(t.integer("left_index", s.left_index, -1, 1023));
-  s.right_a = static_cast<int>(t.integer("right_a", s.right_a, 0, 1023));
-  s.right_b = static_cast<int>(t.integer("right_b", s.right_b, 0, 1023));
   s.right_index = static_cast<int>(t.integer("right_index", s.right_index, -1, 1023));
   s.active_low = t.boolean("active_low", s.active_low);
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);

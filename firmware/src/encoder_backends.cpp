@@ -405,7 +405,11 @@ Result<std::unique_ptr<EncoderBackend>> make_gpio_backend(const Config& cfg) {
   if (!enc) return in_file(cfg, "gpio", std::move(enc).error());
   std::ostringstream d;
   d << "GPIO quadrature on " << s.chip << " (left A/B " << s.left_a << "/" << s.left_b
-    << ", right A/B " << s.right_a << "/" << s.right_b << "), libgpiod both-edge events, 4x";
+    << ", right A/B " << s.right_a << "/" << s.right_b;
+  for (std::size_t k = 0; k + 1 < static_cast<std::size_t>(s.wheels_per_side); ++k)
+    d << "; wheel " << k + 2 << ": left A/B " << s.more_left_a[k] << "/" << s.more_left_b[k]
+      << ", right A/B " << s.more_right_a[k] << "/" << s.more_right_b[k];
+  d << "), libgpiod both-edge events, 4x";
   return std::unique_ptr<EncoderBackend>(new GpioBackend(std::move(enc).value(), d.str()));
 }
 

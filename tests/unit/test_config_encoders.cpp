@@ -190,6 +190,28 @@ right_offset = [0, 4, 0]
   EXPECT_EQ(c->can_encoder.node_left, 4);
 }
 
+TEST(ConfigEncoders, ReadsGpioLinePairsPerWheel) {
+  auto c = parse_config(R"(
+[encoder]
+backend = "gpio"
+wheels_per_side = 2
+[gpio]
+left_a = [17, 5]
+left_b = [18, 6]
+right_a = [22, 12]
+right_b = [23, 13]
+)",
+                        "c.toml");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  const GpioSection& g = c->gpio;
+  EXPECT_EQ(g.wheels_per_side, 2);
+  EXPECT_EQ(g.left_a, 17);
+  EXPECT_EQ(g.more_left_a[0], 5);
+  EXPECT_EQ(g.more_left_b[0], 6);
+  EXPECT_EQ(g.right_b, 23);
+  EXPECT_EQ(g.more_right_b[0], 13);
+}
+
 TEST(ConfigEncoders, CanGyroDefaults) {
   auto c = parse_config("[gyro]\nbackend = \"can\"\n", "g.toml");
   ASSERT_TRUE(c.ok()) << c.error().message;
@@ -369,6 +391,13 @@ INSTANTIATE_TEST_SUITE_P(
         Bad{"[encoder]\nbackend = \"can\"\nwheels_per_side = 2\n[can_encoder]\n"
             "protocol = \"generic\"\nleft_id = [1, 2, 3]\nright_id = [4, 5, 6]\n",
             "bad.toml:6: can_encoder.left_id lists 3 wheel(s) but encoder.wheels_per_side = 2"},
+        Bad{"[gpio]\nleft_a = [17, 5]\nleft_b = 18\n",
+            "bad.toml:3: gpio.left_b lists 1 wheel(s) but left_a lists 2: one A/B pair per "
+            "wheel, both sides alike"},
+        Bad{"[encoder]\nbackend = \"gpio\"\nwheels_per_side = 2\n[gpio]\nleft_a = 17\n",
+            "bad.toml:5: gpio.left_a lists 1 wheel(s) but encoder.wheels_per_side = 2"},
+        Bad{"[gpio]\nright_b = [3, 1024]\n",
+            "bad.toml:2: gpio.right_b[1] = 1024 is outside the allowed range [0, 1023]"},
         Bad{"[can_encoder]\nbus = \"sim\"\nnode_left = [0, 2]\nnode_right = [1, 3]\n",
             "bad.toml:2: can_encoder.bus = \"sim\" simulates one ODrive axis per side: 2 wheels "
             "per side need bus = \"socketcan\""}));
