@@ -302,8 +302,14 @@ TimeNs CanEncoderSource::sample_time(TimeNs now, std::uint32_t& flags) noexcept 
 }
 
 void CanEncoderSource::combine(TimeNs t, EncoderSample& s) noexcept {
-  std::array<SideReadings, 2> side{};
   const int n = can_wheel_count(cfg_);
+  s.counters = counters_;
+  // Before the first frame of any wheel the sides are 0 and stale (sample_time), and no wheel
+  // has dropped out of anything (the start-up state is not an event, as with one wheel).
+  bool any = false;
+  for (int i = 0; i < n; ++i) any = any || wheel_[static_cast<std::size_t>(i)].primed;
+  if (!any) return;
+  std::array<SideReadings, 2> side{};
   for (int i = 0; i < n; ++i) {
     const Wheel& w = wheel_[static_cast<std::size_t>(i)];
     SideReadings& r = side[static_cast<std::size_t>(i % 2)];
@@ -318,7 +324,6 @@ void CanEncoderSource::combine(TimeNs t, EncoderSample& s) noexcept {
   s.flags |= step.flags;
   s.spread_left = step.spread_left;
   s.spread_right = step.spread_right;
-  s.counters = counters_;
   s.counters.stale_events += combiner_->counters().stale_events;
   s.counters.slip_events = combiner_->counters().slip_events;
   s.counters.wheel_drops = combiner_->counters().wheel_drops;

@@ -523,13 +523,18 @@ struct CanEncoderTwoPerSide : CanEncoder {
 TEST_F(CanEncoderTwoPerSide, SidesAreTheMeanOfTheirWheelsEachWrappingOnItsOwn) {
   CanEncoderSource enc = make();
   EXPECT_EQ(enc.counter_bits(), 64);  // the combined counts never wrap
+  // Before any frame: both sides stale at 0, and no wheel counted as dropped.
+  EncoderSample s = enc.read(1 * kMs);
+  EXPECT_EQ(s.flags, kEncoderStaleLeft | kEncoderStaleRight);
+  EXPECT_EQ(s.left, 0);
+  EXPECT_EQ(s.counters.wheel_drops, 0u);
   // First frames: every wheel takes its reference, the sides start at 0. Left wheel 2 sits 47
   // counts below the int32 maximum 2147483647.
   port.inject(odrive(0, 1000, 5 * kMs));
   port.inject(odrive(2, 2147483600, 5 * kMs));
   port.inject(odrive(1, 50, 5 * kMs));
   port.inject(odrive(3, 70, 5 * kMs));
-  EncoderSample s = enc.read(6 * kMs);
+  s = enc.read(6 * kMs);
   EXPECT_EQ(s.flags, 0u);
   EXPECT_EQ(s.left, 0);
   EXPECT_EQ(s.right, 0);
