@@ -7,6 +7,7 @@
 
 #include "odo/drivers/count_plausibility.hpp"
 #include "odo/hal/bytes.hpp"
+#include "odo/hal/side_sample.hpp"
 
 namespace odo::drivers {
 namespace {
@@ -78,11 +79,7 @@ int can_wheel_count(const CanEncoderConfig& cfg) noexcept {
 }
 
 const CanCountLayout& can_wheel_layout(const CanEncoderConfig& cfg, int i) noexcept {
-  const bool left = i % 2 == 0;
-  const int k = i / 2;
-  if (k <= 0) return left ? cfg.left : cfg.right;
-  const auto more = static_cast<std::size_t>(k - 1);
-  return left ? cfg.more_left[more] : cfg.more_right[more];
+  return wheel_of_side(i, cfg.left, cfg.right, cfg.more_left, cfg.more_right);
 }
 
 namespace {
@@ -318,15 +315,7 @@ void CanEncoderSource::combine(TimeNs t, EncoderSample& s) noexcept {
     // A stale or lagging wheel's count is not this instant's: dropped from the mean.
     if (w.stale || w.lagging) r.faulted = static_cast<std::uint8_t>(r.faulted | (1u << k));
   }
-  const SideStep step = combiner_->step(side[0], side[1]);
-  s.left = step.left;
-  s.right = step.right;
-  s.flags |= step.flags;
-  s.spread_left = step.spread_left;
-  s.spread_right = step.spread_right;
-  s.counters.stale_events += combiner_->counters().stale_events;
-  s.counters.slip_events = combiner_->counters().slip_events;
-  s.counters.wheel_drops = combiner_->counters().wheel_drops;
+  apply_side_step(combiner_->step(side[0], side[1]), combiner_->counters(), s);
 }
 
 EncoderSample CanEncoderSource::read(TimeNs now) noexcept {

@@ -14,6 +14,7 @@
 #include "gpiod_util.hpp"
 #include "odo/drivers/monotonic_clock.hpp"
 #include "odo/drivers/quad_tracker.hpp"
+#include "odo/hal/side_sample.hpp"
 
 namespace odo::drivers {
 namespace {
@@ -54,11 +55,7 @@ int gpio_wheel_count(const GpioQuadratureConfig& cfg) noexcept {
 }  // namespace
 
 const GpioWheelLines& gpio_wheel_lines(const GpioQuadratureConfig& cfg, int i) noexcept {
-  const bool left = i % 2 == 0;
-  const int k = i / 2;
-  if (k <= 0) return left ? cfg.left : cfg.right;
-  const auto more = static_cast<std::size_t>(k - 1);
-  return left ? cfg.more_left[more] : cfg.more_right[more];
+  return wheel_of_side(i, cfg.left, cfg.right, cfg.more_left, cfg.more_right);
 }
 
 struct GpioQuadratureEncoder::Impl {
@@ -389,15 +386,7 @@ void GpioQuadratureEncoder::combine(bool failed, EncoderSample& s) noexcept {
       r.faulted = static_cast<std::uint8_t>(r.faulted | (1u << k));
     wheel_invalid_[static_cast<std::size_t>(w)] = inv;
   }
-  const SideStep step = combiner_->step(side[0], side[1]);
-  s.left = step.left;
-  s.right = step.right;
-  s.flags |= step.flags;
-  s.spread_left = step.spread_left;
-  s.spread_right = step.spread_right;
-  s.counters.slip_events = combiner_->counters().slip_events;
-  s.counters.wheel_drops = combiner_->counters().wheel_drops;
-  s.counters.stale_events = combiner_->counters().stale_events;
+  apply_side_step(combiner_->step(side[0], side[1]), combiner_->counters(), s);
 }
 
 GpioWheelStats GpioQuadratureEncoder::wheel(int i) const noexcept {

@@ -10,6 +10,7 @@
 #include "odo/drivers/hctl1100_encoder.hpp"
 #include "odo/drivers/serial_port.hpp"
 #include "odo/firmware/toml_reader.hpp"
+#include "odo/hal/side_sample.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
 #include "odo/odometry/gyrodometry.hpp"
@@ -152,16 +153,6 @@ int same_count(TableReader& t, std::string_view ref_key, int ref, std::string_vi
 }
 constexpr std::string_view kBothSides = "both sides need the same number of wheels";
 
-// wheel_of: wheel k (0-based) of side `right` of a [can_encoder] list field.
-template <class T>
-T wheel_of(const T& first_left, const T& first_right,
-           const std::array<T, kMaxWheelsPerSide - 1>& more_left,
-           const std::array<T, kMaxWheelsPerSide - 1>& more_right, bool right, int k) {
-  if (k == 0) return right ? first_right : first_left;
-  return right ? more_right[static_cast<std::size_t>(k - 1)]
-               : more_left[static_cast<std::size_t>(k - 1)];
-}
-
 // read_can_odrive_nodes: node_left / node_right, one node id per wheel, all different.
 void read_can_odrive_nodes(TableReader& t, CanEncoderSection& s, bool used) {
   const int nl = read_side_list(t, "node_left", s.node_left, s.more_node_left, 0, 63);
@@ -174,11 +165,9 @@ void read_can_odrive_nodes(TableReader& t, CanEncoderSection& s, bool used) {
     return;
   }
   for (int i = 1; i < 2 * s.wheels_per_side; ++i) {
-    const int id =
-        wheel_of(s.node_left, s.node_right, s.more_node_left, s.more_node_right, i % 2 == 1, i / 2);
+    const int id = wheel_of_side(i, s.node_left, s.node_right, s.more_node_left, s.more_node_right);
     for (int j = 0; j < i; ++j) {
-      if (wheel_of(s.node_left, s.node_right, s.more_node_left, s.more_node_right, j % 2 == 1,
-                   j / 2) == id) {
+      if (wheel_of_side(j, s.node_left, s.node_right, s.more_node_left, s.more_node_right) == id) {
         t.reject(i % 2 == 1 ? "node_right" : "node_left",
                  "gives node id " + std::to_string(id) +
                      " to two wheels (each wheel needs its own axis)");
@@ -211,9 +200,8 @@ void read_can_generic_ids(TableReader& t, CanEncoderSection& s, bool used) {
     const bool right = i % 2 == 1;
     const auto at = [&](int w) {
       return std::pair{
-          wheel_of(s.left_id, s.right_id, s.more_left_id, s.more_right_id, w % 2 == 1, w / 2),
-          wheel_of(s.left_offset, s.right_offset, s.more_left_offset, s.more_right_offset,
-                   w % 2 == 1, w / 2)};
+          wheel_of_side(w, s.left_id, s.right_id, s.more_left_id, s.more_right_id),
+          wheel_of_side(w, s.left_offset, s.right_offset, s.more_left_offset, s.more_right_offset)};
     };
     for (int j = 0; j < i; ++j) {
       if (at(i) != at(j)) continue;

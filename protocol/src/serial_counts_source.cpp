@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 
+#include "odo/hal/side_sample.hpp"
 #include "odo/odometry/count_delta.hpp"
 
 namespace odo::protocol {
@@ -332,15 +333,7 @@ void SerialCountsSource::combine(EncoderSample& s) noexcept {
       r.faulted = static_cast<std::uint8_t>(r.faulted | (1u << k));
   }
   read_faults_ = 0;
-  const SideStep step = combiner_->step(side[0], side[1]);
-  s.left = step.left;
-  s.right = step.right;
-  s.flags |= step.flags;
-  s.spread_left = step.spread_left;
-  s.spread_right = step.spread_right;
-  s.counters.slip_events = combiner_->counters().slip_events;
-  s.counters.wheel_drops = combiner_->counters().wheel_drops;
-  s.counters.stale_events += combiner_->counters().stale_events;
+  apply_side_step(combiner_->step(side[0], side[1]), combiner_->counters(), s);
 }
 
 }  // namespace odo::protocol
