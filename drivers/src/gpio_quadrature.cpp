@@ -117,6 +117,9 @@ struct GpioQuadratureEncoder::Impl {
   void process(std::size_t n) noexcept;
   void idle_check() noexcept;
   void run() noexcept;
+  // add_lines: every wheel's A, B and index line (cfg) into `bulk` with its role; errors name
+  // the line and its role.
+  Status add_lines();
 };
 
 void GpioQuadratureEncoder::Impl::process(std::size_t n) noexcept {
@@ -282,6 +285,40 @@ GpioQuadratureEncoder::~GpioQuadratureEncoder() {
   if (impl_->thread.joinable()) impl_->thread.join();
 }
 
+Status GpioQuadratureEncoder::Impl::add_lines() {
+  struct Want {
+    int offset;
+    LineRole role;
+    std::string name;
+  };
+  n_wheels = gpio_wheel_count(cfg);
+  std::vector<Want> wants;
+  for (int i = 0; i < n_wheels; ++i) {
+    const GpioWheelLines& l = gpio_wheel_lines(cfg, i);
+    std::string side = i % 2 == 0 ? "left" : "right";
+    if (n_wheels > 2) side += " " + std::to_string(i / 2 + 1);
+    wants.push_back({static_cast<int>(l.a), {i, Role::kA}, side + " a"});
+    wants.push_back({static_cast<int>(l.b), {i, Role::kB}, side + " b"});
+    wants.push_back({l.index, {i, Role::kIndex}, side + " index"});
+  }
+  std::vector<int> used;
+  for (const Want& w : wants) {
+    if (w.offset < 0) continue;
+    if (std::find(used.begin(), used.end(), w.offset) != used.end())
+      return make_error(Errc::kInvalidArgument, "gpio: line " + std::to_string(w.offset) + " (" +
+                                                    w.name + ") is used twice");
+    used.push_back(w.offset);
+    gpiod_line* l = get_line(chip.get(), static_cast<unsigned>(w.offset));
+    if (l == nullptr) {
+      errno = 0;
+      return line_error(cfg.chip, static_cast<unsigned>(w.offset), w.name.c_str());
+    }
+    gpiod_line_bulk_add(&bulk, l);
+    roles[n_lines++] = w.role;
+  }
+  return Ok{};
+}
+
 Result<std::unique_ptr<GpioQuadratureEncoder>> GpioQuadratureEncoder::open(
     const GpioQuadratureConfig& cfg) {
   if (auto s = check_row(kGpioBatch, "gpio: ", cfg.batch); !s) return std::move(s).error();
@@ -306,36 +343,7 @@ Result<std::unique_ptr<GpioQuadratureEncoder>> GpioQuadratureEncoder::open(
   if (!chip) return std::move(chip).error();
   impl->chip = std::move(chip).value();
   gpiod_line_bulk_init(&impl->bulk);
-  struct Want {
-    int offset;
-    LineRole role;
-    std::string name;
-  };
-  impl->n_wheels = gpio_wheel_count(cfg);
-  std::vector<Want> wants;
-  for (int i = 0; i < impl->n_wheels; ++i) {
-    const GpioWheelLines& l = gpio_wheel_lines(cfg, i);
-    std::string side = i % 2 == 0 ? "left" : "right";
-    if (impl->n_wheels > 2) side += " " + std::to_string(i / 2 + 1);
-    wants.push_back({static_cast<int>(l.a), {i, Role::kA}, side + " a"});
-    wants.push_back({static_cast<int>(l.b), {i, Role::kB}, side + " b"});
-    wants.push_back({l.index, {i, Role::kIndex}, side + " index"});
-  }
-  std::vector<int> used;
-  for (const Want& w : wants) {
-    if (w.offset < 0) continue;
-    if (std::find(used.begin(), used.end(), w.offset) != used.end())
-      return make_error(Errc::kInvalidArgument, "gpio: line " + std::to_string(w.offset) + " (" +
-                                                    w.name + ") is used twice");
-    used.push_back(w.offset);
-    gpiod_line* l = get_line(impl->chip.get(), static_cast<unsigned>(w.offset));
-    if (l == nullptr) {
-      errno = 0;
-      return line_error(cfg.chip, static_cast<unsigned>(w.offset), w.name.c_str());
-    }
-    gpiod_line_bulk_add(&impl->bulk, l);
-    impl->roles[impl->n_lines++] = w.role;
-  }
+  if (Status st = impl->add_lines(); !st) return std::move(st).error();
   const int flags = cfg.active_low ? GPIOD_LINE_REQUEST_FLAG_ACTIVE_LOW : 0;
   if (gpiod_line_request_bulk_both_edges_events_flags(&impl->bulk, cfg.consumer.c_str(), flags) !=
       0)
