@@ -170,7 +170,7 @@ void Daemon::report() {
   if (!o_.json) return;
   nlohmann::json j = report_json(s, st, truth, can_.get());
   if (cfg_->encoder.side.wheels_per_side > 1)
-    j["wheels"] = side_wheels_json(s.encoder_counters, cfg_->encoder.side.wheels_per_side);
+    j["wheels"] = side_wheels_json(s, cfg_->encoder.side.wheels_per_side);
   if (ros2_) j["ros2"] = ros2_->json();
   if (resume_) j["resume"] = resume_json(*resume_, *loop_);
   if (selfcal_) j["selfcal"] = selfcal_json(selfcal_->estimator().counters());

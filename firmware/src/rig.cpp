@@ -16,8 +16,9 @@ namespace odo::fw {
 namespace {
 
 // make_scenario: the [sim] section's squares (sim_hal composes them: the microcontroller
-// firmware's simulated run drives the same path).
-sim::Scenario make_scenario(const SimSection& s, const Kinematics& k) {
+// firmware's simulated run drives the same path), after the simulated gyro's standstill.
+sim::Scenario make_scenario(const Config& cfg, const Kinematics& k) {
+  const SimSection& s = cfg.sim;
   sim::SquareOptions o;
   o.side = s.side;
   o.speed = s.speed;
@@ -29,6 +30,11 @@ sim::Scenario make_scenario(const SimSection& s, const Kinematics& k) {
                                                                      : sim::SquareSet::kNone;
   sim::Scenario sc = sim::squares_scenario(k, o, set);
   if (s.start_delay > 0.0) sc.insert(sc.begin(), {s.start_delay, 0.0, 0.0});
+  // With a gyro the robot first stands still, as a real one does after power-up, so that the
+  // fusion learns the gyro's bias before the first move (detection is off until then): still_time
+  // to confirm the standstill, still_time of averaging, and 0.25 s for real-time ticks (with
+  // exactly 2 still_time the averaging ended within a tick of still_time, valid or not by chance).
+  if (simulated_gyro(cfg)) sc.insert(sc.begin(), {2.0 * cfg.gyro.still_time + 0.25, 0.0, 0.0});
   return sc;
 }
 
@@ -169,13 +175,7 @@ Result<Rig> Rig::create(const Config& cfg, const Kinematics& k, bool virtual_tim
   const bool modelled = cfg.encoder.backend != EncoderKind::kSim;
   const sim::RobotGeometry g =
       sim::simulated_geometry(cfg.sim.robot == SimRobotKind::kLabmate, k.params());
-  sim::Scenario scenario = make_scenario(cfg.sim, k);
-  // With a gyro the robot first stands still, as a real one does after power-up, so that the
-  // fusion learns the gyro's bias before the first move (detection is off until then): still_time
-  // to confirm the standstill, still_time of averaging, and 0.25 s for real-time ticks (with
-  // exactly 2 still_time the averaging ended within a tick of still_time, valid or not by chance).
-  if (simulated_gyro(cfg))
-    scenario.insert(scenario.begin(), {2.0 * cfg.gyro.still_time + 0.25, 0.0, 0.0});
+  sim::Scenario scenario = make_scenario(cfg, k);
   impl->scenario_duration = sim::scenario_duration(scenario);
   auto robot = sim::SimRobot::create(g, std::move(scenario));
   if (!robot) return std::move(robot).error();

@@ -44,7 +44,6 @@ nlohmann::json gyro_json(const loop::LoopGyroStatus& g) {
   j["disagreements"] = g.fusion.disagreements;
   j["speed_events"] = g.fusion.speed_events;
   j["accel_events"] = g.fusion.accel_events;
-  j["slip_events"] = g.fusion.slip_events;
   j["gyro_used_ticks"] = g.fusion.gyro_used_ticks;
   j["faults"] = g.fusion.gyro_faults;
   j["bias"] = g.bias;
@@ -95,10 +94,13 @@ nlohmann::json report_json(const loop::LoopSnapshot& s, const loop::LoopStats& s
   return j;
 }
 
-nlohmann::json side_wheels_json(const EncoderCounters& c, int wheels_per_side) {
+nlohmann::json side_wheels_json(const loop::LoopSnapshot& s, int wheels_per_side) {
+  // The gyro's intervals opened by a slip are here, not in "gyro": with one encoder per side
+  // the --json object stays as it was.
   return {{"wheels_per_side", wheels_per_side},
-          {"slip_events", c.slip_events},
-          {"wheel_drops", c.wheel_drops}};
+          {"slip_events", s.encoder_counters.slip_events},
+          {"wheel_drops", s.encoder_counters.wheel_drops},
+          {"gyro_slip_events", s.gyro.fusion.slip_events}};
 }
 
 nlohmann::json resume_json(const ResumeWiring& resume, const loop::OdometryLoop& loop) {

@@ -20,8 +20,9 @@ nlohmann::json report_json(const loop::LoopSnapshot& s, const loop::LoopStats& s
                            const sim::TruthSample* truth, const CanLink* can);
 
 // side_wheels_json: the "wheels" object of several encoders per side (encoder.wheels_per_side
-// > 1): their count and the combiner's event counters.
-nlohmann::json side_wheels_json(const EncoderCounters& c, int wheels_per_side);
+// > 1): their count, the combiner's event counters and the gyro's intervals opened by a slip
+// (0 without a gyro).
+nlohmann::json side_wheels_json(const loop::LoopSnapshot& s, int wheels_per_side);
 
 // resume_json: the "resume" object: whether the persisted pose was taken, and why.
 nlohmann::json resume_json(const ResumeWiring& resume, const loop::OdometryLoop& loop);

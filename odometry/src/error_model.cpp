@@ -417,7 +417,7 @@ void propagate_arc_slip(Cov3& cov, double sin_theta0, double cos_theta0, double 
       all_finite(d_left, d_right, b, sin_theta0, cos_theta0) && std::isfinite(var_left + var_right);
   if (!(finite && b > 0.0)) return;  // a non-finite step would poison the covariance for good
   const double inv_b = 1.0 / b;
-  const ArcTerms t = arc_terms((d_right - d_left) * inv_b);
+  const ArcTerms t = arc_terms((d_right - d_left) / b);
   const double w_l = k.k_left * k.k_left * std::fabs(d_left) + var_left;
   const double w_r = k.k_right * k.k_right * std::fabs(d_right) + var_right;
   const Mat3 q = input_covariance_w(w_l, w_r, d_left, d_right, inv_b, t);

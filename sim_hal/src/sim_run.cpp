@@ -26,7 +26,17 @@ Result<std::unique_ptr<SimRun>> SimRun::create(const RobotGeometry& g, const Kin
     lc.gyrodometry.gyro_delay = o.gyro->delay;
   }
   run->loop_config_ = lc;
-  auto loop = loop::OdometryLoop::create(lc, believed, run->encoder_, run->clock_,
+  if (o.side_wheels != nullptr) {
+    auto model = SideWheelsSim::create(*o.side_wheels, g);
+    if (!model) return std::move(model).error();
+    SideWheelsConfig c = o.side_config;
+    c.read_period = 1.0 / lc.rate_hz;
+    auto w = SimSideWheelsSource::create(run->robot_, std::move(model).value(), c, o.counter_bits);
+    if (!w) return std::move(w).error();
+    run->wheels_.emplace(std::move(w).value());
+  }
+  EncoderSource& enc = run->wheels_ ? static_cast<EncoderSource&>(*run->wheels_) : run->encoder_;
+  auto loop = loop::OdometryLoop::create(lc, believed, enc, run->clock_,
                                          run->gyro_ ? &*run->gyro_ : nullptr);
   if (!loop) return std::move(loop).error();
   run->loop_ = std::move(loop).value();

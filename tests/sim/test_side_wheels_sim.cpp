@@ -12,6 +12,7 @@
 #include "odo/hal/side_wheels.hpp"
 #include "odo/sim/robot.hpp"
 #include "odo/sim/side_wheels_sim.hpp"
+#include "odo/sim/sim_run.hpp"
 #include "random_drive.hpp"
 
 namespace odo::sim {
@@ -148,6 +149,95 @@ TEST(SideWheelsSim, NoSlipFlagOnASmoothFloor) {
       1.0 / worst);
   EXPECT_EQ(src.combiner().counters().slip_events, 0u);
   EXPECT_EQ(seen & (kEncoderSlipLeft | kEncoderSlipRight), 0u);
+}
+
+// A straight leg in the loop at 100 Hz (20 s at 0.2 m/s on a robot exactly as believed, two
+// wheels per side), with the left side's wheel 0 lifted for 1 s at t = 10 s (after the lead-in).
+struct LiftedLeg {
+  RobotGeometry geo;
+  Kinematics k = Kinematics::create(nominal_params(0.15, geo.wheelbase, geo)).value();
+  GyroModel model = consumer_gyro();
+  SideWheelsSimParams wheels;
+  std::unique_ptr<SimRun> run(bool gyro, bool lift, bool both_sides = false) {
+    SimRunOptions o;
+    o.loop.rate_hz = 100.0;
+    o.gyro = gyro ? &model : nullptr;
+    o.gyro_seed = 3;
+    o.side_wheels = &wheels;
+    const double w = 0.2 / 0.075;
+    Scenario s{{20.0, w, w}, {1.0, 0.0, 0.0}};
+    if (!gyro) s.insert(s.begin(), Segment{o.gyro_lead_in, 0.0, 0.0});
+    auto r = SimRun::create(geo, k, s, o).value();
+    const TimeNs at = from_seconds(o.gyro_lead_in + 10.0);
+    SideWheelsSim& m = r->side_wheels()->model();
+    if (lift) m.inject(0, 0, WheelFault::kUnloaded, at, at + kNsPerSecond);
+    if (both_sides) m.inject(1, 0, WheelFault::kUnloaded, at, at + kNsPerSecond);
+    return r;
+  }
+};
+
+TEST(SideWheelsLoop, SlipGrowsTheCovarianceByTheSpread) {
+  // The lifted wheel spins 1 / (1 - 0.25) = 4/3 of the ground speed after tau_m = 0.05 s: over
+  // the second its excess is 0.2 m/s * (1/3) * (1 - 0.05 (1 - e^-20)) = 0.0633 m, the side's
+  // mean over-counts by half of it, and the heading is off by 0.0317 / 0.34 = 0.093 rad. The
+  // interval's spread S ~ 0.0633 m enters as the left travel's variance S^2: heading variance
+  // S^2 / b^2 = 0.0347 rad^2 (sigma 0.19 rad), so the error is within 1 sigma, where the wheels'
+  // noise alone (k^2 4 m / b^2 ~ 1e-5 rad^2) would put it at 30 sigma.
+  LiftedLeg leg;
+  auto clean = leg.run(false, false);
+  auto lifted = leg.run(false, true);
+  clean->drive(0.0);
+  lifted->drive(0.0);
+  // The lifted wheel's part: the difference of the two runs (the same radii and noise draws, the
+  // clean run's error is the wheels' radius tolerance).
+  const double e = std::fabs(lifted->error().theta);
+  EXPECT_NEAR(lifted->error().theta - clean->error().theta, 0.093, 0.003);
+  const double var = lifted->loop().odometry().covariance()[8];
+  const double var_clean = clean->loop().odometry().covariance()[8];
+  EXPECT_GT(var, e * e);
+  EXPECT_NEAR(var, 0.0347 + var_clean, 0.01);
+  EXPECT_LT(var_clean, 1e-4);
+  EXPECT_EQ(lifted->loop().snapshot().encoder_counters.slip_events, 1u);
+  EXPECT_EQ(clean->loop().snapshot().encoder_counters.slip_events, 0u);
+  std::printf(
+      "lifted 1 s: heading error %.4f rad (clean run %.4f), heading sigma %.4f rad (clean %.2e)\n",
+      e, clean->error().theta, std::sqrt(var), std::sqrt(var_clean));
+}
+
+TEST(SideWheelsLoop, WithAGyroTheSlipTakesTheGyrosHeading) {
+  // With a gyro the lifted wheel's heading error (0.1 rad) is replaced by the gyro's view: the
+  // gyro's own disagreement and the slip flag both open the interval (whichever comes first
+  // counts the event).
+  LiftedLeg leg;
+  auto plain = leg.run(false, true);
+  auto fused = leg.run(true, true);
+  plain->drive(0.0);
+  fused->drive(0.0);
+  const double e_plain = std::fabs(plain->error().theta);
+  const double e_fused = std::fabs(fused->error().theta);
+  const Gyrodometry* g = fused->loop().fusion();
+  ASSERT_NE(g, nullptr);
+  EXPECT_GE(g->counters().slip_events + g->counters().disagreements, 1u);
+  EXPECT_GT(g->counters().gyro_used_ticks, 0u);
+  EXPECT_LT(e_fused, e_plain / 10.0);
+  std::printf("lifted 1 s: heading error odometry %.4f rad, with the gyro %.2e rad\n", e_plain,
+              e_fused);
+}
+
+TEST(SideWheelsLoop, SlipFlagAloneOpensTheGyrosInterval) {
+  // Wheel 0 of both sides lifted at once: both sides over-count alike, the heading hardly moves
+  // and the gyro sees no disagreement; only the slip flags tell. They force the gyro's heading
+  // (the fusion counts slip events, no disagreement), and the heading stays as good as without.
+  LiftedLeg leg;
+  auto fused = leg.run(true, true, true);
+  fused->drive(0.0);
+  const Gyrodometry* g = fused->loop().fusion();
+  ASSERT_NE(g, nullptr);
+  EXPECT_GE(g->counters().slip_events, 1u);
+  EXPECT_EQ(g->counters().disagreements, 0u);
+  EXPECT_GT(g->counters().gyro_used_ticks, 0u);
+  EXPECT_EQ(fused->loop().snapshot().encoder_counters.slip_events, 2u);
+  EXPECT_LT(std::fabs(fused->error().theta), 0.01);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// The twist covariance of the ROS 2 output (twist_covariance of odometry/error_model.hpp, published in
-// nav_msgs/Odometry twist.covariance) against a Monte Carlo of the simulated robot (issue 19:
+// The twist covariance of the ROS 2 output (twist_covariance of odometry/error_model.hpp, published
+// in nav_msgs/Odometry twist.covariance) against a Monte Carlo of the simulated robot (issue 19:
 // within 10 %). The same experiment as `odomctl errormodel validate --twist`.
 #include <gtest/gtest.h>
 

@@ -25,6 +25,7 @@
 #include "odo/protocol/can_protocol.hpp"
 #include "odo/protocol/serial_counts_source.hpp"
 #include "odo/sim/sim_can_bus.hpp"
+#include "odo/sim/sim_run.hpp"
 #include "odo/sim/truth.hpp"
 
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
@@ -330,6 +331,48 @@ TEST(ZeroAlloc, CovarianceMergedOverTicksAllocatesNothing) {
   w.disarm();
   EXPECT_EQ(g_allocs.load(), 0u);
   EXPECT_GT(loop->odometry().covariance()[8], 0.0);  // the groups were propagated
+}
+
+TEST(ZeroAlloc, SlipIntervalsWithAndWithoutAGyroAllocateNothing) {
+  // Two wheels per side (issue 38): the combiner on every read, and the slip path (extra travel
+  // variance; with a gyro, the forced gyro heading) on the ticks of 20 injected lifted wheels, a
+  // counter fault among them, at 1 kHz.
+  const sim::RobotGeometry geo;
+  const Kinematics k = Kinematics::create(sim::nominal_params(0.15, geo.wheelbase, geo)).value();
+  const sim::GyroModel model = sim::consumer_gyro();
+  const sim::SideWheelsSimParams wheels;
+  for (const bool gyro : {false, true}) {
+    sim::SimRunOptions o;
+    o.loop.rate_hz = 1000.0;
+    o.gyro = gyro ? &model : nullptr;
+    o.side_wheels = &wheels;
+    const double w = 0.3 / 0.075;
+    auto run = sim::SimRun::create(geo, k, sim::Scenario{{45.0, w, 0.9 * w}}, o).value();
+    sim::SideWheelsSim& m = run->side_wheels()->model();
+    loop::OdometryLoop& loop = run->loop();
+    loop.start();
+    AllocWindow win;
+    for (int t = 0; t < 44'000; ++t) {
+      // Fault i over [2 + 2i, 2.5 + 2i) s, injected (one per wheel at a time) just before.
+      if (t % 2000 == 1900 && t / 2000 < 20) {
+        const int i = t / 2000;
+        const TimeNs at = from_seconds(2.0 + 2.0 * i);
+        m.inject(i % 2, i % 4 < 2 ? 0 : 1,
+                 i == 7 ? sim::WheelFault::kCounter : sim::WheelFault::kUnloaded, at,
+                 at + from_seconds(0.5));
+      }
+      loop.tick();
+    }
+    win.disarm();
+    EXPECT_EQ(g_allocs.load(), 0u) << (gyro ? "with the gyro" : "odometry alone");
+    EXPECT_EQ(g_frees.load(), 0u);
+    const EncoderCounters& c = loop.snapshot().encoder_counters;
+    EXPECT_EQ(c.slip_events, 19u) << (gyro ? "with the gyro" : "odometry alone");  // the path ran
+    EXPECT_EQ(c.wheel_drops, 1u);
+    // With the gyro the flagged ticks took the fused slip path (the gyro's own disagreement
+    // usually opens the interval first, so it counts the event).
+    if (gyro) EXPECT_GT(loop.fusion()->counters().gyro_used_ticks, 0u);
+  }
 }
 
 TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {

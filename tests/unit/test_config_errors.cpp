@@ -307,6 +307,29 @@ TEST(ConfigErrors, GyroWindowOfOneAndAHalfTicksIsRefusedOnceWithTheFusionsRange)
                "bad.toml:5: gyro.bias_tau = 0.4 is outside the allowed range [0.5, 86400] s");
 }
 
+// [encoder]'s several-wheels numbers from the combiner's own table (side_wheels_range at the
+// default loop rate: slip_window from one tick, 0.01 s, to 128 ticks); wheels_per_side, a whole
+// number, at its limits; several wheels with a backend that reads one counter per side refused.
+TEST(ConfigErrors, EncoderSideWheelsNumbersFromTheCombinersTable) {
+  const Config def = default_config();
+  for (std::size_t i = 1; i < kSideConfigParams; ++i)
+    expect_boundaries("encoder",
+                      side_wheels_range(static_cast<SideParam>(i), 1.0 / def.loop.rate_hz));
+  expect_error("[encoder]\nwheels_per_side = 5\n",
+               "bad.toml:2: encoder.wheels_per_side = 5 is outside the allowed range [1, 4]");
+  expect_error("[encoder]\nwheels_per_side = 0\n",
+               "bad.toml:2: encoder.wheels_per_side = 0 is outside the allowed range [1, 4]");
+  expect_error("[encoder]\nbackend = \"gpio\"\nwheels_per_side = 2\n",
+               "bad.toml:3: encoder.wheels_per_side = 2 needs a backend that reads several "
+               "counters per side; backend \"gpio\" reads one");
+  expect_error("[encoder]\ncombine = \"max\"\n", "encoder.combine");
+  auto c = parse_config("[encoder]\nwheels_per_side = 4\ncombine = \"median\"\n", "ok.toml");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  EXPECT_EQ(c->encoder.side.wheels_per_side, 4);
+  EXPECT_EQ(c->encoder.side.combine, SideCombine::kMedian);
+  EXPECT_DOUBLE_EQ(c->encoder.side.read_period, 0.01);
+}
+
 // RangeText: the "lo..hi" of a config comment, "(lo..hi]" when open at lo; lo may be a word
 // ("2 ticks", "still_time"). Empty lo: none found.
 struct RangeText {

@@ -52,6 +52,38 @@ TEST(ErrorModel, StraightLineHandValues) {
   EXPECT_EQ(p[5], p[7]);
 }
 
+TEST(ErrorModel, SlipVarianceAddsToTheWheelsNoise) {
+  // The same straight 10 m with a slip's extra variance on the left wheel only, var_L = 1e-4 m^2
+  // (a spread of 1 cm): w_L = 1.6e-6 + 1e-4 = 1.016e-4, w_R = 3.364e-6, W+ = 1.04964e-4,
+  // W- = 9.8236e-5, and the straight-line limit as above:
+  //   xx = W+/4 = 2.6241e-5         yy = W+ D^2/(3 b^2) = 1.04964e-2/0.3468
+  //   xy = -W- D/(4b) = -9.8236e-4/1.36         xt = -W-/(2b) = -9.8236e-5/0.68
+  //   yt = W+ D/(2 b^2) = 1.04964e-3/0.2312     tt = W+/b^2 = 1.04964e-4/0.1156
+  Cov3 p{};
+  propagate_arc_slip(p, 0.0, 1.0, 10.0, 10.0, kB, kParams, 1e-4, 0.0);
+  EXPECT_NEAR(p[XX], 2.6241e-5, 1e-19);
+  EXPECT_NEAR(p[YY], 1.04964e-2 / 0.3468, 1e-15);
+  EXPECT_NEAR(p[XY], -9.8236e-4 / 1.36, 1e-17);
+  EXPECT_NEAR(p[XT], -9.8236e-5 / 0.68, 1e-18);
+  EXPECT_NEAR(p[YT], 1.04964e-3 / 0.2312, 1e-16);
+  EXPECT_NEAR(p[TT], 1.04964e-4 / 0.1156, 1e-17);
+  // No extra variance: propagate_arc's (its tiered series may differ in the last bits).
+  Cov3 a{}, b{};
+  propagate_arc_slip(a, std::sin(0.3), std::cos(0.3), 1.0, 1.2, kB, kParams, 0.0, 0.0);
+  propagate_arc(b, 0.3, 1.0, 1.2, kB, kParams);
+  expect_cov_near(a, b, 1e-14, "slip without extra variance");
+}
+
+TEST(ErrorModel, SlipTravelVarianceTelescopesToTheIntervalsSpreadSquared) {
+  // Spreads 3, 1, 2 mm over three ticks: v = 3 (0 + 3) = 9, 1 (2 * 3 + 1) = 7, 2 (2 * 4 + 2) =
+  // 20 [mm^2]: 36 = (3 + 1 + 2)^2, the variance of the interval's whole 6 mm.
+  double s = 0.0;
+  EXPECT_DOUBLE_EQ(slip_travel_variance(s, 3e-3), 9e-6);
+  EXPECT_DOUBLE_EQ(slip_travel_variance(s, 1e-3), 7e-6);
+  EXPECT_DOUBLE_EQ(slip_travel_variance(s, 2e-3), 20e-6);
+  EXPECT_DOUBLE_EQ(s, 6e-3);
+}
+
 TEST(ErrorModel, StraightLineRotatedByHeading) {
   // The same 10 m along heading 90 deg: x and y swap roles (R = [0 -1; 1 0]):
   //   xx' = yy, yy' = xx, xy' = -xy, xt' = -yt, yt' = xt, tt' = tt.

@@ -265,6 +265,31 @@ TEST(Gyrodometry, WheelSpeedBeyondLimitFlagsASlip) {
   EXPECT_EQ(g.counters().speed_events, 1u);
 }
 
+TEST(Gyrodometry, WheelSlipFlagForcesTheGyrosHeading) {
+  // The left wheel 0.01 mm ahead on one tick: odometry's heading -1e-5 / 0.34 = -2.94e-5 rad,
+  // far below the threshold (5.06e-4 rad standing, see the top): unflagged, odometry's own.
+  auto g = Gyrodometry::create(params(kQLabMate)).value();
+  learn_bias(g, 0.0);
+  for (int i = 0; i < 40; ++i) g.step(input(0.001, 0.001, 0.0));
+  const FusedTick quiet = g.step(input(0.00101, 0.001, 0.0));
+  EXPECT_EQ(quiet.flags & kFusionGyroUsed, 0u);
+  EXPECT_EQ(quiet.dtheta, quiet.dtheta_odo);
+  // The same tick with the encoders' slip flag (two wheels of a side disagree): the gyro's
+  // heading, 0, for it; the interval replaces the window's ticks, whose errors are 0 but this
+  // one's, so the correction is exactly -dtheta_odo.
+  auto h = Gyrodometry::create(params(kQLabMate)).value();
+  learn_bias(h, 0.0);
+  for (int i = 0; i < 40; ++i) h.step(input(0.001, 0.001, 0.0));
+  FusionInput in = input(0.00101, 0.001, 0.0);
+  in.slip = true;
+  const FusedTick t = h.step(in);
+  EXPECT_TRUE(t.flags & kFusionWheelSlip);
+  EXPECT_TRUE(t.flags & kFusionGyroUsed);
+  EXPECT_NEAR(t.dtheta, 0.0, 1e-18);
+  EXPECT_EQ(h.counters().slip_events, 1u);
+  EXPECT_EQ(h.counters().disagreements, 0u);
+}
+
 TEST(Gyrodometry, AccelerationFromHalfWindows) {
   // Accelerating both wheels at 12 m/s^2 (limit 10): the halves' mean speeds differ by
   // a T_h = 12 * 0.05 = 0.6 m/s, i.e. 0.03 m of half-window travel > 10 * 0.05^2 = 0.025 m.

@@ -11,6 +11,7 @@
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/kinematics.hpp"
 #include "odo/sim/robot.hpp"
+#include "odo/sim/side_wheels_sim.hpp"
 #include "odo/sim/sim_encoder.hpp"
 #include "odo/sim/sim_gyro.hpp"
 #include "odo/sim/virtual_clock.hpp"
@@ -29,6 +30,11 @@ struct SimRunOptions {
   const GyroModel* gyro = nullptr;
   std::uint64_t gyro_seed = 1;
   double gyro_lead_in = 1.0;
+  // side_wheels: several wheels per side of this model, read through a SideCombiner configured
+  // by side_config (its read_period the loop's tick), instead of one counter per side. Null:
+  // one counter per side (SimEncoderSource).
+  const SideWheelsSimParams* side_wheels = nullptr;
+  SideWheelsConfig side_config;
 };
 
 class SimRun {
@@ -46,6 +52,9 @@ class SimRun {
 
   SimRobot& robot() noexcept { return robot_; }
   SimEncoderSource& encoder() noexcept { return encoder_; }
+  // side_wheels: the several-wheels source (fault injection), null without
+  // SimRunOptions::side_wheels.
+  SimSideWheelsSource* side_wheels() noexcept { return wheels_ ? &*wheels_ : nullptr; }
   VirtualClock& clock() noexcept { return clock_; }
   // gyro: the simulated gyro (fault injection), null without SimRunOptions::gyro.
   SimGyro* gyro() noexcept { return gyro_ ? &*gyro_ : nullptr; }
@@ -59,6 +68,7 @@ class SimRun {
   VirtualClock clock_;
   SimRobot robot_;
   SimEncoderSource encoder_;
+  std::optional<SimSideWheelsSource> wheels_;
   std::optional<SimGyro> gyro_;
   loop::LoopConfig loop_config_;
   std::unique_ptr<loop::OdometryLoop> loop_;
