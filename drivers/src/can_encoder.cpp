@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "odo/drivers/count_plausibility.hpp"
 #include "odo/hal/bytes.hpp"
+#include "odo/hal/side_sample.hpp"
 
 namespace odo::drivers {
 namespace {
@@ -71,31 +73,77 @@ Status check_layout(const CanCountLayout& l) {
   return Ok{};
 }
 
+int can_wheel_count(const CanEncoderConfig& cfg) noexcept {
+  const int n = cfg.wheels.wheels_per_side;
+  return 2 * (n < 1 ? 1 : (n > kMaxWheelsPerSide ? kMaxWheelsPerSide : n));
+}
+
+const CanCountLayout& can_wheel_layout(const CanEncoderConfig& cfg, int i) noexcept {
+  return wheel_of_side(i, cfg.left, cfg.right, cfg.more_left, cfg.more_right);
+}
+
+namespace {
+
+// wheel_name: "left wheel", "right wheel" (one per side) or "left wheel 2" (several).
+std::string wheel_name(const CanEncoderConfig& cfg, int i) {
+  std::string n = i % 2 == 0 ? "left wheel" : "right wheel";
+  if (cfg.wheels.wheels_per_side > 1) n += " " + std::to_string(i / 2 + 1);
+  return n;
+}
+
+// check_wheels: every wheel's layout valid, one width, no two wheels on the same bytes.
+Status check_wheels(const CanEncoderConfig& cfg) {
+  auto bad = [](const std::string& m) { return make_error(Errc::kInvalidArgument, m); };
+  const int n = can_wheel_count(cfg);
+  for (int i = 0; i < n; ++i) {
+    const CanCountLayout& l = can_wheel_layout(cfg, i);
+    if (Status s = check_layout(l); !s) return bad(wheel_name(cfg, i) + ": " + s.error().message);
+    if (l.width_bits != cfg.left.width_bits)
+      return bad(n > 2 ? "all wheels' counts must have the same width"
+                       : "both wheels' counts must have the same width");
+    for (int j = 0; j < i; ++j) {
+      const CanCountLayout& o = can_wheel_layout(cfg, j);
+      if (l.id == o.id && l.extended == o.extended && l.byte_offset == o.byte_offset)
+        return bad(n > 2 ? wheel_name(cfg, j) + " and " + wheel_name(cfg, i) +
+                               " read the same bytes of the same frame"
+                         : "both wheels read the same bytes of the same frame");
+    }
+  }
+  return Ok{};
+}
+
+}  // namespace
+
 Result<CanEncoderSource> CanEncoderSource::create(CanBus& bus, const CanEncoderConfig& cfg) {
   auto bad = [](const std::string& m) { return make_error(Errc::kInvalidArgument, m); };
-  if (Status s = check_layout(cfg.left); !s) return bad("left wheel: " + s.error().message);
-  if (Status s = check_layout(cfg.right); !s) return bad("right wheel: " + s.error().message);
-  if (cfg.left.width_bits != cfg.right.width_bits)
-    return bad("both wheels' counts must have the same width");
-  if (cfg.left.id == cfg.right.id && cfg.left.extended == cfg.right.extended &&
-      cfg.left.byte_offset == cfg.right.byte_offset)
-    return bad("both wheels read the same bytes of the same frame");
+  const int per_side = cfg.wheels.wheels_per_side;
+  if (per_side < 1 || per_side > kMaxWheelsPerSide)
+    return bad("wheels_per_side " + std::to_string(per_side) + " must be 1.." +
+               std::to_string(kMaxWheelsPerSide));
+  if (Status s = check_wheels(cfg); !s) return std::move(s).error();
   if (cfg.timeout <= 0) return bad("timeout must be > 0 s");
   if (!(cfg.max_counts_per_s > 0.0 && cfg.max_counts_per_s <= 1e9))
     return bad("max_counts_per_s must be in (0, 1e9] counts/s");
   if (auto s = check_row(kCanMaxFramesPerRead, "", cfg.max_frames_per_read); !s)
     return std::move(s).error();
   if (cfg.request_period < 0) return bad("request_period must be >= 0 s");
-  return CanEncoderSource(bus, cfg);
+  CanEncoderSource src(bus, cfg);
+  src.cfg_.wheels.counter_bits = cfg.left.width_bits;
+  if (per_side > 1) {
+    auto c = SideCombiner::create(src.cfg_.wheels);
+    if (!c) return std::move(c).error();
+    src.combiner_.emplace(std::move(c).value());
+  }
+  return src;
 }
 
 void CanEncoderSource::accept(int i, std::int64_t value, TimeNs stamp,
                               std::uint32_t& flags) noexcept {
   Wheel& w = wheel_[static_cast<std::size_t>(i)];
-  const int bits = counter_bits();
+  const int bits = cfg_.left.width_bits;  // each wheel's own counter (counter_bits() may be 64)
   // Stamps of one socket never go back; a clock conversion could by a few ns: held.
   if (w.primed && stamp < w.last_stamp) stamp = w.last_stamp;
-  const bool reverse = i == 0 ? cfg_.reverse_left : cfg_.reverse_right;
+  const bool reverse = i % 2 == 0 ? cfg_.reverse_left : cfg_.reverse_right;
   const std::int64_t raw = reverse ? wrap_sub(0, value, bits) : wrap_bits(value, bits);
   if (!w.primed) {
     // The controller's own counter is reported, so that counts stay continuous across restarts
@@ -128,7 +176,7 @@ std::int64_t CanEncoderSource::count_at(const Wheel& w, TimeNs t) const noexcept
     if (f.stamp <= t) {
       if (k == 0) return f.count;  // t at or after the newest frame: its count
       const Stamped& g = w.history[after];
-      const int bits = counter_bits();
+      const int bits = cfg_.left.width_bits;  // each wheel's own counter (counter_bits() may be 64)
       const double frac = static_cast<double>(t - f.stamp) / static_cast<double>(g.stamp - f.stamp);
       const double step = static_cast<double>(wrap_sub(g.count, f.count, bits));
       return wrap_add(f.count, std::llround(frac * step), bits);
@@ -140,14 +188,20 @@ std::int64_t CanEncoderSource::count_at(const Wheel& w, TimeNs t) const noexcept
 
 void CanEncoderSource::send_requests(TimeNs now) noexcept {
   if (cfg_.request_period <= 0 || now < next_request_) return;
-  // Skip missed periods: one request per wheel per period at most, never a burst.
+  // Skip missed periods: one request per id per period at most, never a burst.
   next_request_ = now + cfg_.request_period;
-  const std::array<const CanCountLayout*, 2> ls{&cfg_.left, &cfg_.right};
-  for (std::size_t i = 0; i < 2; ++i) {
-    if (i == 1 && ls[1]->id == ls[0]->id && ls[1]->extended == ls[0]->extended) break;
+  const int n = can_wheel_count(cfg_);
+  for (int i = 0; i < n; ++i) {
+    const CanCountLayout& l = can_wheel_layout(cfg_, i);
+    bool asked = false;  // an earlier wheel shares the id: its request answers both
+    for (int j = 0; j < i; ++j) {
+      const CanCountLayout& o = can_wheel_layout(cfg_, j);
+      asked = asked || (o.id == l.id && o.extended == l.extended);
+    }
+    if (asked) continue;
     CanFrame r;
-    r.id = ls[i]->id;
-    r.extended = ls[i]->extended;
+    r.id = l.id;
+    r.extended = l.extended;
     r.rtr = true;
     r.len = 8;
     if (bus_->send(r) == CanTx::kSent)
@@ -158,19 +212,19 @@ void CanEncoderSource::send_requests(TimeNs now) noexcept {
 }
 
 int CanEncoderSource::drain(TimeNs now, std::uint32_t& flags) noexcept {
-  const std::array<const CanCountLayout*, 2> ls{&cfg_.left, &cfg_.right};
+  const int wheels = can_wheel_count(cfg_);
   CanFrame f;
   int n = 0;
   for (; n < cfg_.max_frames_per_read && bus_->receive(f); ++n) {
     ++stats_.frames;
     bool ours = false;
-    for (std::size_t i = 0; i < 2; ++i) {
+    for (int i = 0; i < wheels; ++i) {
       std::int64_t v = 0;
-      switch (decode_count(f, *ls[i], v)) {
+      switch (decode_count(f, can_wheel_layout(cfg_, i), v)) {
         case CanDecode::kOk:
           // Every frame, not only a read's newest: the jump check and the interpolation work
           // on each frame's own stamp.
-          accept(static_cast<int>(i), v, f.stamp != 0 ? f.stamp : now, flags);
+          accept(i, v, f.stamp != 0 ? f.stamp : now, flags);
           ++stats_.decoded;
           ours = true;
           break;
@@ -191,25 +245,91 @@ int CanEncoderSource::drain(TimeNs now, std::uint32_t& flags) noexcept {
   return n;
 }
 
+void CanEncoderSource::mark_lagging() noexcept {
+  const int n = can_wheel_count(cfg_);
+  TimeNs horizon = 0;  // the newest among the fresh wheels' oldest kept frames
+  for (int i = 0; i < n; ++i) {
+    const Wheel& w = wheel_[static_cast<std::size_t>(i)];
+    if (w.stale || w.kept == 0) continue;
+    horizon = std::max(horizon, w.history[(w.newest + kHistory - (w.kept - 1)) % kHistory].stamp);
+  }
+  std::array<int, 2> fresh{}, lagging{};
+  for (int i = 0; i < n; ++i) {
+    Wheel& w = wheel_[static_cast<std::size_t>(i)];
+    w.lagging = !w.stale && w.last_stamp < horizon;
+    fresh[static_cast<std::size_t>(i % 2)] += w.stale ? 0 : 1;
+    lagging[static_cast<std::size_t>(i % 2)] += w.lagging ? 1 : 0;
+  }
+  // A side whose every fresh wheel lags (a slower sender than the other side's) is held back as
+  // with one wheel per side, never dropped for it.
+  for (int i = 0; i < n; ++i) {
+    const auto side = static_cast<std::size_t>(i % 2);
+    if (lagging[side] == fresh[side]) wheel_[static_cast<std::size_t>(i)].lagging = false;
+  }
+}
+
+TimeNs CanEncoderSource::sample_time(TimeNs now, std::uint32_t& flags) noexcept {
+  const int n = can_wheel_count(cfg_);
+  std::array<bool, 2> side_fresh{false, false};
+  for (int i = 0; i < n; ++i) {
+    Wheel& w = wheel_[static_cast<std::size_t>(i)];
+    const bool stale = !w.primed || now - w.last_stamp > cfg_.timeout;
+    // Several wheels per side: a wheel going stale is a wheel drop, a side going stale an event
+    // (both counted by the combiner).
+    if (stale && !w.stale && w.primed && !combiner_) ++counters_.stale_events;
+    w.stale = stale;
+    if (!stale) side_fresh[static_cast<std::size_t>(i % 2)] = true;
+  }
+  if (combiner_) mark_lagging();
+  // A side is stale when none of its wheels is fresh (with one wheel per side: that wheel).
+  if (!side_fresh[0]) flags |= kEncoderStaleLeft;
+  if (!side_fresh[1]) flags |= kEncoderStaleRight;
+  // One instant for all wheels: the oldest newest frame of the fresh wheels (the others
+  // interpolated to it; lagging ones left out); with a stale side there is none, and the read
+  // time is used as before. Never back in time.
+  TimeNs oldest = std::numeric_limits<TimeNs>::max();  // a frame may be stamped after `now`
+  for (int i = 0; i < n; ++i) {
+    const Wheel& w = wheel_[static_cast<std::size_t>(i)];
+    if (!w.stale && !w.lagging) oldest = std::min(oldest, w.last_stamp);
+  }
+  TimeNs t = side_fresh[0] && side_fresh[1] ? oldest : now;
+  if (t < last_sample_) t = last_sample_;
+  last_sample_ = t;
+  return t;
+}
+
+void CanEncoderSource::combine(TimeNs t, EncoderSample& s) noexcept {
+  const int n = can_wheel_count(cfg_);
+  s.counters = counters_;
+  // Before the first frame of any wheel the sides are 0 and stale (sample_time), and no wheel
+  // has dropped out of anything (the start-up state is not an event, as with one wheel).
+  bool any = false;
+  for (int i = 0; i < n; ++i) any = any || wheel_[static_cast<std::size_t>(i)].primed;
+  if (!any) return;
+  std::array<SideReadings, 2> side{};
+  for (int i = 0; i < n; ++i) {
+    const Wheel& w = wheel_[static_cast<std::size_t>(i)];
+    SideReadings& r = side[static_cast<std::size_t>(i % 2)];
+    const int k = i / 2;
+    r.counts[static_cast<std::size_t>(k)] = w.primed ? count_at(w, t) : 0;
+    // A stale or lagging wheel's count is not this instant's: dropped from the mean.
+    if (w.stale || w.lagging) r.faulted = static_cast<std::uint8_t>(r.faulted | (1u << k));
+  }
+  apply_side_step(combiner_->step(side[0], side[1]), combiner_->counters(), s);
+}
+
 EncoderSample CanEncoderSource::read(TimeNs now) noexcept {
   EncoderSample s;
   send_requests(now);
   if (drain(now, s.flags) == cfg_.max_frames_per_read) ++stats_.capped_reads;
-  bool all_fresh = true;
-  for (int i = 0; i < 2; ++i) {
-    Wheel& w = wheel_[static_cast<std::size_t>(i)];
-    const bool stale = !w.primed || now - w.last_stamp > cfg_.timeout;
-    if (stale && !w.stale && w.primed) ++counters_.stale_events;
-    w.stale = stale;
-    if (stale) s.flags |= i == 0 ? kEncoderStaleLeft : kEncoderStaleRight;
-    all_fresh = all_fresh && !stale;
-  }
-  // One instant for both wheels: the older newest frame (the other wheel interpolated to it);
-  // with a stale wheel there is none, and the read time is used as before. Never back in time.
-  TimeNs t = all_fresh ? std::min(wheel_[0].last_stamp, wheel_[1].last_stamp) : now;
-  if (t < last_sample_) t = last_sample_;
-  last_sample_ = t;
+  const TimeNs t = sample_time(now, s.flags);
   s.stamp = t;
+  if (combiner_) {
+    // The combined counts are no controller's counter (they start at 0): nothing to hand back
+    // (each wheel's rejected jumps stay in its own offset).
+    combine(t, s);
+    return s;
+  }
   s.left = wheel_[0].primed ? count_at(wheel_[0], t) : 0;
   s.right = wheel_[1].primed ? count_at(wheel_[1], t) : 0;
   s.left_rejected = wheel_[0].offset;  // the controller holds left + offset (issue 39)

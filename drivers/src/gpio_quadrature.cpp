@@ -14,11 +14,15 @@
 #include "gpiod_util.hpp"
 #include "odo/drivers/monotonic_clock.hpp"
 #include "odo/drivers/quad_tracker.hpp"
+#include "odo/hal/side_sample.hpp"
 
 namespace odo::drivers {
 namespace {
 
 enum class Role : std::uint8_t { kA, kB, kIndex };
+
+constexpr int kMaxWheels = 2 * kMaxWheelsPerSide;
+constexpr int kMaxLines = 3 * kMaxWheels;  // A, B and index of every wheel
 
 struct LineRole {
   int wheel = 0;
@@ -43,25 +47,35 @@ struct WheelAtomics {
   std::atomic<std::uint64_t> dropped{0};
 };
 
+// gpio_wheel_count: 2 * wheels_per_side (clamped to 1..kMaxWheelsPerSide per side).
+int gpio_wheel_count(const GpioQuadratureConfig& cfg) noexcept {
+  return 2 * std::clamp(cfg.wheels.wheels_per_side, 1, kMaxWheelsPerSide);
+}
+
 }  // namespace
+
+const GpioWheelLines& gpio_wheel_lines(const GpioQuadratureConfig& cfg, int i) noexcept {
+  return wheel_of_side(i, cfg.left, cfg.right, cfg.more_left, cfg.more_right);
+}
 
 struct GpioQuadratureEncoder::Impl {
   GpioQuadratureConfig cfg;
   ChipHandle chip;
   gpiod_line_bulk bulk{};
-  std::array<LineRole, 6> roles{};
+  std::array<LineRole, kMaxLines> roles{};
   unsigned n_lines = 0;
-  std::array<QuadTracker, 2> trackers{};
-  std::array<std::uint64_t, 2> edges{};
-  std::array<std::uint64_t, 2> index_pulses{};
-  std::array<std::int64_t, 2> index_count{};
-  std::array<TimeNs, 2> last_ts{};  // timestamp of the last applied A/B edge per wheel
-  TimeNs seen_ts[2][2] = {};        // newest received timestamp per wheel and line (A, B)
-  std::uint64_t events_read = 0;    // all events read from the kernel
-  bool suspect = false;             // idle check saw a difference once
-  std::array<QuadState, 2> suspect_levels{};
+  int n_wheels = 2;  // 2 * wheels_per_side
+  std::array<QuadTracker, kMaxWheels> trackers{};
+  std::array<std::uint64_t, kMaxWheels> edges{};
+  std::array<std::uint64_t, kMaxWheels> index_pulses{};
+  std::array<std::int64_t, kMaxWheels> index_count{};
+  std::array<TimeNs, kMaxWheels> last_ts{};  // timestamp of the last applied A/B edge per wheel
+  TimeNs seen_ts[kMaxWheels][2] = {};        // newest received timestamp per wheel and line (A, B)
+  std::uint64_t events_read = 0;             // all events read from the kernel
+  bool suspect = false;                      // idle check saw a difference once
+  std::array<QuadState, kMaxWheels> suspect_levels{};
   std::uint64_t suspect_events = 0;  // events_read when the idle check first saw a difference
-  std::array<WheelAtomics, 2> pub;
+  std::array<WheelAtomics, kMaxWheels> pub;
   std::atomic<bool> stop{false};
   std::atomic<bool> held{false};
   std::atomic<bool> failed{false};
@@ -70,11 +84,11 @@ struct GpioQuadratureEncoder::Impl {
   std::thread thread;
 
   std::int64_t signed_count(int w) const noexcept {
-    const bool rev = w == 0 ? cfg.left.reverse : cfg.right.reverse;
+    const bool rev = gpio_wheel_lines(cfg, w).reverse;
     return rev ? -trackers[w].count() : trackers[w].count();
   }
   void publish() noexcept {
-    for (int w = 0; w < 2; ++w) {
+    for (int w = 0; w < n_wheels; ++w) {
       pub[w].edges.store(edges[w], std::memory_order_relaxed);
       pub[w].invalid.store(trackers[w].invalid(), std::memory_order_relaxed);
       pub[w].index_pulses.store(index_pulses[w], std::memory_order_relaxed);
@@ -82,10 +96,10 @@ struct GpioQuadratureEncoder::Impl {
       pub[w].count.store(signed_count(w), std::memory_order_release);
     }
   }
-  bool read_levels(std::array<QuadState, 2>& out) noexcept {
-    int v[6] = {};
+  bool read_levels(std::array<QuadState, kMaxWheels>& out) noexcept {
+    int v[kMaxLines] = {};
     if (gpiod_line_get_value_bulk(&bulk, v) != 0) return false;
-    out = {0, 0};
+    out = {};
     for (unsigned i = 0; i < n_lines; ++i) {
       const LineRole r = roles[i];
       if (r.role == Role::kIndex || v[i] == 0) continue;
@@ -103,6 +117,9 @@ struct GpioQuadratureEncoder::Impl {
   void process(std::size_t n) noexcept;
   void idle_check() noexcept;
   void run() noexcept;
+  // add_lines: every wheel's A, B and index line (cfg) into `bulk` with its role; errors name
+  // the line and its role.
+  Status add_lines();
 };
 
 void GpioQuadratureEncoder::Impl::process(std::size_t n) noexcept {
@@ -148,16 +165,16 @@ void GpioQuadratureEncoder::Impl::idle_check() noexcept {
   // A difference between the lines and the decoded state counts as lost edges only when it was
   // seen at two idle checks in a row (idle_check apart) with not one event read in between:
   // an edge whose event is merely late (the kernel's IRQ thread not yet run) is not a loss.
-  std::array<QuadState, 2> now{};
+  std::array<QuadState, kMaxWheels> now{};
   if (!read_levels(now)) return;
   bool differs = false;
-  for (int w = 0; w < 2; ++w) differs = differs || now[w] != trackers[w].state();
+  for (int w = 0; w < n_wheels; ++w) differs = differs || now[w] != trackers[w].state();
   if (!differs) {
     suspect = false;
     return;
   }
   if (suspect && suspect_levels == now && suspect_events == events_read) {
-    for (int w = 0; w < 2; ++w) trackers[w].resync(now[w]);
+    for (int w = 0; w < n_wheels; ++w) trackers[w].resync(now[w]);
     suspect = false;
     return;
   }
@@ -268,30 +285,22 @@ GpioQuadratureEncoder::~GpioQuadratureEncoder() {
   if (impl_->thread.joinable()) impl_->thread.join();
 }
 
-Result<std::unique_ptr<GpioQuadratureEncoder>> GpioQuadratureEncoder::open(
-    const GpioQuadratureConfig& cfg) {
-  if (auto s = check_row(kGpioBatch, "gpio: ", cfg.batch); !s) return std::move(s).error();
-  if (cfg.reorder_window < 0 || cfg.reorder_window > 100'000'000)
-    return make_error(Errc::kInvalidArgument, "gpio: reorder_window must be in [0, 0.1] s");
-  if (cfg.idle_check < 10'000'000 || cfg.idle_check > 10 * kNsPerSecond)
-    return make_error(Errc::kInvalidArgument, "gpio: idle_check must be in [0.01, 10] s");
-  auto impl = std::make_unique<Impl>();
-  impl->cfg = cfg;
-  auto chip = open_chip(cfg.chip);
-  if (!chip) return std::move(chip).error();
-  impl->chip = std::move(chip).value();
-  gpiod_line_bulk_init(&impl->bulk);
+Status GpioQuadratureEncoder::Impl::add_lines() {
   struct Want {
     int offset;
     LineRole role;
-    const char* name;
+    std::string name;
   };
-  const Want wants[6] = {{static_cast<int>(cfg.left.a), {0, Role::kA}, "left a"},
-                         {static_cast<int>(cfg.left.b), {0, Role::kB}, "left b"},
-                         {cfg.left.index, {0, Role::kIndex}, "left index"},
-                         {static_cast<int>(cfg.right.a), {1, Role::kA}, "right a"},
-                         {static_cast<int>(cfg.right.b), {1, Role::kB}, "right b"},
-                         {cfg.right.index, {1, Role::kIndex}, "right index"}};
+  n_wheels = gpio_wheel_count(cfg);
+  std::vector<Want> wants;
+  for (int i = 0; i < n_wheels; ++i) {
+    const GpioWheelLines& l = gpio_wheel_lines(cfg, i);
+    std::string side = i % 2 == 0 ? "left" : "right";
+    if (n_wheels > 2) side += " " + std::to_string(i / 2 + 1);
+    wants.push_back({static_cast<int>(l.a), {i, Role::kA}, side + " a"});
+    wants.push_back({static_cast<int>(l.b), {i, Role::kB}, side + " b"});
+    wants.push_back({l.index, {i, Role::kIndex}, side + " index"});
+  }
   std::vector<int> used;
   for (const Want& w : wants) {
     if (w.offset < 0) continue;
@@ -299,27 +308,57 @@ Result<std::unique_ptr<GpioQuadratureEncoder>> GpioQuadratureEncoder::open(
       return make_error(Errc::kInvalidArgument, "gpio: line " + std::to_string(w.offset) + " (" +
                                                     w.name + ") is used twice");
     used.push_back(w.offset);
-    gpiod_line* l = get_line(impl->chip.get(), static_cast<unsigned>(w.offset));
+    gpiod_line* l = get_line(chip.get(), static_cast<unsigned>(w.offset));
     if (l == nullptr) {
       errno = 0;
-      return line_error(cfg.chip, static_cast<unsigned>(w.offset), w.name);
+      return line_error(cfg.chip, static_cast<unsigned>(w.offset), w.name.c_str());
     }
-    gpiod_line_bulk_add(&impl->bulk, l);
-    impl->roles[impl->n_lines++] = w.role;
+    gpiod_line_bulk_add(&bulk, l);
+    roles[n_lines++] = w.role;
   }
+  return Ok{};
+}
+
+Result<std::unique_ptr<GpioQuadratureEncoder>> GpioQuadratureEncoder::open(
+    const GpioQuadratureConfig& cfg) {
+  if (auto s = check_row(kGpioBatch, "gpio: ", cfg.batch); !s) return std::move(s).error();
+  if (cfg.reorder_window < 0 || cfg.reorder_window > 100'000'000)
+    return make_error(Errc::kInvalidArgument, "gpio: reorder_window must be in [0, 0.1] s");
+  if (cfg.idle_check < 10'000'000 || cfg.idle_check > 10 * kNsPerSecond)
+    return make_error(Errc::kInvalidArgument, "gpio: idle_check must be in [0.01, 10] s");
+  if (cfg.wheels.wheels_per_side < 1 || cfg.wheels.wheels_per_side > kMaxWheelsPerSide)
+    return make_error(Errc::kInvalidArgument,
+                      "gpio: wheels_per_side must be 1.." + std::to_string(kMaxWheelsPerSide));
+  std::optional<SideCombiner> combiner;
+  if (cfg.wheels.wheels_per_side > 1) {
+    SideWheelsConfig w = cfg.wheels;
+    w.counter_bits = 64;  // each wheel's count is a 64-bit integer of the decoder
+    auto c = SideCombiner::create(w);
+    if (!c) return std::move(c).error();
+    combiner.emplace(std::move(c).value());
+  }
+  auto impl = std::make_unique<Impl>();
+  impl->cfg = cfg;
+  auto chip = open_chip(cfg.chip);
+  if (!chip) return std::move(chip).error();
+  impl->chip = std::move(chip).value();
+  gpiod_line_bulk_init(&impl->bulk);
+  if (Status st = impl->add_lines(); !st) return std::move(st).error();
   const int flags = cfg.active_low ? GPIOD_LINE_REQUEST_FLAG_ACTIVE_LOW : 0;
   if (gpiod_line_request_bulk_both_edges_events_flags(&impl->bulk, cfg.consumer.c_str(), flags) !=
       0)
     return line_error(cfg.chip, cfg.left.a, "encoder lines");
-  std::array<QuadState, 2> levels{};
+  std::array<QuadState, kMaxWheels> levels{};
   if (!impl->read_levels(levels))
     return make_error(Errc::kIo, "GPIO chip '" + cfg.chip + "': cannot read the encoder lines");
-  for (int w = 0; w < 2; ++w) impl->trackers[w].reset(levels[w]);
+  for (int w = 0; w < impl->n_wheels; ++w) impl->trackers[w].reset(levels[w]);
   impl->buf.resize(static_cast<std::size_t>(cfg.batch));
   impl->pending.reserve(8192);
   Impl* raw = impl.get();
   impl->thread = std::thread([raw] { raw->run(); });
-  return std::unique_ptr<GpioQuadratureEncoder>(new GpioQuadratureEncoder(std::move(impl)));
+  std::unique_ptr<GpioQuadratureEncoder> enc(new GpioQuadratureEncoder(std::move(impl)));
+  enc->combiner_ = std::move(combiner);
+  return enc;
 }
 
 EncoderSample GpioQuadratureEncoder::read(TimeNs now) noexcept {
@@ -327,20 +366,39 @@ EncoderSample GpioQuadratureEncoder::read(TimeNs now) noexcept {
   s.stamp = now;
   s.left = impl_->pub[0].count.load(std::memory_order_acquire);
   s.right = impl_->pub[1].count.load(std::memory_order_acquire);
-  const std::uint64_t inv = impl_->pub[0].invalid.load(std::memory_order_relaxed) +
-                            impl_->pub[1].invalid.load(std::memory_order_relaxed);
+  std::uint64_t inv = 0;
+  for (int w = 0; w < impl_->n_wheels; ++w)
+    inv += impl_->pub[w].invalid.load(std::memory_order_relaxed);
   if (inv != last_invalid_) s.flags |= kEncoderInvalidTransition;
   last_invalid_ = inv;
   s.counters.invalid_transitions = inv;
-  if (impl_->failed.load(std::memory_order_acquire)) {
+  const bool failed = impl_->failed.load(std::memory_order_acquire);
+  if (failed) {
     s.flags |= kEncoderReadError;
     s.counters.read_errors = 1;
   }
+  if (combiner_) combine(failed, s);
   return s;
 }
 
+void GpioQuadratureEncoder::combine(bool failed, EncoderSample& s) noexcept {
+  std::array<SideReadings, 2> side{};
+  for (int w = 0; w < impl_->n_wheels; ++w) {
+    const auto k = static_cast<std::size_t>(w / 2);
+    SideReadings& r = side[static_cast<std::size_t>(w % 2)];
+    r.counts[k] = impl_->pub[w].count.load(std::memory_order_acquire);
+    // An invalid transition on this wheel's lines since the last read: steps of this wheel may
+    // be lost (or its levels adopted), so its count is not trusted this read.
+    const std::uint64_t inv = impl_->pub[w].invalid.load(std::memory_order_relaxed);
+    if (failed || inv != wheel_invalid_[static_cast<std::size_t>(w)])
+      r.faulted = static_cast<std::uint8_t>(r.faulted | (1u << k));
+    wheel_invalid_[static_cast<std::size_t>(w)] = inv;
+  }
+  apply_side_step(combiner_->step(side[0], side[1]), combiner_->counters(), s);
+}
+
 GpioWheelStats GpioQuadratureEncoder::wheel(int i) const noexcept {
-  const WheelAtomics& a = impl_->pub[i == 0 ? 0 : 1];
+  const WheelAtomics& a = impl_->pub[i >= 0 && i < impl_->n_wheels ? i : (i == 0 ? 0 : 1)];
   GpioWheelStats s;
   s.count = a.count.load(std::memory_order_acquire);
   s.received = a.received.load(std::memory_order_relaxed);

@@ -10,6 +10,7 @@
 #include "odo/drivers/hctl1100_encoder.hpp"
 #include "odo/drivers/serial_port.hpp"
 #include "odo/firmware/toml_reader.hpp"
+#include "odo/hal/side_sample.hpp"
 #include "odo/loop/loop.hpp"
 #include "odo/odometry/count_delta.hpp"
 #include "odo/odometry/gyrodometry.hpp"
@@ -129,13 +130,111 @@ void read_hctl1100(TableReader t, Hctl1100Section& s) {
   t.finish();
 }
 
-void read_gpio(TableReader t, GpioSection& s) {
+// read_side_list: the side's key `key`, an integer (one wheel) or a list of 1..kMaxWheelsPerSide
+// in [lo, hi]; wheel 1 into `first`, wheels 2.. into `more`; returns the number of wheels.
+template <class T, class U>
+int read_side_list(TableReader& t, std::string_view key, T& first,
+                   std::array<U, kMaxWheelsPerSide - 1>& more, std::int64_t lo, std::int64_t hi) {
+  const std::vector<std::int64_t> v =
+      t.integers(key, {static_cast<std::int64_t>(first)}, lo, hi, kMaxWheelsPerSide);
+  first = static_cast<T>(v.front());
+  for (std::size_t k = 1; k < v.size(); ++k) more[k - 1] = static_cast<U>(v[k]);
+  return static_cast<int>(v.size());
+}
+
+// same_count: `key` lists as many wheels as `ref_key` (else reported at `key`, with `why`);
+// returns the reference count.
+int same_count(TableReader& t, std::string_view ref_key, int ref, std::string_view key, int n,
+               std::string_view why) {
+  if (n != ref)
+    t.reject(key, "lists " + std::to_string(n) + " wheel(s) but " + std::string(ref_key) +
+                      " lists " + std::to_string(ref) + ": " + std::string(why));
+  return ref;
+}
+constexpr std::string_view kBothSides = "both sides need the same number of wheels";
+
+// read_can_odrive_nodes: node_left / node_right, one node id per wheel, all different.
+void read_can_odrive_nodes(TableReader& t, CanEncoderSection& s, bool used) {
+  const int nl = read_side_list(t, "node_left", s.node_left, s.more_node_left, 0, 63);
+  const int nr = read_side_list(t, "node_right", s.node_right, s.more_node_right, 0, 63);
+  if (!used) return;
+  s.wheels_per_side = same_count(t, "node_left", nl, "node_right", nr, kBothSides);
+  if (s.wheels_per_side == 1 && s.node_left == s.node_right) {
+    t.reject("node_right", "= " + std::to_string(s.node_right) +
+                               " is the left wheel's node id too (they must differ)");
+    return;
+  }
+  for (int i = 1; i < 2 * s.wheels_per_side; ++i) {
+    const int id = wheel_of_side(i, s.node_left, s.node_right, s.more_node_left, s.more_node_right);
+    for (int j = 0; j < i; ++j) {
+      if (wheel_of_side(j, s.node_left, s.node_right, s.more_node_left, s.more_node_right) == id) {
+        t.reject(i % 2 == 1 ? "node_right" : "node_left",
+                 "gives node id " + std::to_string(id) +
+                     " to two wheels (each wheel needs its own axis)");
+        return;
+      }
+    }
+  }
+}
+
+// read_can_generic_ids: left_id / right_id (a list: one frame per wheel) and the offsets (one
+// for the side's wheels, or a list as long); no two wheels on the same bytes of one frame.
+void read_can_generic_ids(TableReader& t, CanEncoderSection& s, bool used) {
+  const std::int64_t max_id = s.extended ? 0x1FFFFFFF : 0x7FF;
+  const int il = read_side_list(t, "left_id", s.left_id, s.more_left_id, 0, max_id);
+  const int ir = read_side_list(t, "right_id", s.right_id, s.more_right_id, 0, max_id);
+  const int max_offset = 8 - s.width / 8;
+  const int ol = read_side_list(t, "left_offset", s.left_offset, s.more_left_offset, 0, max_offset);
+  const int orr =
+      read_side_list(t, "right_offset", s.right_offset, s.more_right_offset, 0, max_offset);
+  if (!used) return;
+  s.wheels_per_side = same_count(t, "left_id", il, "right_id", ir, kBothSides);
+  const int n = s.wheels_per_side;
+  // One offset: every wheel of the side uses it.
+  if (ol == 1) s.more_left_offset.fill(s.left_offset);
+  if (orr == 1) s.more_right_offset.fill(s.right_offset);
+  constexpr std::string_view kOffsets = "give one offset for all, or one per wheel";
+  if (ol != 1) same_count(t, "left_id", n, "left_offset", ol, kOffsets);
+  if (orr != 1) same_count(t, "right_id", n, "right_offset", orr, kOffsets);
+  for (int i = 1; i < 2 * n; ++i) {
+    const bool right = i % 2 == 1;
+    const auto at = [&](int w) {
+      return std::pair{
+          wheel_of_side(w, s.left_id, s.right_id, s.more_left_id, s.more_right_id),
+          wheel_of_side(w, s.left_offset, s.right_offset, s.more_left_offset, s.more_right_offset)};
+    };
+    for (int j = 0; j < i; ++j) {
+      if (at(i) != at(j)) continue;
+      if (n == 1)
+        t.reject("right_offset", "= " + std::to_string(s.right_offset) +
+                                     ": both wheels would read the same bytes of frame " +
+                                     std::to_string(s.left_id));
+      else
+        t.reject(right ? "right_id" : "left_id",
+                 "puts two wheels on the same bytes (frame " + std::to_string(at(i).first) +
+                     ", offset " + std::to_string(at(i).second) +
+                     "): give each wheel its own frame id or offset");
+      return;
+    }
+  }
+}
+
+// read_gpio: [gpio]; `wheels`: encoder.wheels_per_side when GPIO is the encoder, 0 otherwise.
+void read_gpio(TableReader t, GpioSection& s, int wheels) {
   s.chip = t.string("chip", s.chip);
-  s.left_a = static_cast<int>(t.integer("left_a", s.left_a, 0, 1023));
-  s.left_b = static_cast<int>(t.integer("left_b", s.left_b, 0, 1023));
+  const std::array<int, 4> n{read_side_list(t, "left_a", s.left_a, s.more_left_a, 0, 1023),
+                             read_side_list(t, "left_b", s.left_b, s.more_left_b, 0, 1023),
+                             read_side_list(t, "right_a", s.right_a, s.more_right_a, 0, 1023),
+                             read_side_list(t, "right_b", s.right_b, s.more_right_b, 0, 1023)};
+  constexpr std::array<const char*, 4> kKeys{"left_a", "left_b", "right_a", "right_b"};
+  s.wheels_per_side = n[0];
+  for (std::size_t i = 1; i < n.size(); ++i)
+    same_count(t, kKeys[0], n[0], kKeys[i], n[i], "one A/B pair per wheel, both sides alike");
+  if (wheels > 0 && n[0] != wheels)
+    t.reject("left_a", "lists " + std::to_string(n[0]) +
+                           " wheel(s) but encoder.wheels_per_side = " + std::to_string(wheels) +
+                           ": give one line per wheel of the side");
   s.left_index = static_cast<int>(t.integer("left_index", s.left_index, -1, 1023));
-  s.right_a = static_cast<int>(t.integer("right_a", s.right_a, 0, 1023));
-  s.right_b = static_cast<int>(t.integer("right_b", s.right_b, 0, 1023));
   s.right_index = static_cast<int>(t.integer("right_index", s.right_index, -1, 1023));
   s.active_low = t.boolean("active_low", s.active_low);
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
@@ -146,12 +245,13 @@ void read_gpio(TableReader t, GpioSection& s) {
   t.finish();
 }
 
-void read_can_encoder(TableReader t, CanEncoderSection& s) {
+// read_can_encoder: [can_encoder]; `wheels`: encoder.wheels_per_side when the CAN backend is
+// the encoder (its lists must be that long), 0 otherwise.
+void read_can_encoder(TableReader t, CanEncoderSection& s, int wheels) {
   s.bus = t.choice("bus", s.bus);
   s.interface = t.string("interface", s.interface);
   s.protocol = t.choice("protocol", s.protocol);
-  s.node_left = static_cast<int>(t.integer("node_left", s.node_left, 0, 63));
-  s.node_right = static_cast<int>(t.integer("node_right", s.node_right, 0, 63));
+  read_can_odrive_nodes(t, s, s.protocol == CanEncoderProtocol::kOdrive);
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
   s.reverse_right = t.boolean("reverse_right", s.reverse_right);
   s.timeout = t.number("timeout", s.timeout, 0.005, 10.0, "s");
@@ -160,33 +260,31 @@ void read_can_encoder(TableReader t, CanEncoderSection& s) {
   s.max_frames_per_read =
       static_cast<int>(t.integer(s.max_frames_per_read, drivers::kCanMaxFramesPerRead));
   s.extended = t.boolean("extended", s.extended);
-  const std::int64_t max_id = s.extended ? 0x1FFFFFFF : 0x7FF;
-  s.left_id = t.integer("left_id", s.left_id, 0, max_id);
-  s.right_id = t.integer("right_id", s.right_id, 0, max_id);
   s.width = static_cast<int>(t.integer("width", s.width, 16, 64));
   if (s.width % 8 != 0)
     t.reject("width",
              "= " + std::to_string(s.width) + " must be a whole number of bytes (16, 24, ..., 64)");
-  const int bytes = s.width / 8;
-  s.left_offset = static_cast<int>(t.integer("left_offset", s.left_offset, 0, 8 - bytes));
-  s.right_offset = static_cast<int>(t.integer("right_offset", s.right_offset, 0, 8 - bytes));
+  read_can_generic_ids(t, s, s.protocol == CanEncoderProtocol::kGeneric);
   s.is_signed = t.boolean("signed", s.is_signed);
   s.byte_order = t.choice("byte_order", s.byte_order);
-  if (s.protocol == CanEncoderProtocol::kGeneric && s.left_id == s.right_id &&
-      s.left_offset == s.right_offset)
-    t.reject("right_offset", "= " + std::to_string(s.right_offset) +
-                                 ": both wheels would read the same bytes of frame " +
-                                 std::to_string(s.left_id));
-  if (s.protocol == CanEncoderProtocol::kOdrive && s.node_left == s.node_right)
-    t.reject("node_right", "= " + std::to_string(s.node_right) +
-                               " is the left wheel's node id too (they must differ)");
   s.sim_period = t.number("sim_period", s.sim_period, 0.001, 1.0, "s");
   s.sim_stop_left_after = t.number("sim_stop_left_after", s.sim_stop_left_after, -1.0, 1e6, "s");
   s.sim_stop_right_after = t.number("sim_stop_right_after", s.sim_stop_right_after, -1.0, 1e6, "s");
+  if (wheels > 0 && s.wheels_per_side != wheels)
+    t.reject(s.protocol == CanEncoderProtocol::kOdrive ? "node_left" : "left_id",
+             "lists " + std::to_string(s.wheels_per_side) +
+                 " wheel(s) but encoder.wheels_per_side = " + std::to_string(wheels) +
+                 ": give one per wheel of the side");
+  if (s.bus == CanEncoderBus::kSim && s.wheels_per_side > 1)
+    t.reject("bus",
+             "= \"sim\" simulates one ODrive axis per side: " + std::to_string(s.wheels_per_side) +
+                 " wheels per side need bus = \"socketcan\"");
   t.finish();
 }
 
-void read_serial(TableReader t, SerialSection& s) {
+// read_serial: [serial]; `wheels`: encoder.wheels_per_side when the serial backend is the
+// encoder, 0 otherwise.
+void read_serial(TableReader t, SerialSection& s, int wheels) {
   s.link = t.choice("link", s.link);
   s.device = t.string("device", s.device);
   s.device_where = t.location("device");
@@ -200,6 +298,10 @@ void read_serial(TableReader t, SerialSection& s) {
   s.reverse_left = t.boolean("reverse_left", s.reverse_left);
   s.reverse_right = t.boolean("reverse_right", s.reverse_right);
   for (const auto& n : kSerialNumbers) s.*n.member = t.number(s.*n.member, n.row);
+  if (wheels > 1 && s.protocol == SerialProtocol::kArduinoBridge)
+    t.reject("protocol",
+             "= \"arduino-bridge\" carries one count per side: encoder.wheels_per_side = " +
+                 std::to_string(wheels) + " needs protocol = \"diffodom\" (version 2 records)");
   t.finish();
 }
 
@@ -433,9 +535,12 @@ Result<Config> parse_config(std::string_view text, std::string_view source) {
   read_realtime(root.sub("realtime"), c.realtime);
   read_calibration(root.sub("calibration"), c.calibration);
   read_hctl1100(root.sub("hctl1100"), c.hctl1100);
-  read_gpio(root.sub("gpio"), c.gpio);
-  read_can_encoder(root.sub("can_encoder"), c.can_encoder);
-  read_serial(root.sub("serial"), c.serial);
+  read_gpio(root.sub("gpio"), c.gpio,
+            c.encoder.backend == EncoderKind::kGpio ? c.encoder.side.wheels_per_side : 0);
+  read_can_encoder(root.sub("can_encoder"), c.can_encoder,
+                   c.encoder.backend == EncoderKind::kCan ? c.encoder.side.wheels_per_side : 0);
+  read_serial(root.sub("serial"), c.serial,
+              c.encoder.backend == EncoderKind::kSerial ? c.encoder.side.wheels_per_side : 0);
   read_error_model(root.sub("error_model"), c.error_model);
   read_can(root.sub("can"), c.can, root.sub("loop"), c.loop.rate_hz);
   ros2::Config ros2_cfg;

@@ -138,14 +138,32 @@ std::string layout_text(const drivers::CanCountLayout& l) {
   return b;
 }
 
+// side_text: the side's wheels' layouts, "id 0x00A bytes 0..3" or "[id 0x00A ..., id 0x04A ...]".
+std::string side_text(const drivers::CanEncoderConfig& c, int side) {
+  const int n = c.wheels.wheels_per_side;
+  std::string t = n > 1 ? "[" : "";
+  for (int k = 0; k < n; ++k)
+    t += (k > 0 ? ", " : "") + layout_text(drivers::can_wheel_layout(c, 2 * k + side));
+  return t + (n > 1 ? "]" : "");
+}
+
 std::string can_text(const CanEncoderSection& s, const drivers::CanEncoderConfig& c) {
   std::ostringstream d;
-  if (s.protocol == CanEncoderProtocol::kOdrive)
-    d << "ODrive CAN Simple encoder counts (nodes " << s.node_left << "/" << s.node_right << ", ";
-  else
+  if (s.protocol == CanEncoderProtocol::kOdrive) {
+    d << "ODrive CAN Simple encoder counts (nodes ";
+    for (int k = 0; k < 2 * s.wheels_per_side; ++k)
+      d << (k == s.wheels_per_side ? "/" : (k > 0 ? "," : ""))
+        << (drivers::can_wheel_layout(
+                c, k < s.wheels_per_side ? 2 * k : 2 * (k - s.wheels_per_side) + 1)
+                .id >>
+            5);
+    d << ", ";
+  } else {
     d << "generic CAN counts (";
-  d << "left " << layout_text(c.left) << ", right " << layout_text(c.right) << ", "
-    << c.left.width_bits << "-bit " << (c.left.is_signed ? "signed" : "unsigned") << " "
+  }
+  if (s.wheels_per_side > 1) d << s.wheels_per_side << " wheels per side, ";
+  d << "left " << side_text(c, 0) << ", right " << side_text(c, 1) << ", " << c.left.width_bits
+    << "-bit " << (c.left.is_signed ? "signed" : "unsigned") << " "
     << (c.left.big_endian ? "big" : "little") << " endian), stale after " << s.timeout * 1e3
     << " ms, jump limit " << c.max_counts_per_s << " counts/s"
     << (s.request_rate > 0 ? ", requests at " + std::to_string(s.request_rate) + " Hz" : "");
@@ -172,12 +190,12 @@ class SerialSimBackend final : public EncoderBackend, public EncoderSource, publ
  public:
   SerialSimBackend(const Config& cfg, const Kinematics& k, sim::SimRobot& robot, TimeNs epoch,
                    std::string d)
-      : model_(cfg.serial.protocol),
+      : model_(cfg.serial.protocol, cfg.encoder.side.wheels_per_side),
         protocol_(cfg.serial.protocol),
         robot_(robot),
         epoch_(epoch),
         period_(from_seconds(cfg.serial.sim_period)),
-        source_(*this, serial_source_config(cfg.serial, k.params())),
+        source_(*this, serial_source_config(cfg.serial, cfg.encoder.side, k.params())),
         desc_(std::move(d)) {}
   EncoderSample read(TimeNs now) noexcept override {
     now_ = now;
@@ -238,9 +256,10 @@ std::string serial_text(const SerialSection& s) {
 
 }  // namespace
 
-protocol::SerialSourceConfig serial_source_config(const SerialSection& s,
+protocol::SerialSourceConfig serial_source_config(const SerialSection& s, const SideWheelsConfig& w,
                                                   const KinematicParams& p) {
   protocol::SerialSourceConfig c;
+  c.wheels = w;
   c.protocol = s.protocol == SerialProtocol::kDiffodom ? protocol::SerialProtocol::kDiffodom
                                                        : protocol::SerialProtocol::kArduinoBridge;
   c.bits_left = s.bits_left;
@@ -266,8 +285,8 @@ Result<std::unique_ptr<EncoderBackend>> make_serial_tty_backend(const Config& cf
   }
   std::ostringstream d;
   d << serial_text(s) << " on " << s.device << " at " << s.baud << " baud";
-  return std::unique_ptr<EncoderBackend>(
-      new SerialTtyBackend(std::move(port).value(), serial_source_config(s, k.params()), d.str()));
+  return std::unique_ptr<EncoderBackend>(new SerialTtyBackend(
+      std::move(port).value(), serial_source_config(s, cfg.encoder.side, k.params()), d.str()));
 }
 
 Result<std::unique_ptr<EncoderBackend>> make_serial_sim_backend(const Config& cfg,
@@ -282,17 +301,28 @@ Result<std::unique_ptr<EncoderBackend>> make_serial_sim_backend(const Config& cf
   return std::unique_ptr<EncoderBackend>(new SerialSimBackend(cfg, k, robot, epoch, d.str()));
 }
 
-drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const KinematicParams& p) {
+drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const SideWheelsConfig& w,
+                                             const KinematicParams& p) {
   drivers::CanEncoderConfig c;
-  if (s.protocol == CanEncoderProtocol::kOdrive) {
-    c.left = drivers::odrive_count_layout(static_cast<std::uint32_t>(s.node_left));
-    c.right = drivers::odrive_count_layout(static_cast<std::uint32_t>(s.node_right));
-  } else {
-    for (int i = 0; i < 2; ++i) {
-      drivers::CanCountLayout& l = i == 0 ? c.left : c.right;
-      l.id = static_cast<std::uint32_t>(i == 0 ? s.left_id : s.right_id);
+  c.wheels = w;  // counter_bits: set by the source from the layouts
+  c.wheels.wheels_per_side = s.wheels_per_side;
+  for (int k = 0; k < s.wheels_per_side; ++k) {
+    const auto m = static_cast<std::size_t>(k > 0 ? k - 1 : 0);
+    for (int side = 0; side < 2; ++side) {
+      drivers::CanCountLayout& l =
+          k == 0 ? (side == 0 ? c.left : c.right) : (side == 0 ? c.more_left[m] : c.more_right[m]);
+      if (s.protocol == CanEncoderProtocol::kOdrive) {
+        const int node = k == 0 ? (side == 0 ? s.node_left : s.node_right)
+                                : (side == 0 ? s.more_node_left[m] : s.more_node_right[m]);
+        l = drivers::odrive_count_layout(static_cast<std::uint32_t>(node));
+        continue;
+      }
+      l.id =
+          static_cast<std::uint32_t>(k == 0 ? (side == 0 ? s.left_id : s.right_id)
+                                            : (side == 0 ? s.more_left_id[m] : s.more_right_id[m]));
       l.extended = s.extended;
-      l.byte_offset = i == 0 ? s.left_offset : s.right_offset;
+      l.byte_offset = k == 0 ? (side == 0 ? s.left_offset : s.right_offset)
+                             : (side == 0 ? s.more_left_offset[m] : s.more_right_offset[m]);
       l.width_bits = s.width;
       l.is_signed = s.is_signed;
       l.big_endian = s.byte_order == ByteOrder::kBig;
@@ -310,12 +340,13 @@ drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const K
 Result<std::unique_ptr<EncoderBackend>> make_can_socketcan_backend(const Config& cfg,
                                                                    const Kinematics& k) {
   const CanEncoderSection& s = cfg.can_encoder;
-  const drivers::CanEncoderConfig c = can_encoder_config(s, k.params());
+  const drivers::CanEncoderConfig c = can_encoder_config(s, cfg.encoder.side, k.params());
   drivers::SocketCanOptions o;
   o.interface = s.interface;
-  for (const drivers::CanCountLayout* l : {&c.left, &c.right}) {
+  for (int i = 0; i < drivers::can_wheel_count(c); ++i) {
     // Exact-id filters: every other frame is dropped by the kernel.
-    o.filters.push_back({l->id, l->extended ? 0x1FFFFFFFu : 0x7FFu, l->extended});
+    const drivers::CanCountLayout& l = drivers::can_wheel_layout(c, i);
+    o.filters.push_back({l.id, l.extended ? 0x1FFFFFFFu : 0x7FFu, l.extended});
   }
   auto bus = drivers::SocketCanBus::open(o);
   if (!bus) return in_file(cfg, "can_encoder", std::move(bus).error());
@@ -335,7 +366,7 @@ Result<std::unique_ptr<EncoderBackend>> make_can_sim_backend(const Config& cfg, 
                       cfg.source +
                           ": [can_encoder] bus = \"sim\" simulates ODrive controllers: "
                           "set protocol = \"odrive\"");
-  const drivers::CanEncoderConfig c = can_encoder_config(s, k.params());
+  const drivers::CanEncoderConfig c = can_encoder_config(s, cfg.encoder.side, k.params());
   auto b = std::make_unique<CanSimBackend>(s, robot, epoch);
   auto enc = drivers::CanEncoderSource::create(b->port(), c);
   if (!enc) return in_file(cfg, "can_encoder", std::move(enc).error());
@@ -358,6 +389,14 @@ Result<std::unique_ptr<EncoderBackend>> make_gpio_backend(const Config& cfg) {
             s.reverse_left};
   c.right = {static_cast<unsigned>(s.right_a), static_cast<unsigned>(s.right_b), s.right_index,
              s.reverse_right};
+  c.wheels = cfg.encoder.side;
+  c.wheels.wheels_per_side = s.wheels_per_side;
+  for (std::size_t k = 0; k + 1 < static_cast<std::size_t>(s.wheels_per_side); ++k) {
+    c.more_left[k] = {static_cast<unsigned>(s.more_left_a[k]),
+                      static_cast<unsigned>(s.more_left_b[k]), -1, s.reverse_left};
+    c.more_right[k] = {static_cast<unsigned>(s.more_right_a[k]),
+                       static_cast<unsigned>(s.more_right_b[k]), -1, s.reverse_right};
+  }
   c.active_low = s.active_low;
   c.batch = s.batch;
   c.reorder_window = from_seconds(s.reorder_window);
@@ -366,7 +405,11 @@ Result<std::unique_ptr<EncoderBackend>> make_gpio_backend(const Config& cfg) {
   if (!enc) return in_file(cfg, "gpio", std::move(enc).error());
   std::ostringstream d;
   d << "GPIO quadrature on " << s.chip << " (left A/B " << s.left_a << "/" << s.left_b
-    << ", right A/B " << s.right_a << "/" << s.right_b << "), libgpiod both-edge events, 4x";
+    << ", right A/B " << s.right_a << "/" << s.right_b;
+  for (std::size_t k = 0; k + 1 < static_cast<std::size_t>(s.wheels_per_side); ++k)
+    d << "; wheel " << k + 2 << ": left A/B " << s.more_left_a[k] << "/" << s.more_left_b[k]
+      << ", right A/B " << s.more_right_a[k] << "/" << s.more_right_b[k];
+  d << "), libgpiod both-edge events, 4x";
   return std::unique_ptr<EncoderBackend>(new GpioBackend(std::move(enc).value(), d.str()));
 }
 

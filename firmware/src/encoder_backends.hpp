@@ -46,8 +46,10 @@ Result<std::unique_ptr<EncoderBackend>> make_hctl_sim_backend(const Config& cfg,
                                                               TimeNs epoch);
 
 // can_encoder_config: the driver configuration of [can_encoder] for this robot (layouts from
-// the protocol, jump limit from max_speed, request period from request_rate).
-drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const KinematicParams& p);
+// the protocol, jump limit from max_speed, request period from request_rate; the wheels per side
+// and their combination from [encoder], `w`).
+drivers::CanEncoderConfig can_encoder_config(const CanEncoderSection& s, const SideWheelsConfig& w,
+                                             const KinematicParams& p);
 
 // make_can_socketcan_backend: [can_encoder] with bus = "socketcan": a raw socket on
 // `interface` with kernel filters for the two wheel ids.
@@ -60,9 +62,11 @@ Result<std::unique_ptr<EncoderBackend>> make_can_socketcan_backend(const Config&
 Result<std::unique_ptr<EncoderBackend>> make_can_sim_backend(const Config& cfg, const Kinematics& k,
                                                              sim::SimRobot& robot, TimeNs epoch);
 
-// serial_source_config: the source configuration of [serial] for this robot (jump limit from
+// serial_source_config: the source configuration of [serial] for this robot (wheels per side
+// from [encoder], `w`) (jump limit from
 // max_speed, poll period from poll_rate).
-protocol::SerialSourceConfig serial_source_config(const SerialSection& s, const KinematicParams& p);
+protocol::SerialSourceConfig serial_source_config(const SerialSection& s, const SideWheelsConfig& w,
+                                                  const KinematicParams& p);
 
 // make_serial_tty_backend: [serial] with link = "tty": the device in raw mode; a missing device,
 // one that is not a tty, an unsupported baud rate: an error naming file, line and key.

@@ -31,6 +31,23 @@ void SerialPeerModel::reset(TimeNs t, std::int64_t left, std::int64_t right) noe
   cmd_len_ = 0;
 }
 
+std::size_t SerialPeerModel::sample_wheels(protocol::SerialCounts& c,
+                                           std::span<std::uint8_t, kMaxOut> out) noexcept {
+  c.wheels_per_side = static_cast<std::uint8_t>(wheels_);
+  c.wheel_faults = wheel_faults_;
+  c.more_left.fill(c.left);
+  c.more_right.fill(c.right);
+  // A faulted wheel's counter reads garbage (a fixed pattern far from any count).
+  constexpr std::int32_t kGarbage = 0x55AA55AA;
+  for (int k = 0; k < wheels_; ++k) {
+    auto& l = k == 0 ? c.left : c.more_left[static_cast<std::size_t>(k - 1)];
+    auto& r = k == 0 ? c.right : c.more_right[static_cast<std::size_t>(k - 1)];
+    if ((wheel_faults_ >> k) & 1u) l = kGarbage;
+    if ((wheel_faults_ >> (4 + k)) & 1u) r = kGarbage;
+  }
+  return protocol::encode_serial_counts_v2(c, out.first<protocol::kSerialCountsFrameMaxV2>());
+}
+
 std::size_t SerialPeerModel::sample(TimeNs t, std::int64_t left, std::int64_t right,
                                     std::span<std::uint8_t, kMaxOut> out) noexcept {
   if (protocol_ == SerialProtocol::kDiffodom) {
@@ -41,6 +58,7 @@ std::size_t SerialPeerModel::sample(TimeNs t, std::int64_t left, std::int64_t ri
     c.right = static_cast<std::int32_t>(right - base_right_);
     c.flags = booted_records_ > 0 ? protocol::kSerialFlagBooted : 0;
     if (booted_records_ > 0) --booted_records_;
+    if (wheels_ > 1) return sample_wheels(c, out);
     return protocol::encode_serial_counts(c, out.first<protocol::kSerialCountsFrameMax>());
   }
   std::size_t n = 0;

@@ -85,6 +85,35 @@ std::int64_t TableReader::integer(std::string_view key, std::int64_t def, std::i
   return *i;
 }
 
+std::vector<std::int64_t> TableReader::integers(std::string_view key, std::vector<std::int64_t> def,
+                                                std::int64_t lo, std::int64_t hi,
+                                                std::size_t max_count) {
+  const toml::node* n = get(key);
+  if (n == nullptr) return def;
+  if (!n->is_array()) return {integer(key, def.empty() ? lo : def.front(), lo, hi)};
+  const toml::array& a = *n->as_array();
+  if (a.empty() || a.size() > max_count) {
+    fail(n, key,
+         "has " + std::to_string(a.size()) + " entries: give 1.." + std::to_string(max_count));
+    return def;
+  }
+  std::vector<std::int64_t> v;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::string elem = std::string(key) + "[" + std::to_string(i) + "]";
+    auto x = a.get(i)->value_exact<std::int64_t>();
+    if (!x) {
+      fail(a.get(i), elem, "must be an integer");
+      return def;
+    }
+    if (*x < lo || *x > hi) {
+      fail(a.get(i), elem, range_text(integer_range(elem, *x, lo, hi)));
+      return def;
+    }
+    v.push_back(*x);
+  }
+  return v;
+}
+
 bool TableReader::boolean(std::string_view key, bool def) {
   const toml::node* n = get(key);
   if (n == nullptr) return def;

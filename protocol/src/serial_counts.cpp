@@ -107,11 +107,39 @@ std::size_t encode_serial_counts(const SerialCounts& s,
 
 SerialDecodeResult SerialCountsDecoder::push(std::uint8_t byte) noexcept {
   if (byte == 0) return finish();
-  if (len_ < buf_.size())
+  if (len_ < limit_)
     buf_[len_++] = byte;
   else
     overrun_ = true;  // reported at the delimiter, which is where the stream resynchronises
   return SerialDecodeResult::kNeedMore;
+}
+
+std::size_t encode_serial_counts_v2(const SerialCounts& s,
+                                    std::span<std::uint8_t, kSerialCountsFrameMaxV2> out) noexcept {
+  std::array<std::uint8_t, kSerialCountsRecordV2Max> rec{};
+  const int n = s.wheels_per_side < 1
+                    ? 1
+                    : (s.wheels_per_side > kSerialMaxWheelsPerSide ? kSerialMaxWheelsPerSide
+                                                                   : s.wheels_per_side);
+  rec[0] = kSerialCountsVersion2;
+  rec[1] = s.flags;
+  put_u16(&rec[2], s.seq);
+  put_u32(&rec[4], s.time_us);
+  rec[8] = static_cast<std::uint8_t>(n);
+  rec[9] = s.wheel_faults;
+  std::size_t at = 10;
+  for (int side = 0; side < 2; ++side) {
+    for (int k = 0; k < n; ++k, at += 4) {
+      const auto& more = side == 0 ? s.more_left : s.more_right;
+      const std::int32_t v =
+          k == 0 ? (side == 0 ? s.left : s.right) : more[static_cast<std::size_t>(k - 1)];
+      put_u32(&rec[at], static_cast<std::uint32_t>(v));
+    }
+  }
+  put_u16(&rec[at], crc16_ccitt_false(std::span(rec).first(at)));
+  const std::size_t len = cobs_encode(std::span(rec).first(at + 2), out.first(out.size() - 1));
+  out[len] = 0;
+  return len + 1;
 }
 
 SerialDecodeResult SerialCountsDecoder::finish() noexcept {
@@ -120,18 +148,46 @@ SerialDecodeResult SerialCountsDecoder::finish() noexcept {
   reset();
   if (len == 0 && !overrun) return SerialDecodeResult::kNeedMore;  // idle delimiters
   if (overrun) return SerialDecodeResult::kBadLength;
-  std::array<std::uint8_t, kSerialCountsRecord + 1> rec{};  // one spare: longer is detected
-  const std::ptrdiff_t n = cobs_decode(std::span(buf_).first(len), rec);
-  if (n < 0) return SerialDecodeResult::kBadCobs;
-  if (static_cast<std::size_t>(n) != kSerialCountsRecord) return SerialDecodeResult::kBadLength;
-  if (crc16_ccitt_false(std::span(rec).first<kSerialCountsPayload>()) != get_u16(&rec[16]))
+  std::array<std::uint8_t, kSerialCountsRecordV2Max + 1> rec{};  // one spare: longer is detected
+  const std::ptrdiff_t decoded = cobs_decode(std::span(buf_).first(len), rec);
+  if (decoded < 0) return SerialDecodeResult::kBadCobs;
+  const auto n = static_cast<std::size_t>(decoded);
+  // The record lengths: 18 (version 1) and 12 + 8 N (version 2, N = 1..4).
+  const bool v2_length = several_ && n >= 20 && n <= kSerialCountsRecordV2Max && (n - 12) % 8 == 0;
+  if (n != kSerialCountsRecord && !v2_length) return SerialDecodeResult::kBadLength;
+  if (crc16_ccitt_false(std::span(rec).first(n - 2)) != get_u16(&rec[n - 2]))
     return SerialDecodeResult::kCrcMismatch;
+  if (n != kSerialCountsRecord) return decode_v2(std::span(rec).first(n));
   if (rec[0] != kSerialCountsVersion) return SerialDecodeResult::kBadVersion;
+  counts_ = SerialCounts{};
   counts_.flags = rec[1];
   counts_.seq = get_u16(&rec[2]);
   counts_.time_us = get_u32(&rec[4]);
   counts_.left = static_cast<std::int32_t>(get_u32(&rec[8]));
   counts_.right = static_cast<std::int32_t>(get_u32(&rec[12]));
+  return SerialDecodeResult::kFrame;
+}
+
+SerialDecodeResult SerialCountsDecoder::decode_v2(std::span<const std::uint8_t> rec) noexcept {
+  if (rec[0] != kSerialCountsVersion2) return SerialDecodeResult::kBadVersion;
+  const int n = rec[8];
+  if (n < 1 || n > kSerialMaxWheelsPerSide || rec.size() != 12 + 8 * static_cast<std::size_t>(n))
+    return SerialDecodeResult::kBadLength;
+  counts_ = SerialCounts{};
+  counts_.flags = rec[1];
+  counts_.seq = get_u16(&rec[2]);
+  counts_.time_us = get_u32(&rec[4]);
+  counts_.wheels_per_side = static_cast<std::uint8_t>(n);
+  counts_.wheel_faults = rec[9];
+  std::size_t at = 10;
+  for (int side = 0; side < 2; ++side) {
+    for (int k = 0; k < n; ++k, at += 4) {
+      const auto v = static_cast<std::int32_t>(get_u32(&rec[at]));
+      auto& more = side == 0 ? counts_.more_left : counts_.more_right;
+      (k == 0 ? (side == 0 ? counts_.left : counts_.right)
+              : more[static_cast<std::size_t>(k - 1)]) = v;
+    }
+  }
   return SerialDecodeResult::kFrame;
 }
 

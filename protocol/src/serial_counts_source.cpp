@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 
+#include "odo/hal/side_sample.hpp"
 #include "odo/odometry/count_delta.hpp"
 
 namespace odo::protocol {
@@ -34,10 +35,21 @@ bool parse_int(const char*& p, const char* end, std::int64_t& out) noexcept {
 
 }  // namespace
 
+static_assert(kSerialMaxWheelsPerSide == kMaxWheelsPerSide);
+
 SerialCountsSource::SerialCountsSource(ByteLink& link, const SerialSourceConfig& cfg) noexcept
-    : link_(&link), cfg_(cfg), clock_(cfg.clock_window, 8) {
-  wheel_[0].bits = cfg.bits_left;
-  wheel_[1].bits = cfg.bits_right;
+    : link_(&link),
+      cfg_(cfg),
+      decoder_(cfg.wheels.wheels_per_side > 1),
+      clock_(cfg.clock_window, 8) {
+  for (std::size_t i = 0; i < wheel_.size(); ++i)
+    wheel_[i].bits = i % 2 == 0 ? cfg.bits_left : cfg.bits_right;
+  if (cfg.wheels.wheels_per_side > 1) {
+    // The config reader checked the numbers (encoder.*); a combiner that cannot be made leaves
+    // the source reporting one wheel per side.
+    cfg_.wheels.counter_bits = 64;
+    if (auto c = SideCombiner::create(cfg_.wheels)) combiner_.emplace(std::move(c).value());
+  }
 }
 
 void SerialCountsSource::link_gone(TimeNs now, std::uint32_t& flags) noexcept {
@@ -116,7 +128,7 @@ void SerialCountsSource::on_record(const SerialCounts& c, TimeNs now, TimeNs arr
     // boot (from 0 to these counts) is kept: the counts continue, no spin.
     ++counters_.controller_resets;
     flags |= kEncoderControllerReset;
-    wheel_[0].last_raw = wheel_[1].last_raw = 0;
+    for (Wheel& w : wheel_) w.last_raw = 0;
     clock_.reset();
     controller_ns_ = 0;
     have_record_ = false;  // no gap to count against the old sequence
@@ -139,8 +151,52 @@ void SerialCountsSource::on_record(const SerialCounts& c, TimeNs now, TimeNs arr
   last_seq_ = c.seq;
   last_time_us_ = c.time_us;
   last_flags_ = c.flags;
-  accept(c.left, c.right, clock_.map(controller_ns_, arrival), flags);
+  if (combiner_)
+    accept_wheels(c, clock_.map(controller_ns_, arrival), flags);
+  else
+    accept(c.left, c.right, clock_.map(controller_ns_, arrival), flags);
   last_valid_ = now;
+}
+
+void SerialCountsSource::accept_wheels(const SerialCounts& c, TimeNs stamp,
+                                       std::uint32_t& flags) noexcept {
+  const int n = cfg_.wheels.wheels_per_side;
+  const double dt = primed_ ? to_seconds(stamp - stamp_) : 0.0;
+  // Slack of 20 ms of motion + 1 count, as for one wheel per side.
+  const auto limit = static_cast<std::int64_t>(cfg_.max_counts_per_s * (dt + 0.02)) + 1;
+  for (int i = 0; i < 2 * n; ++i) {
+    const bool right = i % 2 == 1;
+    const int k = i / 2;
+    const auto& more = right ? c.more_right : c.more_left;
+    std::int64_t v = k == 0 ? (right ? c.right : c.left) : more[static_cast<std::size_t>(k - 1)];
+    if (right ? cfg_.reverse_right : cfg_.reverse_left) v = -v;
+    Wheel& w = wheel_[static_cast<std::size_t>(i)];
+    const std::int64_t r = sign_extend(v, w.bits);
+    const std::int64_t step = primed_ ? wrap_delta(w.last_raw, r, w.bits) : 0;
+    if (!primed_) w.count = r;  // the controller's own count
+    w.last_raw = r;
+    const auto bit = static_cast<std::uint8_t>(1u << (right ? 4 + k : k));
+    // Untrusted (the board says so, or a step no wheel makes): dropped from its side this read;
+    // the combiner re-references the wheel when it is clean again. A flagged wheel's count is
+    // not judged (garbage is what a fault looks like).
+    const bool board_fault = (c.wheel_faults & bit) != 0;
+    // The first clean record after a flagged one is the wheel's new start, not a step from the
+    // garbage it reported.
+    const bool restart = w.faulted && !board_fault;
+    w.faulted = board_fault;
+    if (restart) continue;
+    const bool jump = !board_fault && std::llabs(step) > limit;
+    if (jump) ++counters_.implausible_jumps;
+    if (jump) flags |= kEncoderImplausibleJump;
+    if (jump || board_fault)
+      read_faults_ |= bit;
+    else
+      w.count += step;
+  }
+  primed_ = true;
+  if (stamp > stamp_) stamp_ = stamp;
+  ++stats_.samples;
+  ++valid_since_open_;
 }
 
 void SerialCountsSource::on_byte_diffodom(std::uint8_t b, TimeNs now, TimeNs arrival,
@@ -150,8 +206,12 @@ void SerialCountsSource::on_byte_diffodom(std::uint8_t b, TimeNs now, TimeNs arr
   // The first frame after an open may have been joined halfway: not an error of the line.
   const bool first = !synced_;
   synced_ = true;
-  if (r == SerialDecodeResult::kFrame)
+  // A record with another number of wheels per side than configured is not this robot's.
+  const int wheels = combiner_ ? cfg_.wheels.wheels_per_side : 1;
+  if (r == SerialDecodeResult::kFrame && decoder_.counts().wheels_per_side == wheels)
     on_record(decoder_.counts(), now, arrival, flags);
+  else if (r == SerialDecodeResult::kFrame)
+    link_error(false, flags);
   else if (!first)
     link_error(r == SerialDecodeResult::kCrcMismatch, flags);
 }
@@ -249,11 +309,31 @@ EncoderSample SerialCountsSource::read(TimeNs now) noexcept {
   if (stale) s.flags |= kEncoderStaleLeft | kEncoderStaleRight;
   if (open_ && bytes_since_open_ >= kGarbageBytes && valid_since_open_ == 0)
     s.flags |= kEncoderNoValidData;
-  s.left = wheel_[0].count;
-  s.right = wheel_[1].count;
   s.stamp = primed_ ? stamp_ : now;
   s.counters = counters_;
+  if (combiner_) {
+    combine(s);
+    return s;
+  }
+  s.left = wheel_[0].count;
+  s.right = wheel_[1].count;
   return s;
+}
+
+void SerialCountsSource::combine(EncoderSample& s) noexcept {
+  // Before the first record there are no counts: the sides are 0 and stale (set above), and no
+  // wheel has dropped out of anything.
+  if (!primed_) return;
+  std::array<SideReadings, 2> side{};
+  for (int i = 0; i < 2 * cfg_.wheels.wheels_per_side; ++i) {
+    const int k = i / 2;
+    SideReadings& r = side[static_cast<std::size_t>(i % 2)];
+    r.counts[static_cast<std::size_t>(k)] = wheel_[static_cast<std::size_t>(i)].count;
+    if ((read_faults_ >> (i % 2 == 1 ? 4 + k : k)) & 1u)
+      r.faulted = static_cast<std::uint8_t>(r.faulted | (1u << k));
+  }
+  read_faults_ = 0;
+  apply_side_step(combiner_->step(side[0], side[1]), combiner_->counters(), s);
 }
 
 }  // namespace odo::protocol

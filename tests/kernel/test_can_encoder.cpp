@@ -45,8 +45,10 @@ struct Rig {
   bool open(const std::string& ifname, const CanEncoderConfig& c) {
     drivers::SocketCanOptions o;
     o.interface = ifname;
-    for (const CanCountLayout* l : {&c.left, &c.right})
-      o.filters.push_back({l->id, l->extended ? 0x1FFFFFFFu : 0x7FFu, l->extended});
+    for (int i = 0; i < drivers::can_wheel_count(c); ++i) {
+      const CanCountLayout& l = drivers::can_wheel_layout(c, i);
+      o.filters.push_back({l.id, l.extended ? 0x1FFFFFFFu : 0x7FFu, l.extended});
+    }
     auto b = SocketCanBus::open(o);
     if (!b) {
       ADD_FAILURE() << b.error().message;
@@ -290,6 +292,68 @@ TEST(CanEncoderKernel, StoppedSenderIsStaleWithinTheTimeoutPlusOnePeriod) {
   EXPECT_GT(from_last, 0.100);
   EXPECT_LE(from_last, 0.100 + 0.010 + to_seconds(late));
   EXPECT_EQ(r.enc->read(r.clock.now()).counters.stale_events, 1u);
+}
+
+// Issue 38: two ODrive axes per side (nodes 0 and 2 left, 1 and 3 right) on vcan, frames sent
+// in-process on a raw socket. Each side is the mean of its wheels' travel; then node 2 falls
+// silent: once its newest frame is older than the other wheels' kept frames (8 frames: 80 ms
+// here, before the 200 ms timeout) it is dropped (wheel-dropped, the left side not stale) and
+// node 0 alone carries the left side.
+TEST(CanEncoderKernel, TwoWheelsPerSideMeanThenASilentControllerIsDropped) {
+  ODO_REQUIRE_VM();
+  Vcan v("vcce5");
+  ASSERT_TRUE(v.ok);
+  CanEncoderConfig c = odrive_config();
+  c.timeout = 200 * kMs;
+  c.wheels.wheels_per_side = 2;
+  c.more_left[0] = drivers::odrive_count_layout(2);
+  c.more_right[0] = drivers::odrive_count_layout(3);
+  Rig r;
+  ASSERT_TRUE(r.open(v.name, c));
+  EXPECT_EQ(r.enc->counter_bits(), 64);
+  RawSender tx(v.name);
+  ASSERT_GE(tx.fd, 0);
+  // send4: the four counts, twice: every wheel's newest two frames then hold the same count, so
+  // its count at the common instant (the oldest newest frame) is exact, however the frames'
+  // stamps interleave.
+  auto send4 = [&](std::int32_t l0, std::int32_t l1, std::int32_t r0, std::int32_t r1) {
+    for (int k = 0; k < 2; ++k)
+      ASSERT_TRUE(tx.send(0, l0) && tx.send(2, l1) && tx.send(1, r0) && tx.send(3, r1));
+  };
+  send4(1000, 5000, -100, 300);
+  EncoderSample s = r.settle(20);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 0);  // the combined counts start at 0 (each wheel's first frame: reference)
+  EXPECT_EQ(s.right, 0);
+  // Left +40 and +60: mean 50. Right -30 and -40: mean -35.
+  send4(1040, 5060, -130, 260);
+  s = r.settle(20);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 50);
+  EXPECT_EQ(s.right, -35);
+  // Node 2 silent; the others move every 10 ms for 40 steps (> 400 ms, twice the timeout): node 0
+  // +10, nodes 1 and 3 -6 each per step. Until node 2 lags beyond node 0's 8 kept frames it holds
+  // the instant at its last frame (no count moves); then it is dropped and the left side is node
+  // 0's whole travel (not half of it, as a mean with a held wheel would make it).
+  std::int32_t l0 = 1040, r0 = -130, r1 = 260;
+  for (int i = 0; i < 40; ++i) {
+    l0 += 10;
+    r0 -= 6;
+    r1 -= 6;
+    ASSERT_TRUE(tx.send(0, l0) && tx.send(1, r0) && tx.send(3, r1));
+    s = r.enc->read(r.clock.now());
+    EXPECT_EQ(s.flags & (kEncoderStaleLeft | kEncoderStaleRight), 0u) << "step " << i;
+    r.clock.sleep_until(r.clock.now() + 10 * kMs);
+  }
+  ASSERT_TRUE(tx.send(0, l0) && tx.send(1, r0) && tx.send(3, r1));
+  s = r.settle(20);
+  // Left: 50 + 40 * 10 = 450 (node 0 alone); right: -35 + 40 * -6 = -275 (both wheels).
+  EXPECT_EQ(s.flags, kEncoderWheelDropped);
+  EXPECT_EQ(s.left, 450);
+  EXPECT_EQ(s.right, -275);
+  EXPECT_EQ(s.counters.wheel_drops, 1u);
+  EXPECT_EQ(s.counters.stale_events, 0u);
+  EXPECT_EQ(r.enc->stats().foreign, 0u);
 }
 
 // rx_packets: frames the interface carried so far (the kernel's counter).

@@ -179,6 +179,92 @@ TEST(GpioQuadratureKernel, LostEventsAreDetectedAndNotCounted) {
   EXPECT_EQ(e.wheel(0).invalid, inv);
 }
 
+// Issue 38: two A/B pairs per side on one gpio-sim chip (left 0/1 and 4/5, right 2/3 and 6/7).
+// Each side is the mean of its wheels; a wheel whose lines give an illegal transition (events
+// lost in the kernel while A toggles, as above) is dropped for that read and the other wheel
+// carries the side; it rejoins from the next read.
+TEST(GpioQuadratureKernel, TwoPairsPerSideMeanAndAWheelWithIllegalTransitionsIsDropped) {
+  ODO_REQUIRE_VM();
+  GpioSim sim("odo_quad_two", 8);
+  drivers::GpioQuadratureConfig c = quad_config(sim);
+  c.left.index = -1;
+  c.wheels.wheels_per_side = 2;
+  c.more_left[0] = {4, 5, -1, false};
+  c.more_right[0] = {6, 7, -1, false};
+  auto enc = drivers::GpioQuadratureEncoder::open(c);
+  ASSERT_TRUE(enc.ok()) << enc.error().message;
+  auto& e = **enc;
+  EXPECT_EQ(e.counter_bits(), 64);
+  auto received = [&] {
+    std::uint64_t n = 0;
+    for (int w = 0; w < 4; ++w) n += e.wheel(w).received;
+    return n;
+  };
+  FlowControl flow{received};
+  QuadWriter l1{sim, 0, 1, &flow}, r1{sim, 2, 3, &flow}, l2{sim, 4, 5, &flow}, r2{sim, 6, 7, &flow};
+  EncoderSample s = e.read(0);  // every wheel's reference: the sides start at 0
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 0);
+  // Left wheels +100 and +200: mean 150; right -40 and -60: -50.
+  for (int i = 0; i < 200; ++i) {
+    if (i < 100) l1.step(+1);
+    l2.step(+1);
+    if (i < 40) r1.step(-1);
+    if (i < 60) r2.step(-1);
+  }
+  ASSERT_TRUE(wait_until([&] { return e.wheel(2).count == 200 && e.wheel(3).count == -60; }, 20));
+  ASSERT_TRUE(wait_until([&] { return e.wheel(0).count == 100 && e.wheel(1).count == -40; }, 5));
+  s = e.read(0);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 150);
+  EXPECT_EQ(s.right, -50);
+  // Left wheel 1 moves +30; left wheel 2's A toggles 41 times while the reader is held, until
+  // the decoder reports an invalid transition on it (up to 5 rounds, see above).
+  for (int i = 0; i < 30; ++i) l1.step(+1);
+  ASSERT_TRUE(wait_until([&] { return e.wheel(0).count == 130; }, 5));
+  bool a = (quad_state_at(l2.pos) & 2u) != 0;
+  const bool b = (quad_state_at(l2.pos) & 1u) != 0;
+  for (int round = 0; e.wheel(2).invalid == 0 && round < 5; ++round) {
+    e.hold(true);
+    std::this_thread::sleep_for(20ms);
+    for (int i = 1; i <= 41; ++i) ASSERT_TRUE(sim.pull(4, (i % 2 == 1) ? !a : a));
+    a = !a;
+    e.hold(false);
+    std::uint64_t seen = 0;
+    do {
+      seen = e.wheel(2).received;
+      std::this_thread::sleep_for(300ms);
+    } while (e.wheel(2).received != seen);
+  }
+  ASSERT_GE(e.wheel(2).invalid, 1u) << "no illegal transition detected in 5 rounds";
+  EXPECT_EQ(e.wheel(0).invalid, 0u);
+  // The read: left wheel 2 dropped, the side moved by wheel 1's +30 alone: 150 + 30.
+  s = e.read(0);
+  EXPECT_EQ(s.flags & (kEncoderWheelDropped | kEncoderInvalidTransition),
+            kEncoderWheelDropped | kEncoderInvalidTransition);
+  EXPECT_EQ(s.flags & (kEncoderStaleLeft | kEncoderStaleRight), 0u);
+  EXPECT_EQ(s.left, 180);
+  EXPECT_EQ(s.right, -50);
+  EXPECT_EQ(s.counters.wheel_drops, 1u);
+  // Next read: clean again, it takes its new reference; then both left wheels +20: 200.
+  s = e.read(0);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 180);
+  l2.pos = 0;
+  while (quad_state_at(l2.pos) != quad_state(a, b)) ++l2.pos;
+  flow.written = received();
+  const std::int64_t w1 = e.wheel(0).count, w2 = e.wheel(2).count;
+  for (int i = 0; i < 20; ++i) {
+    l1.step(+1);
+    l2.step(+1);
+  }
+  ASSERT_TRUE(
+      wait_until([&] { return e.wheel(0).count == w1 + 20 && e.wheel(2).count == w2 + 20; }, 5));
+  s = e.read(0);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 200);
+}
+
 TEST(GpioQuadratureKernel, BadLinesAreClearErrors) {
   ODO_REQUIRE_VM();
   GpioSim sim("odo_quad_bad", 5);

@@ -602,6 +602,21 @@ TEST(ZeroAlloc, SerialArduinoBridgeBackendTicksWithoutAllocating) {
   serial_backend_without_allocating(fw::SerialProtocol::kArduinoBridge);
 }
 
+// Issue 38: the diffodom link with two wheels per side (version 2 records from the simulated
+// board, each wheel unwrapped and combined by SideCombiner every tick) allocates nothing either.
+TEST(ZeroAlloc, SerialTwoWheelsPerSideTicksWithoutAllocating) {
+  fw::Config cfg = fw::default_config();
+  cfg.loop.rate_hz = 1000.0;
+  cfg.encoder.backend = fw::EncoderKind::kSerial;
+  cfg.encoder.side.wheels_per_side = 2;
+  cfg.encoder.side.read_period = 1e-3;
+  cfg.serial.link = fw::SerialLink::kSim;
+  loop::LoopSnapshot snap;
+  ASSERT_NO_FATAL_FAILURE(rig_ticks_without_allocating(cfg, snap));
+  EXPECT_EQ(snap.encoder_flags, 0u);
+  EXPECT_GT(snap.distance, 1.0);
+}
+
 TEST(ZeroAlloc, SerialPortOnAPtyReadsWithoutAllocating) {
   // The tty path itself: SerialPort (termios, its reader thread's ring drained by the loop) on a
   // kernel pseudo-terminal, diffodom records written into the master between reads.

@@ -510,6 +510,125 @@ TEST_F(CanEncoder, CreateRejectsMismatchedWidthsAndOverlaps) {
   EXPECT_FALSE(CanEncoderSource::create(port, cfg).ok());
 }
 
+// Two wheels per side (issue 38): ODrive nodes 0 and 2 on the left, 1 and 3 on the right.
+struct CanEncoderTwoPerSide : CanEncoder {
+  CanEncoderTwoPerSide() {
+    cfg.wheels.wheels_per_side = 2;
+    cfg.more_left[0] = odrive_count_layout(2);   // id 0x04A
+    cfg.more_right[0] = odrive_count_layout(3);  // id 0x06A
+  }
+};
+
+// Each side is the mean of its wheels' travel; each wheel's counter wraps on its own.
+TEST_F(CanEncoderTwoPerSide, SidesAreTheMeanOfTheirWheelsEachWrappingOnItsOwn) {
+  CanEncoderSource enc = make();
+  EXPECT_EQ(enc.counter_bits(), 64);  // the combined counts never wrap
+  // Before any frame: both sides stale at 0, and no wheel counted as dropped.
+  EncoderSample s = enc.read(1 * kMs);
+  EXPECT_EQ(s.flags, kEncoderStaleLeft | kEncoderStaleRight);
+  EXPECT_EQ(s.left, 0);
+  EXPECT_EQ(s.counters.wheel_drops, 0u);
+  // First frames: every wheel takes its reference, the sides start at 0. Left wheel 2 sits 47
+  // counts below the int32 maximum 2147483647.
+  port.inject(odrive(0, 1000, 5 * kMs));
+  port.inject(odrive(2, 2147483600, 5 * kMs));
+  port.inject(odrive(1, 50, 5 * kMs));
+  port.inject(odrive(3, 70, 5 * kMs));
+  s = enc.read(6 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 0);
+  EXPECT_EQ(s.right, 0);
+  EXPECT_EQ(s.stamp, 5 * kMs);
+  // 10 ms later: left +40 and +50 (wheel 2 wraps: 2147483600 + 50 - 2^32 = -2147483646),
+  // right -30 and -34 (all under the 150-count jump limit: 10 000 counts/s * (10 + 5) ms).
+  // Means: left (40 + 50) / 2 = 45, right (-30 - 34) / 2 = -32.
+  port.inject(odrive(0, 1040, 15 * kMs));
+  port.inject(odrive(2, -2147483646, 15 * kMs));
+  port.inject(odrive(1, 20, 15 * kMs));
+  port.inject(odrive(3, 36, 15 * kMs));
+  s = enc.read(16 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 45);
+  EXPECT_EQ(s.right, -32);
+  EXPECT_EQ(s.counters.wheel_drops, 0u);
+}
+
+// A wheel whose controller falls silent is dropped from its side once stale (flagged
+// wheel-dropped, not stale: its neighbour carries the side); it rejoins from its next frame
+// without its silent motion; a side whose wheels are all silent is stale.
+TEST_F(CanEncoderTwoPerSide, SilentWheelIsDroppedWhileTheOtherCarriesTheSide) {
+  CanEncoderSource enc = make();
+  // Every 10 ms from 10 ms: left wheels +20 counts per 10 ms, right wheels +10; left wheel 2
+  // (node 2) sends only at 10 ms until it comes back at 110 ms.
+  auto send = [&](TimeNs t, bool left2) {
+    const auto ms = static_cast<std::int32_t>(t / kMs) - 10;
+    port.inject(odrive(0, 2 * ms, t));
+    if (left2) port.inject(odrive(2, 2 * ms, t));
+    port.inject(odrive(1, ms, t));
+    port.inject(odrive(3, ms, t));
+  };
+  EncoderSample s;
+  for (TimeNs t = 10 * kMs; t <= 100 * kMs; t += 10 * kMs) {
+    send(t, t == 10 * kMs);
+    s = enc.read(t);
+    if (t <= 60 * kMs) {
+      // Node 2's newest frame (10 ms) is 50 ms old or less: fresh, and it holds the instant
+      // back at 10 ms, where every wheel's count is its first: both sides 0.
+      EXPECT_EQ(s.flags, 0u) << t;
+      EXPECT_EQ(s.stamp, 10 * kMs) << t;
+      EXPECT_EQ(s.left, 0) << t;
+    } else {
+      // Stale from 70 ms (60 ms > 50 ms): dropped; the left side is node 0 alone, at the read's
+      // frames: 2 * (t - 10 ms) counts; the right side (t - 10 ms).
+      EXPECT_EQ(s.flags, kEncoderWheelDropped) << t;
+      EXPECT_EQ(s.stamp, t) << t;
+      EXPECT_EQ(s.left, 2 * (t / kMs - 10)) << t;
+      EXPECT_EQ(s.right, t / kMs - 10) << t;
+    }
+  }
+  EXPECT_EQ(s.counters.wheel_drops, 1u);
+  EXPECT_EQ(s.counters.stale_events, 0u);  // the side never went stale
+  // Node 2 returns at 110 ms at 200 counts (its motion while silent): it takes that as its new
+  // reference; the left side is node 0's 200. From 120 ms both wheels count: +20 each, 220.
+  send(110 * kMs, true);
+  s = enc.read(110 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 200);
+  send(120 * kMs, true);
+  s = enc.read(120 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 220);
+  // Both left controllers silent, the right ones sending: from 180 ms (60 ms > 50 ms) the left
+  // side is stale and keeps 220; one side event, two more wheel drops.
+  for (TimeNs t = 130 * kMs; t <= 200 * kMs; t += 10 * kMs) {
+    port.inject(odrive(1, static_cast<std::int32_t>(t / kMs) - 10, t));
+    port.inject(odrive(3, static_cast<std::int32_t>(t / kMs) - 10, t));
+    s = enc.read(t);
+  }
+  EXPECT_EQ(s.flags & (kEncoderStaleLeft | kEncoderStaleRight), kEncoderStaleLeft);
+  EXPECT_EQ(s.left, 220);
+  EXPECT_EQ(s.right, 190);
+  EXPECT_EQ(s.counters.stale_events, 1u);
+  EXPECT_EQ(s.counters.wheel_drops, 3u);
+}
+
+TEST_F(CanEncoderTwoPerSide, CreateNamesTheWheelsThatOverlapAndTheWheelCount) {
+  cfg.more_left[0] = cfg.left;
+  auto e = CanEncoderSource::create(port, cfg);
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.error().message,
+            "left wheel 1 and left wheel 2 read the same bytes of the same frame");
+  cfg.more_left[0] = odrive_count_layout(2);
+  cfg.more_right[0].width_bits = 16;
+  e = CanEncoderSource::create(port, cfg);
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.error().message, "all wheels' counts must have the same width");
+  cfg.wheels.wheels_per_side = 5;
+  e = CanEncoderSource::create(port, cfg);
+  ASSERT_FALSE(e.ok());
+  EXPECT_EQ(e.error().message, "wheels_per_side 5 must be 1..4");
+}
+
 TEST(SimOdrive, PublishesCanSimpleEncoderCountFrames) {
   sim::SimCanPort port(8, 8);
   sim::SimOdrive od(port, sim::SimOdriveOptions{2, 5, 8192});

@@ -151,6 +151,67 @@ reverse_left = true
   EXPECT_FALSE(e.reverse_right);
 }
 
+// Several wheels per side (issue 38): a list per side, one node id (or frame id) per wheel.
+TEST(ConfigEncoders, ReadsCanEncoderWheelListsPerSide) {
+  auto c = parse_config(
+      "[encoder]\nbackend = \"can\"\nwheels_per_side = 2\n[can_encoder]\nnode_left = [0, 2]\n"
+      "node_right = [1, 3]\n",
+      "c.toml");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  const CanEncoderSection& e = c->can_encoder;
+  EXPECT_EQ(e.wheels_per_side, 2);
+  EXPECT_EQ(e.node_left, 0);
+  EXPECT_EQ(e.more_node_left[0], 2);
+  EXPECT_EQ(e.node_right, 1);
+  EXPECT_EQ(e.more_node_right[0], 3);
+  // Generic: one offset for the side's wheels, or a list as long as the ids.
+  c = parse_config(R"(
+[can_encoder]
+protocol = "generic"
+left_id = [0x100, 0x102, 0x104]
+right_id = [0x101, 0x101, 0x105]
+left_offset = 2
+right_offset = [0, 4, 0]
+)",
+                   "c.toml");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  const CanEncoderSection& g = c->can_encoder;
+  EXPECT_EQ(g.wheels_per_side, 3);
+  EXPECT_EQ(g.left_id, 0x100);
+  EXPECT_EQ(g.more_left_id[1], 0x104);
+  EXPECT_EQ(g.more_left_offset[0], 2);
+  EXPECT_EQ(g.more_left_offset[1], 2);
+  EXPECT_EQ(g.more_right_id[0], 0x101);
+  EXPECT_EQ(g.more_right_offset[0], 4);
+  // One integer is one wheel per side, as before.
+  c = parse_config("[can_encoder]\nnode_left = [4]\nnode_right = 5\n", "c.toml");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  EXPECT_EQ(c->can_encoder.wheels_per_side, 1);
+  EXPECT_EQ(c->can_encoder.node_left, 4);
+}
+
+TEST(ConfigEncoders, ReadsGpioLinePairsPerWheel) {
+  auto c = parse_config(R"(
+[encoder]
+backend = "gpio"
+wheels_per_side = 2
+[gpio]
+left_a = [17, 5]
+left_b = [18, 6]
+right_a = [22, 12]
+right_b = [23, 13]
+)",
+                        "c.toml");
+  ASSERT_TRUE(c.ok()) << c.error().message;
+  const GpioSection& g = c->gpio;
+  EXPECT_EQ(g.wheels_per_side, 2);
+  EXPECT_EQ(g.left_a, 17);
+  EXPECT_EQ(g.more_left_a[0], 5);
+  EXPECT_EQ(g.more_left_b[0], 6);
+  EXPECT_EQ(g.right_b, 23);
+  EXPECT_EQ(g.more_right_b[0], 13);
+}
+
 TEST(ConfigEncoders, CanGyroDefaults) {
   auto c = parse_config("[gyro]\nbackend = \"can\"\n", "g.toml");
   ASSERT_TRUE(c.ok()) << c.error().message;
@@ -298,6 +359,48 @@ INSTANTIATE_TEST_SUITE_P(
             "bad.toml:6: can_gyro.bus = \"sim\" with gyro.backend = \"can\" is a simulated gyro, "
             "which needs the simulated robot, but encoder.backend = \"can\" reads real "
             "hardware"}));
+
+INSTANTIATE_TEST_SUITE_P(
+    WheelLists, ConfigEncodersReject,
+    ::testing::Values(
+        Bad{"[can_encoder]\nnode_left = [0, 64]\n",
+            "bad.toml:2: can_encoder.node_left[1] = 64 is outside the allowed range [0, 63]"},
+        Bad{"[can_encoder]\nnode_left = [0, 2, 4, 6, 8]\n",
+            "bad.toml:2: can_encoder.node_left has 5 entries: give 1..4"},
+        Bad{"[can_encoder]\nnode_left = []\n",
+            "bad.toml:2: can_encoder.node_left has 0 entries: give 1..4"},
+        Bad{"[can_encoder]\nnode_left = [0, \"2\"]\n",
+            "bad.toml:2: can_encoder.node_left[1] must be an integer"},
+        Bad{"[can_encoder]\nnode_left = [0, 2]\nnode_right = 1\n",
+            "bad.toml:3: can_encoder.node_right lists 1 wheel(s) but node_left lists 2: both "
+            "sides need the same number of wheels"},
+        Bad{"[can_encoder]\nnode_left = [0, 2]\nnode_right = [1, 2]\n",
+            "bad.toml:3: can_encoder.node_right gives node id 2 to two wheels (each wheel needs "
+            "its own axis)"},
+        Bad{"[can_encoder]\nprotocol = \"generic\"\nleft_id = [0x100, 0x102]\n"
+            "right_id = [0x101, 0x103]\nleft_offset = [0, 4, 0]\n",
+            "bad.toml:5: can_encoder.left_offset lists 3 wheel(s) but left_id lists 2: give one "
+            "offset for all, or one per wheel"},
+        Bad{"[can_encoder]\nprotocol = \"generic\"\nleft_id = [0x100, 0x100]\n"
+            "right_id = [0x101, 0x103]\n",
+            "bad.toml:3: can_encoder.left_id puts two wheels on the same bytes (frame 256, offset "
+            "0)"},
+        Bad{"[encoder]\nbackend = \"can\"\nwheels_per_side = 2\n[can_encoder]\nnode_left = 0\n",
+            "bad.toml:5: can_encoder.node_left lists 1 wheel(s) but encoder.wheels_per_side = 2: "
+            "give one per wheel of the side"},
+        Bad{"[encoder]\nbackend = \"can\"\nwheels_per_side = 2\n[can_encoder]\n"
+            "protocol = \"generic\"\nleft_id = [1, 2, 3]\nright_id = [4, 5, 6]\n",
+            "bad.toml:6: can_encoder.left_id lists 3 wheel(s) but encoder.wheels_per_side = 2"},
+        Bad{"[gpio]\nleft_a = [17, 5]\nleft_b = 18\n",
+            "bad.toml:3: gpio.left_b lists 1 wheel(s) but left_a lists 2: one A/B pair per "
+            "wheel, both sides alike"},
+        Bad{"[encoder]\nbackend = \"gpio\"\nwheels_per_side = 2\n[gpio]\nleft_a = 17\n",
+            "bad.toml:5: gpio.left_a lists 1 wheel(s) but encoder.wheels_per_side = 2"},
+        Bad{"[gpio]\nright_b = [3, 1024]\n",
+            "bad.toml:2: gpio.right_b[1] = 1024 is outside the allowed range [0, 1023]"},
+        Bad{"[can_encoder]\nbus = \"sim\"\nnode_left = [0, 2]\nnode_right = [1, 3]\n",
+            "bad.toml:2: can_encoder.bus = \"sim\" simulates one ODrive axis per side: 2 wheels "
+            "per side need bus = \"socketcan\""}));
 
 // The simulated gyro goes with every simulated robot: encoder backend sim, or the counter chip
 // and the CAN motor controllers on their simulated buses.

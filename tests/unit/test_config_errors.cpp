@@ -319,9 +319,9 @@ TEST(ConfigErrors, EncoderSideWheelsNumbersFromTheCombinersTable) {
                "bad.toml:2: encoder.wheels_per_side = 5 is outside the allowed range [1, 4]");
   expect_error("[encoder]\nwheels_per_side = 0\n",
                "bad.toml:2: encoder.wheels_per_side = 0 is outside the allowed range [1, 4]");
-  expect_error("[encoder]\nbackend = \"gpio\"\nwheels_per_side = 2\n",
+  expect_error("[encoder]\nbackend = \"hctl1100\"\nwheels_per_side = 2\n",
                "bad.toml:3: encoder.wheels_per_side = 2 needs a backend that reads several "
-               "counters per side; backend \"gpio\" reads one");
+               "counters per side; backend \"hctl1100\" reads one");
   expect_error("[encoder]\ncombine = \"max\"\n", "encoder.combine");
   auto c = parse_config("[encoder]\nwheels_per_side = 4\ncombine = \"median\"\n", "ok.toml");
   ASSERT_TRUE(c.ok()) << c.error().message;

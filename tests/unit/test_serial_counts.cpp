@@ -179,6 +179,70 @@ TEST(SerialCountsDecoder, EveryErrorKind) {
   EXPECT_EQ(d.counts().right, 1);
 }
 
+// Version 2 (issue 38): two wheels per side, seq 0x0102, time 0x03040506 us, left wheels +1 and
+// +2, right wheels -1 and +3, left wheel 2 faulted (wheel_faults bit 1). Payload, little-endian:
+// 02 (version) 00 (flags) 02 01 (seq) 06 05 04 03 (time) 02 (wheels per side) 02 (faults)
+// 01 00 00 00, 02 00 00 00 (left) FF FF FF FF, 03 00 00 00 (right): 26 bytes; CRC 0xC26B (Python's
+// binascii.crc_hqx(payload, 0xFFFF)), sent 6B C2. COBS: 02 (the version byte then a zero),
+// 0A (9 bytes up to the zero after the first left count's 01), 02 02 .. as below.
+const Bytes kExampleFrameV2{0x02, 0x02, 0x0A, 0x02, 0x01, 0x06, 0x05, 0x04, 0x03, 0x02,
+                            0x02, 0x01, 0x01, 0x01, 0x02, 0x02, 0x01, 0x01, 0x06, 0xFF,
+                            0xFF, 0xFF, 0xFF, 0x03, 0x01, 0x01, 0x03, 0x6B, 0xC2, 0x00};
+
+TEST(SerialCountsFrame, Version2LayoutByHandAndRoundTrip) {
+  SerialCounts c{.seq = 0x0102, .time_us = 0x03040506, .left = 1, .right = -1, .flags = 0};
+  c.wheels_per_side = 2;
+  c.more_left[0] = 2;
+  c.more_right[0] = 3;
+  c.wheel_faults = 0x02;
+  std::array<std::uint8_t, kSerialCountsFrameMaxV2> buf{};
+  const std::size_t n = encode_serial_counts_v2(c, buf);
+  EXPECT_EQ(Bytes(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n)), kExampleFrameV2);
+  EXPECT_EQ(kSerialCountsFrameMaxV2, 46u);  // 4 wheels: 10 + 32 + 2 = 44, COBS +1, 0x00 +1
+  // A host reading several wheels decodes it; a version 1 host (the default decoder) finds it
+  // longer than any record it knows, as it always did.
+  SerialCountsDecoder several(true);
+  ASSERT_EQ(push_all(several, kExampleFrameV2), std::vector{SerialDecodeResult::kFrame});
+  const SerialCounts& d = several.counts();
+  EXPECT_EQ(d.wheels_per_side, 2);
+  EXPECT_EQ(d.seq, 0x0102);
+  EXPECT_EQ(d.time_us, 0x03040506u);
+  EXPECT_EQ(d.left, 1);
+  EXPECT_EQ(d.more_left[0], 2);
+  EXPECT_EQ(d.right, -1);
+  EXPECT_EQ(d.more_right[0], 3);
+  EXPECT_EQ(d.wheel_faults, 0x02);
+  SerialCountsDecoder v1;
+  EXPECT_EQ(push_all(v1, kExampleFrameV2), std::vector{SerialDecodeResult::kBadLength});
+  // An old board's version 1 record still decodes on the several-wheels decoder (one wheel).
+  ASSERT_EQ(push_all(several, kExampleFrame), std::vector{SerialDecodeResult::kFrame});
+  EXPECT_EQ(several.counts().wheels_per_side, 1);
+  EXPECT_EQ(several.counts().left, 1);
+  EXPECT_EQ(several.counts().right, -1);
+  // Four wheels per side, extremes; every fault bit.
+  c.wheels_per_side = 4;
+  c.more_left = {INT32_MIN, 0, INT32_MAX};
+  c.more_right = {-7, 8, -9};
+  c.wheel_faults = 0xFF;
+  const std::size_t n4 = encode_serial_counts_v2(c, buf);
+  EXPECT_EQ(n4, 46u);
+  ASSERT_EQ(push_all(several, Bytes(buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n4))),
+            std::vector{SerialDecodeResult::kFrame});
+  EXPECT_EQ(several.counts().more_left, c.more_left);
+  EXPECT_EQ(several.counts().more_right, c.more_right);
+  EXPECT_EQ(several.counts().wheel_faults, 0xFF);
+  // A version 2 record whose wheel count disagrees with its length: bad length (CRC good).
+  Bytes payload(26, 0);
+  payload[0] = 2;
+  payload[8] = 3;  // says 3 wheels: 10 + 24 = 34 bytes, not 26
+  EXPECT_EQ(push_all(several, frame_of(record_of(payload))),
+            std::vector{SerialDecodeResult::kBadLength});
+  payload[8] = 2;
+  payload[0] = 3;  // a version after 2
+  EXPECT_EQ(push_all(several, frame_of(record_of(payload))),
+            std::vector{SerialDecodeResult::kBadVersion});
+}
+
 TEST(SerialCountsDecoder, ResynchronisesAfterGarbage) {
   using R = SerialDecodeResult;
   SerialCountsDecoder d;

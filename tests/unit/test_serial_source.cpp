@@ -45,6 +45,11 @@ struct FakeLink final : ByteLink {
     in.insert(in.end(), f.begin(), f.begin() + static_cast<std::ptrdiff_t>(n));
   }
   void send(const std::string& s) { in.insert(in.end(), s.begin(), s.end()); }
+  void send_v2(const SerialCounts& c) {
+    std::array<std::uint8_t, kSerialCountsFrameMaxV2> f{};
+    const std::size_t n = encode_serial_counts_v2(c, f);
+    in.insert(in.end(), f.begin(), f.begin() + static_cast<std::ptrdiff_t>(n));
+  }
 };
 
 SerialSourceConfig stream_config() {
@@ -229,6 +234,73 @@ TEST(SerialSourceBridge, SixteenBitWrap) {
   // An int16 counter on the board wraps from 32767 to -32768: 32760 -> -32766 is +10 counts.
   link.send("-32766 0\r\n");
   EXPECT_EQ(src.read(20 * kMs).left, 32770);
+}
+
+// Two wheels per side (issue 38): version 2 records; each side the mean of its wheels' steps; a
+// wheel the board flags, or whose step is implausible, dropped for that read and re-referenced
+// after; a record of another wheel count is a link error.
+TEST(SerialSourceWheels, TwoPerSideMeanBoardFaultJumpAndWrongWheelCount) {
+  FakeLink link;
+  SerialSourceConfig cfg = stream_config();
+  cfg.wheels.wheels_per_side = 2;
+  SerialCountsSource src(link, cfg);
+  EXPECT_EQ(src.counter_bits(), 64);
+  auto v2 = [](std::uint16_t seq, std::int32_t l1, std::int32_t l2, std::int32_t r1,
+               std::int32_t r2, std::uint8_t faults = 0) {
+    SerialCounts c = rec(seq, 10'000u * seq, l1, r1);
+    c.wheels_per_side = 2;
+    c.more_left[0] = l2;
+    c.more_right[0] = r2;
+    c.wheel_faults = faults;
+    return c;
+  };
+  // Before any record: both sides stale at 0, no wheel drop counted.
+  EncoderSample s = src.read(0);
+  EXPECT_EQ(s.flags, kEncoderStaleLeft | kEncoderStaleRight);
+  EXPECT_EQ(s.counters.wheel_drops, 0u);
+  // The first record is every wheel's reference: the sides start at 0.
+  link.send_v2(v2(0, 100, 200, 10, 20));
+  s = src.read(1 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 0);
+  EXPECT_EQ(s.right, 0);
+  // Left +40 and +60: 50; right -10 and +10: 0.
+  link.send_v2(v2(1, 140, 260, 0, 30));
+  s = src.read(11 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 50);
+  EXPECT_EQ(s.right, 0);
+  // The board flags left wheel 2 (bit 1): its garbage count is dropped, wheel 1's +40 is the
+  // side's: 90.
+  link.send_v2(v2(2, 180, 999'999, 0, 30, 0x02));
+  s = src.read(21 * kMs);
+  EXPECT_EQ(s.flags, kEncoderWheelDropped);
+  EXPECT_EQ(s.left, 90);
+  EXPECT_EQ(s.counters.wheel_drops, 1u);
+  // Clean again: wheel 2 takes 1 000 100 as its new reference (rejoins next read): 90 + 40.
+  link.send_v2(v2(3, 220, 1'000'100, 0, 30));
+  s = src.read(31 * kMs);
+  EXPECT_EQ(s.flags, 0u);
+  EXPECT_EQ(s.left, 130);
+  // Both count: +40 and +50: 45 -> 175.
+  link.send_v2(v2(4, 260, 1'000'150, 0, 30));
+  s = src.read(41 * kMs);
+  EXPECT_EQ(s.left, 175);
+  // Left wheel 1 jumps +5000 (limit 1e5 counts/s * (10 + 20) ms + 1 = 3001): flagged, counted,
+  // dropped; wheel 2's +50 carries the side: 225.
+  link.send_v2(v2(5, 5260, 1'000'200, 0, 30));
+  s = src.read(51 * kMs);
+  EXPECT_EQ(s.flags, kEncoderImplausibleJump | kEncoderWheelDropped);
+  EXPECT_EQ(s.left, 225);
+  EXPECT_EQ(s.counters.implausible_jumps, 1u);
+  EXPECT_EQ(s.counters.wheel_drops, 2u);
+  // A version 1 record (one wheel per side) from a board that is not this robot's: a link error,
+  // the counts hold.
+  link.send(rec(6, 60'000, 1, 1));
+  s = src.read(61 * kMs);
+  EXPECT_EQ(s.flags & kEncoderLinkError, kEncoderLinkError);
+  EXPECT_EQ(s.left, 225);
+  EXPECT_EQ(s.counters.link_errors, 1u);
 }
 
 }  // namespace

@@ -39,14 +39,25 @@
 //   last frame is real motion (the counts are cumulative) unless it is implausible;
 // - optionally sends a remote request (RTR) for each wheel's id at request_period, for
 //   controllers that answer only on request; a dropped request is counted, never waited for.
+//
+// Several wheels per side (issue 38, wheels.wheels_per_side = N in 2..4, e.g. one ODrive axis per
+// wheel of a 4WD base): every wheel is read as above on its own layout (its own frames, stamps,
+// jump check and wrap); a wheel is stale on its own and is then dropped from its side (faulted),
+// the side is stale only when all its wheels are; the instant is the oldest newest frame of the
+// fresh wheels, except that a wheel silent for longer than the others' kept frames (kHistory)
+// is dropped at once rather than holding the instant back until it is stale (mark_lagging); the
+// side's count is SideCombiner's (hal/side_wheels.hpp: wrap-aware per wheel,
+// 64-bit, never wraps), so counter_bits() is 64. N = 1 is exactly the two-wheel source above.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <optional>
 
 #include "odo/hal/can_bus.hpp"
 #include "odo/hal/encoder.hpp"
 #include "odo/hal/result.hpp"
+#include "odo/hal/side_wheels.hpp"
 #include "odo/hal/time.hpp"
 
 namespace odo::drivers {
@@ -93,7 +104,19 @@ struct CanEncoderConfig {
   double max_counts_per_s = 1e6;  // physical maximum count rate of a wheel [counts/s]
   int max_frames_per_read = 64;   // frames taken from the bus per read, 1..4096
   TimeNs request_period = 0;      // [ns] between remote requests, 0 = never (cyclic senders)
+  // N wheels per side: `left`/`right` are wheel 0 of each side, more_left[k - 1] /
+  // more_right[k - 1] wheel k (k < wheels.wheels_per_side); reverse_* applies to a whole side.
+  // wheels.counter_bits is set by create() to the layouts' width.
+  SideWheelsConfig wheels;
+  std::array<CanCountLayout, kMaxWheelsPerSide - 1> more_left{};
+  std::array<CanCountLayout, kMaxWheelsPerSide - 1> more_right{};
 };
+
+// can_wheel_count: the number of wheels of `cfg`, both sides (2 * wheels_per_side).
+int can_wheel_count(const CanEncoderConfig& cfg) noexcept;
+// can_wheel_layout: the layout of wheel `i` (0..can_wheel_count - 1): side i % 2 (0 left,
+// 1 right), wheel i / 2 of that side; so wheels 0 and 1 are `left` and `right`.
+const CanCountLayout& can_wheel_layout(const CanEncoderConfig& cfg, int i) noexcept;
 
 // Per-source diagnostics beyond EncoderCounters.
 struct CanEncoderStats {
@@ -114,18 +137,25 @@ class CanEncoderSource final : public EncoderSource {
 
   // read: drains frames and reports both wheels; see the header comment.
   EncoderSample read(TimeNs now) noexcept override;
-  // counter_bits: the width of the configured count field.
-  int counter_bits() const noexcept override { return cfg_.left.width_bits; }
+  // counter_bits: the width of the configured count field; 64 with N > 1 wheels per side (the
+  // combined counts never wrap).
+  int counter_bits() const noexcept override {
+    return cfg_.wheels.wheels_per_side > 1 ? 64 : cfg_.left.width_bits;
+  }
 
   const CanEncoderStats& stats() const noexcept { return stats_; }
-  // last_frame: receive stamp of the newest accepted frame of wheel 0 (left) or 1 (right) [ns];
-  // 0 before the first.
+  // last_frame: receive stamp of the newest accepted frame of wheel `wheel` (can_wheel_layout's
+  // numbering: 0 left, 1 right, 2 the left side's second, ...) [ns]; 0 before the first.
   TimeNs last_frame(int wheel) const noexcept {
-    return wheel_[wheel == 0 ? 0 : 1].primed ? wheel_[wheel == 0 ? 0 : 1].last_stamp : 0;
+    const Wheel& w = wheel_[static_cast<std::size_t>(wheel_index(wheel))];
+    return w.primed ? w.last_stamp : 0;
   }
 
  private:
   CanEncoderSource(CanBus& bus, const CanEncoderConfig& cfg) : bus_(&bus), cfg_(cfg) {}
+  int wheel_index(int wheel) const noexcept {
+    return wheel >= 0 && wheel < can_wheel_count(cfg_) ? wheel : (wheel == 0 ? 0 : 1);
+  }
   // Frames of one wheel kept for interpolation: a wheel may lag the other by up to
   // kHistory - 1 of its frames before its count at the common instant is clamped to the oldest.
   static constexpr std::size_t kHistory = 8;
@@ -139,6 +169,7 @@ class CanEncoderSource final : public EncoderSource {
     TimeNs last_stamp = 0;      // receive time of the newest frame [ns]
     bool primed = false;        // a frame has arrived
     bool stale = true;          // flagged stale at the last read
+    bool lagging = false;       // N > 1: left out of the last read (mark_lagging)
     std::array<Stamped, kHistory> history{};  // ring; newest at `newest`
     std::size_t newest = 0;
     std::size_t kept = 0;  // valid entries, 0..kHistory
@@ -150,10 +181,20 @@ class CanEncoderSource final : public EncoderSource {
   // count_at: wheel `w`'s reported count at `t` [ns]: interpolated between the frames around t,
   // the newest count after the newest frame, the oldest kept before the oldest.
   std::int64_t count_at(const Wheel& w, TimeNs t) const noexcept;
+  // mark_lagging: N > 1 wheels per side: a fresh wheel whose newest frame is older than another
+  // fresh wheel's oldest kept frame would hold the instant where that wheel's count is clamped
+  // (its travel half-weighted in its side's mean until the silent wheel is stale): it is left
+  // out of this read (faulted: dropped) unless every fresh wheel of its side lags.
+  void mark_lagging() noexcept;
+  // sample_time: the instant of this read (see the header comment); marks stale wheels.
+  TimeNs sample_time(TimeNs now, std::uint32_t& flags) noexcept;
+  // combine: N > 1 wheels per side: each wheel's count at `t` into SideCombiner.
+  void combine(TimeNs t, EncoderSample& s) noexcept;
 
   CanBus* bus_;
   CanEncoderConfig cfg_;
-  std::array<Wheel, 2> wheel_{};
+  std::optional<SideCombiner> combiner_;  // with wheels_per_side > 1
+  std::array<Wheel, 2 * kMaxWheelsPerSide> wheel_{};
   EncoderCounters counters_;
   CanEncoderStats stats_;
   TimeNs next_request_ = 0;

@@ -4,15 +4,23 @@
 // a QuadTracker; counts and fault counters reach the loop through atomics (no locks). An
 // optional index line per wheel latches the count at its rising edge. libgpiod types stay in
 // the .cpp.
+//
+// Several wheels per side (issue 38, wheels.wheels_per_side = N > 1): one A/B pair (and optional
+// index) per wheel, each decoded on its own; a wheel whose lines gave an invalid transition since
+// the last read is faulted for that read (dropped from its side), and SideCombiner forms the
+// sides' counts. N = 1 is exactly the two-wheel encoder above.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "odo/hal/encoder.hpp"
 #include "odo/hal/result.hpp"
+#include "odo/hal/side_wheels.hpp"
 #include "odo/hal/time.hpp"
 
 namespace odo::drivers {
@@ -42,7 +50,15 @@ struct GpioQuadratureConfig {
   // counts a difference as lost edges [ns].
   TimeNs idle_check = 50'000'000;
   std::string consumer = "odometryd";
+  // N wheels per side: `left`/`right` are wheel 0 of each side, more_left[k - 1] /
+  // more_right[k - 1] wheel k; counter_bits is set to 64 by open().
+  SideWheelsConfig wheels;
+  std::array<GpioWheelLines, kMaxWheelsPerSide - 1> more_left{};
+  std::array<GpioWheelLines, kMaxWheelsPerSide - 1> more_right{};
 };
+
+// gpio_wheel_lines: the lines of wheel `i` (0..2 N - 1): side i % 2 (0 left), wheel i / 2.
+const GpioWheelLines& gpio_wheel_lines(const GpioQuadratureConfig& cfg, int i) noexcept;
 
 // Diagnostics of one wheel, read from the atomics.
 struct GpioWheelStats {
@@ -77,7 +93,9 @@ class GpioQuadratureEncoder final : public EncoderSource {
   EncoderSample read(TimeNs now) noexcept override;
   int counter_bits() const noexcept override { return 64; }
 
-  GpioWheelStats wheel(int i) const noexcept;  // 0 left, 1 right
+  // wheel: diagnostics of wheel i (gpio_wheel_lines' numbering: 0 left, 1 right, 2 the left
+  // side's second, ...).
+  GpioWheelStats wheel(int i) const noexcept;
   // hold: diagnostics/tests: while held the thread reads no events (the kernel queue fills and
   // overflows as it would under an overloaded CPU).
   void hold(bool on) noexcept;
@@ -85,8 +103,13 @@ class GpioQuadratureEncoder final : public EncoderSource {
  private:
   struct Impl;
   explicit GpioQuadratureEncoder(std::unique_ptr<Impl> impl);
+  // combine: several wheels per side: each wheel's count and fault into SideCombiner.
+  void combine(bool failed, EncoderSample& s) noexcept;
   std::unique_ptr<Impl> impl_;
   std::uint64_t last_invalid_ = 0;
+  // Several wheels per side: each wheel's invalid count at the last read; the combiner.
+  std::array<std::uint64_t, 2 * kMaxWheelsPerSide> wheel_invalid_{};
+  std::optional<SideCombiner> combiner_;
 };
 
 }  // namespace odo::drivers

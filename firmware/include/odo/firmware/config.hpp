@@ -2,6 +2,7 @@
 // the line, the field and the allowed range.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -192,6 +193,13 @@ struct GpioSection {
   int batch = 64;                // events per read, 1..1024
   double reorder_window = 0.02;  // [s] 0..0.1
   double idle_check = 0.05;      // [s] 0.01..10
+  // Several wheels per side (issue 38): left_a = [17, 5] etc. give one A/B pair per wheel; the
+  // fields above are wheel 1 of each side (the index lines too), more_*[k - 2] wheel k.
+  int wheels_per_side = 1;  // the lists' length
+  std::array<int, kMaxWheelsPerSide - 1> more_left_a{};
+  std::array<int, kMaxWheelsPerSide - 1> more_left_b{};
+  std::array<int, kMaxWheelsPerSide - 1> more_right_a{};
+  std::array<int, kMaxWheelsPerSide - 1> more_right_b{};
 };
 
 // [can_encoder]: wheel encoder counts that motor controllers publish on CAN. bus = "socketcan":
@@ -218,6 +226,16 @@ struct CanEncoderSection {
   int width = 32;         // [bits] 16, 24, ..., 64
   bool is_signed = true;  // key "signed"
   ByteOrder byte_order = ByteOrder::kLittle;
+  // Several wheels per side (issue 38): node_left = [0, 2] (odrive) or left_id = [0x100, 0x102]
+  // (generic, with left_offset one offset for all or a list as long) gives the side's wheels;
+  // the fields above are wheel 1 of each side, more_*[k - 2] wheel k. Both sides alike.
+  int wheels_per_side = 1;  // the lists' length, 1..kMaxWheelsPerSide
+  std::array<int, kMaxWheelsPerSide - 1> more_node_left{};
+  std::array<int, kMaxWheelsPerSide - 1> more_node_right{};
+  std::array<std::int64_t, kMaxWheelsPerSide - 1> more_left_id{};
+  std::array<std::int64_t, kMaxWheelsPerSide - 1> more_right_id{};
+  std::array<int, kMaxWheelsPerSide - 1> more_left_offset{};
+  std::array<int, kMaxWheelsPerSide - 1> more_right_offset{};
   // bus = "sim" only
   double sim_period = 0.01;           // [s] cyclic message period of the simulated controllers
   double sim_stop_left_after = -1.0;  // [s] the left axis stops sending after this; < 0 never
@@ -277,7 +295,8 @@ struct EncoderSection {
 // backend_carries_side_wheels: whether encoder backend `be` reads several counters per side
 // (encoder.wheels_per_side > 1 is refused for the others).
 constexpr bool backend_carries_side_wheels(EncoderKind be) {
-  return be == EncoderKind::kSim;
+  return be == EncoderKind::kSim || be == EncoderKind::kCan || be == EncoderKind::kSerial ||
+         be == EncoderKind::kGpio;
 }
 
 // [realtime]: how the loop thread is made real-time at start (each part reported at start).

@@ -12,13 +12,20 @@
 
 #include "odo/firmware/config.hpp"
 #include "odo/hal/time.hpp"
+#include "odo/protocol/serial_counts.hpp"
 
 namespace odo::fw {
 
 class SerialPeerModel {
  public:
   static constexpr std::size_t kMaxOut = 64;  // bytes one call may produce
-  explicit SerialPeerModel(SerialProtocol p) noexcept : protocol_(p) {}
+  // wheels_per_side > 1 (diffodom): version 2 records with that many counts per side, every
+  // wheel of a side at the side's count (wheels alike) unless faulted (set_wheel_faults).
+  explicit SerialPeerModel(SerialProtocol p, int wheels_per_side = 1) noexcept
+      : protocol_(p), wheels_(wheels_per_side) {}
+  // set_wheel_faults: the wheels the board flags faulted from now on (version 2 wheel_faults
+  // bits: k left wheel k, 4 + k right wheel k); a faulted wheel's count is sent as garbage.
+  void set_wheel_faults(std::uint8_t bits) noexcept { wheel_faults_ = bits; }
 
   // on_host_bytes: bytes the host wrote (arduino-bridge commands; diffodom ignores them).
   void on_host_bytes(std::span<const std::uint8_t> in) noexcept;
@@ -35,7 +42,13 @@ class SerialPeerModel {
   std::int64_t reported_right(std::int64_t right) const noexcept { return right - base_right_; }
 
  private:
+  // sample_wheels: record `c` (wheel 1 of each side filled) as version 2 with wheels_ per side.
+  std::size_t sample_wheels(protocol::SerialCounts& c,
+                            std::span<std::uint8_t, kMaxOut> out) noexcept;
+
   SerialProtocol protocol_;
+  int wheels_ = 1;
+  std::uint8_t wheel_faults_ = 0;
   std::int64_t base_left_ = 0;  // counts at the last reset / "r"
   std::int64_t base_right_ = 0;
   TimeNs boot_ = 0;  // clock of the last reset

@@ -33,6 +33,10 @@ class TableReader {
     return integer(row.key, def, static_cast<std::int64_t>(row.lo),
                    static_cast<std::int64_t>(row.hi));
   }
+  // integers: an integer (read as a list of one) or an array of 1..max_count integers, each in
+  // [lo, hi]; errors name the element (key[i]) and its line. Absent: `def`.
+  std::vector<std::int64_t> integers(std::string_view key, std::vector<std::int64_t> def,
+                                     std::int64_t lo, std::int64_t hi, std::size_t max_count);
   bool boolean(std::string_view key, bool def);
   std::string string(std::string_view key, std::string def);
   // strings: an array of strings (may be empty).

@@ -20,13 +20,21 @@
 // exactly 0: the counts are re-based, the motion since the boot kept: a jump, not a spin),
 // reconnects, stale (no valid sample within the timeout, a board that never answers), and
 // kEncoderNoValidData while bytes arrive but none is valid (the typical sign of a wrong baud rate).
+//
+// Several wheels per side (issue 38, wheels.wheels_per_side = N > 1, diffodom only): records of
+// version 2 with N counts per side; each wheel is unwrapped from its side's width on its own, a
+// wheel the board flags faulted (wheel_faults) or whose step is implausible is faulted for that
+// read (dropped from its side by SideCombiner, which forms the sides' counts); a record with
+// another N is a link error. N = 1 is exactly the two-wheel source above.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <optional>
 
 #include "odo/hal/byte_link.hpp"
 #include "odo/hal/encoder.hpp"
+#include "odo/hal/side_wheels.hpp"
 #include "odo/hal/time.hpp"
 #include "odo/odometry/clock_map.hpp"
 #include "odo/protocol/serial_counts.hpp"
@@ -51,6 +59,9 @@ struct SerialSourceConfig {
   TimeNs poll_period = 10'000'000;      // [ns] arduino-bridge: between "e" requests
   double max_counts_per_s = 1e6;        // physical maximum count rate of a wheel [counts/s]
   TimeNs clock_window = 1'000'000'000;  // [ns] diffodom: ClockMap window
+  // Wheels per side and their combination (wheels_per_side > 1: diffodom version 2 records;
+  // counter_bits is set to 64 by the source: each wheel is unwrapped on its own first).
+  SideWheelsConfig wheels;
 };
 
 // Per-source diagnostics beyond EncoderCounters.
@@ -87,6 +98,10 @@ class SerialCountsSource final : public EncoderSource {
   void on_line(TimeNs now, TimeNs arrival, std::uint32_t& flags) noexcept;
   void on_record(const SerialCounts& c, TimeNs now, TimeNs arrival, std::uint32_t& flags) noexcept;
   void accept(std::int64_t left, std::int64_t right, TimeNs stamp, std::uint32_t& flags) noexcept;
+  // accept_wheels: a version 2 record's N counts per side (wheels_per_side > 1).
+  void accept_wheels(const SerialCounts& c, TimeNs stamp, std::uint32_t& flags) noexcept;
+  // combine: wheels_per_side > 1: the wheels' counts and this read's faults into SideCombiner.
+  void combine(EncoderSample& s) noexcept;
   void link_error(bool crc, std::uint32_t& flags) noexcept;
   void poll(TimeNs now) noexcept;
 
@@ -94,6 +109,7 @@ class SerialCountsSource final : public EncoderSource {
     std::int64_t count = 0;     // unwrapped, reported
     std::int64_t last_raw = 0;  // last reading (after reverse), `bits` wide
     int bits = 32;
+    bool faulted = false;  // several wheels: the board flagged it in the last record
   };
 
   ByteLink* link_;
@@ -109,9 +125,12 @@ class SerialCountsSource final : public EncoderSource {
   bool awaiting_ = false;  // arduino-bridge: a request is out
   TimeNs request_time_ = 0;
   TimeNs next_poll_ = 0;
-  std::array<Wheel, 2> wheel_{};
-  bool primed_ = false;       // a valid sample arrived (ever)
-  bool have_record_ = false;  // diffodom: seq/time of the previous record are valid
+  // Wheel i: side i % 2 (0 left), wheel i / 2 of that side (two wheels: 0 left, 1 right).
+  std::array<Wheel, 2 * kMaxWheelsPerSide> wheel_{};
+  std::optional<SideCombiner> combiner_;  // wheels_per_side > 1
+  std::uint8_t read_faults_ = 0;          // wheels faulted since the last read (wheel_faults bits)
+  bool primed_ = false;                   // a valid sample arrived (ever)
+  bool have_record_ = false;              // diffodom: seq/time of the previous record are valid
   std::uint16_t last_seq_ = 0;
   std::uint32_t last_time_us_ = 0;
   std::uint8_t last_flags_ = 0;
