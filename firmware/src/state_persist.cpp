@@ -146,6 +146,9 @@ std::uint32_t gyro_id(const Config& cfg) {
 }
 
 bool counters_survive_restart(const Config& cfg) {
+  // Several encoders per side: the sides' counts are this process's combination of the wheels'
+  // deltas (hal/side_wheels.hpp), from 0 at its start, not a counter that kept counting.
+  if (cfg.encoder.side.wheels_per_side > 1) return false;
   switch (cfg.encoder.backend) {
     case EncoderKind::kHctl1100:
       return cfg.hctl1100.bus == HctlBus::kGpio;

@@ -59,6 +59,14 @@ TEST(StatePersist, OnlyCountersThatKeepCountingResume) {
   EXPECT_FALSE(counters_survive_restart(c));
   c.can_encoder.bus = CanEncoderBus::kSocketCan;  // the controllers' own counters
   EXPECT_TRUE(counters_survive_restart(c));
+  // Two wheels per side: the sides' counts are this process's combination, from 0 at its start.
+  c.encoder.side.wheels_per_side = 2;
+  EXPECT_FALSE(counters_survive_restart(c));
+  c.encoder.backend = EncoderKind::kSerial;
+  c.serial.link = SerialLink::kTty;
+  EXPECT_FALSE(counters_survive_restart(c));
+  c.encoder.side.wheels_per_side = 1;
+  EXPECT_TRUE(counters_survive_restart(c));
 }
 
 // A learnt bias belongs to one gyro: whatever changes the meaning of its rate makes another id;
