@@ -28,7 +28,8 @@ Result<Kinematics> Kinematics::create(const KinematicParams& p) {
                   check_range(bad, "wheelbase_nominal", "m", p.wheelbase_nominal, L::kWheelbase) &&
                   check_range(bad, "wheelbase", "m", p.wheelbase, L::kWheelbase) &&
                   check_range(bad, "c_l", "", p.c_l, L::kFactor) &&
-                  check_range(bad, "c_r", "", p.c_r, L::kFactor);
+                  check_range(bad, "c_r", "", p.c_r, L::kFactor) &&
+                  check_range(bad, "x_icr", "m", p.x_icr, L::kXIcr);
   if (!ok) return range_error(std::move(*bad));
   return Kinematics(p);
 }

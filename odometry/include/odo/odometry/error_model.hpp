@@ -150,6 +150,10 @@ class PoseCovariance {
   // variance var_heading [rad^2] (gyrodometry.hpp propagate_gyro_arc; defined there).
   void step_gyro_sc(double sin_theta0, double cos_theta0, double d_left, double d_right,
                     double dtheta, double var_heading) noexcept;
+  // shift_point: flush, then make cov() that of the pose of the point e [m] ahead of the one it
+  // was of, on the body's x axis, at heading (sin_theta, cos_theta) (a skid-steer base's
+  // instantaneous centre of rotation, Odometry::advance).
+  void shift_point(double sin_theta, double cos_theta, double e) noexcept;
   // flush: propagate the ticks merged so far (none: nothing), so that cov() includes them.
   void flush() noexcept;
   // pending_ticks: ticks merged but not yet in cov() (0 with covariance_ticks = 1).

@@ -64,6 +64,11 @@ inline HalfAngle half_angle(double h) noexcept {
 // of a base with wheelbase b [m]; stable for any turn, including none and on-the-spot.
 Pose2 arc_step(const Pose2& p, double d_left, double d_right, double b) noexcept;
 
+// arc_step_icr: arc_step for a skid-steer base whose instantaneous centre of rotation lies x_icr
+// [m] ahead of the centre point (Mandow et al. 2007): the centre also slides sideways by
+// -x_icr * dtheta over the arc. arc_step when x_icr is 0.
+Pose2 arc_step_icr(const Pose2& p, double d_left, double d_right, double b, double x_icr) noexcept;
+
 // report_step: UMBmark report Eq. 2.3-2.6 (heading updated first, then a straight chord along
 // the new heading); kept for comparison with the exact arc.
 Pose2 report_step(const Pose2& p, double d_left, double d_right, double b) noexcept;
@@ -121,6 +126,10 @@ class PoseIntegrator {
   // step_arc: advance along an arc of centre travel ds [m] and heading change dtheta [rad] (a
   // heading from elsewhere, e.g. the gyrodometry fusion; step() is step_arc of the wheels').
   void step_arc(double ds, double dtheta) noexcept;
+  // step_arc_icr: step_arc of a body whose instantaneous centre of rotation lies x_icr [m] ahead
+  // of the centre point, so that the centre slides sideways by -x_icr * dtheta [m] (x_icr != 0;
+  // the tick keeps step_arc for the plain base).
+  void step_arc_icr(double ds, double dtheta, double x_icr) noexcept;
   const Pose2& pose() const noexcept { return pose_; }
   double sin_theta() const noexcept { return heading_.sin(); }
   double cos_theta() const noexcept { return heading_.cos(); }
@@ -148,6 +157,10 @@ class Odometry {
     // and cosine of it spare a trigonometric call.
     const double s0 = sin_theta(), c0 = cos_theta();
     update(dn_left, dn_right, dt);
+    if (k_.x_icr() != 0.0) [[unlikely]] {
+      step_covariance_icr(s0, c0, false, 0.0);
+      return;
+    }
     // update's heading change is (d_R - d_L) / b: the covariance's phi, already divided.
     cov_.step_sc_phi(s0, c0, d_left_, d_right_, k_.wheelbase(), dth_);
   }
@@ -174,6 +187,10 @@ class Odometry {
   void advance_travel(double d_l, double d_r, double dt) noexcept {
     const double s0 = sin_theta(), c0 = cos_theta();
     update_travel(d_l, d_r, dt);
+    if (k_.x_icr() != 0.0) [[unlikely]] {
+      step_covariance_icr(s0, c0, false, 0.0);
+      return;
+    }
     cov_.step_sc_phi(s0, c0, d_left_, d_right_, k_.wheelbase(), dth_);
   }
   // update_travel: update() from wheel travels d_l, d_r [m] (the pose only).
@@ -206,8 +223,12 @@ class Odometry {
 
  private:
   // integrate: one tick of wheel travels d_l, d_r [m], centre travel ds [m] and heading change
-  // dth [rad].
+  // dth [rad] (with the kinematics' sideways slide -x_icr * dth when x_icr != 0).
   void integrate(double d_l, double d_r, double ds, double dth, double dt) noexcept;
+  // step_covariance_icr: the covariance step of the last tick (started at heading s0, c0) for
+  // x_icr != 0: the plain arc's (gyro_heading: the gyro's, var_heading [rad^2]) about the
+  // instantaneous centre of rotation (PoseCovariance::shift_point).
+  void step_covariance_icr(double s0, double c0, bool gyro_heading, double var_heading) noexcept;
   Kinematics k_;
   PoseCovariance cov_;
   PoseIntegrator integ_;
