@@ -161,6 +161,23 @@ TEST(OdometryIcr, SpotTurnMovesCentreAlongChordAboutTheIcr) {
   EXPECT_NEAR(m.pose().y, -0.05, 1e-13);
 }
 
+TEST(OdometryIcr, GyroHeadingDrivesTheSlide) {
+  // A spot turn whose heading change comes from the gyro (pi/2) while the wheels claim more
+  // (d = +-0.5 m on b = 0.5: 2 rad): the slide is -x_icr times the fused dtheta, so the centre
+  // ends at (0.05, -0.05) as in the wheels' spot turn above. The covariance, shifted to the ICR
+  // and back, grows and stays symmetric.
+  Odometry o = skid_odometry(0.05);
+  o.advance_fused(-0.5, 0.5, 0.01, kPi / 2, 0.0, true, 1e-4);
+  EXPECT_NEAR(o.pose().x, 0.05, 1e-15);
+  EXPECT_NEAR(o.pose().y, -0.05, 1e-15);
+  const Cov3& c = o.covariance();
+  EXPECT_GT(c[0], 0.0);
+  EXPECT_GT(c[8], 0.0);
+  EXPECT_EQ(c[1], c[3]);
+  EXPECT_EQ(c[2], c[6]);
+  EXPECT_EQ(c[5], c[7]);
+}
+
 TEST(OdometryIcr, QuarterArcRotatesAboutTheOffsetCentre) {
   // R = ds/dtheta = 1 m to the left, b = 0.5, dtheta = pi/2: d_L = (1 - 0.25) pi/2,
   // d_R = (1 + 0.25) pi/2. Centre of rotation at body (0.05, 1); the centre's offset from it,
