@@ -42,6 +42,7 @@ Kinematics::Kinematics(const KinematicParams& p) : p_(p) {
   c_m_ = std::numbers::pi * p.wheel_diameter / (p.gear_ratio * p.counts_per_rev);
   m_per_count_l_ = p.c_l * c_m_;
   m_per_count_r_ = p.c_r * c_m_;
+  skid_ = p.x_icr != 0.0;
 }
 
 }  // namespace odo

@@ -70,8 +70,8 @@ void PoseIntegrator::step_arc_icr(double ds, double dth, double x_icr) noexcept 
 
 // flatten: the integrator's step inlined into the tick's pose update (a call would spill the
 // values the update still needs around it; other callers keep the out-of-line step_arc).
-[[gnu::flatten]] void Odometry::update(std::int64_t dn_left, std::int64_t dn_right,
-                                       double dt) noexcept {
+[[gnu::flatten]] void Odometry::update_plain(std::int64_t dn_left, std::int64_t dn_right,
+                                             double dt) noexcept {
   const double d_l = static_cast<double>(dn_left) * k_.metres_per_count_left();  // Eq. 6.35
   const double d_r = static_cast<double>(dn_right) * k_.metres_per_count_right();
   // update_fused() with ds_correction 0 adds 0.0 to the mean travel, which changes no bits here:
@@ -80,25 +80,48 @@ void PoseIntegrator::step_arc_icr(double ds, double dth, double x_icr) noexcept 
   integrate(d_l, d_r, 0.5 * (d_l + d_r), (d_r - d_l) / k_.wheelbase(), dt);
 }
 
-[[gnu::flatten]] void Odometry::update_travel(double d_l, double d_r, double dt) noexcept {
+[[gnu::flatten]] void Odometry::update_travel_plain(double d_l, double d_r, double dt) noexcept {
   integrate(d_l, d_r, 0.5 * (d_l + d_r), (d_r - d_l) / k_.wheelbase(), dt);
+}
+
+void Odometry::update_skid(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
+  const double d_l = static_cast<double>(dn_left) * k_.metres_per_count_left();
+  const double d_r = static_cast<double>(dn_right) * k_.metres_per_count_right();
+  integrate_skid(d_l, d_r, 0.5 * (d_l + d_r), (d_r - d_l) / k_.wheelbase(), dt);
+}
+
+void Odometry::advance_skid(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
+  const double s0 = sin_theta(), c0 = cos_theta();
+  update_skid(dn_left, dn_right, dt);
+  step_covariance_icr(s0, c0, false, 0.0);
+}
+
+void Odometry::advance_travel_skid(double d_l, double d_r, double dt) noexcept {
+  const double s0 = sin_theta(), c0 = cos_theta();
+  integrate_skid(d_l, d_r, 0.5 * (d_l + d_r), (d_r - d_l) / k_.wheelbase(), dt);
+  step_covariance_icr(s0, c0, false, 0.0);
 }
 
 void Odometry::update_fused(std::int64_t dn_left, std::int64_t dn_right, double dt, double dtheta,
                             double ds_correction) noexcept {
   const double d_l = static_cast<double>(dn_left) * k_.metres_per_count_left();
   const double d_r = static_cast<double>(dn_right) * k_.metres_per_count_right();
+  if (k_.skid()) [[unlikely]] {
+    integrate_skid(d_l, d_r, 0.5 * (d_l + d_r) + ds_correction, dtheta, dt);
+    return;
+  }
   integrate(d_l, d_r, 0.5 * (d_l + d_r) + ds_correction, dtheta, dt);
 }
 
 void Odometry::advance_fused(double d_l, double d_r, double dt, double dtheta, double ds_correction,
                              bool gyro_heading, double var_heading) noexcept {
   const double s0 = sin_theta(), c0 = cos_theta();
-  integrate(d_l, d_r, 0.5 * (d_l + d_r) + ds_correction, dtheta, dt);
-  if (k_.x_icr() != 0.0) [[unlikely]] {
+  if (k_.skid()) [[unlikely]] {
+    integrate_skid(d_l, d_r, 0.5 * (d_l + d_r) + ds_correction, dtheta, dt);
     step_covariance_icr(s0, c0, gyro_heading, var_heading);
     return;
   }
+  integrate(d_l, d_r, 0.5 * (d_l + d_r) + ds_correction, dtheta, dt);
   if (gyro_heading) {
     cov_.step_gyro_sc(s0, c0, d_left_, d_right_, dtheta, var_heading);
   } else {
@@ -121,16 +144,19 @@ void Odometry::step_covariance_icr(double s0, double c0, bool gyro_heading,
 }
 
 void Odometry::integrate(double d_l, double d_r, double ds, double dth, double dt) noexcept {
+  integ_.step_arc(ds, dth);
+  record(d_l, d_r, ds, dth, dt);
+}
+
+void Odometry::integrate_skid(double d_l, double d_r, double ds, double dth, double dt) noexcept {
+  integ_.step_arc_icr(ds, dth, k_.x_icr());
+  record(d_l, d_r, ds, dth, dt);
+}
+
+void Odometry::record(double d_l, double d_r, double ds, double dth, double dt) noexcept {
   d_left_ = d_l;
   d_right_ = d_r;
   dth_ = dth;
-  // A plain base never takes the sideways slide: a predictable branch instead of adding
-  // 0 * dth terms, so its steps keep their bits and cost.
-  if (k_.x_icr() != 0.0) [[unlikely]] {
-    integ_.step_arc_icr(ds, dth, k_.x_icr());
-  } else {
-    integ_.step_arc(ds, dth);
-  }
   distance_ += std::fabs(ds);
   if (dt > 0.0) {
     // A fixed-rate loop's ticks have one length: its reciprocal is divided once (a division is

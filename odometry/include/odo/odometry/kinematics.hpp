@@ -54,6 +54,9 @@ class Kinematics {
   double metres_per_count_right() const noexcept { return m_per_count_r_; }  // c_R * c_m [m]
   double wheelbase() const noexcept { return p_.wheelbase; }                 // b [m]
   double x_icr() const noexcept { return p_.x_icr; }  // longitudinal ICR offset [m], 0 = none
+  // skid: x_icr != 0, kept as a flag so that the tick tests one byte (a compare of a double
+  // with 0 is five instructions on x86-64).
+  bool skid() const noexcept { return skid_; }
 
  private:
   explicit Kinematics(const KinematicParams& p);
@@ -61,6 +64,7 @@ class Kinematics {
   double c_m_ = 0.0;
   double m_per_count_l_ = 0.0;
   double m_per_count_r_ = 0.0;
+  bool skid_ = false;
 };
 
 }  // namespace odo

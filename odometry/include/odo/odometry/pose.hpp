@@ -150,17 +150,24 @@ class Odometry {
       : k_(k), cov_(error_model) {}
   // update: integrate the count deltas of one tick of length dt [s] (dt <= 0: velocity kept);
   // the pose only.
-  void update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept;
+  void update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
+    if (k_.skid()) [[unlikely]] {
+      update_skid(dn_left, dn_right, dt);
+      return;
+    }
+    update_plain(dn_left, dn_right, dt);
+  }
   // advance: update() and the covariance step of the same tick.
   void advance(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
     // The covariance needs the heading at the start of the tick; the integrator's cached sine
     // and cosine of it spare a trigonometric call.
-    const double s0 = sin_theta(), c0 = cos_theta();
-    update(dn_left, dn_right, dt);
-    if (k_.x_icr() != 0.0) [[unlikely]] {
-      step_covariance_icr(s0, c0, false, 0.0);
+    // A plain base tests one flag per tick and takes no sideways slide (its bits and cost kept).
+    if (k_.skid()) [[unlikely]] {
+      advance_skid(dn_left, dn_right, dt);
       return;
     }
+    const double s0 = sin_theta(), c0 = cos_theta();
+    update_plain(dn_left, dn_right, dt);
     // update's heading change is (d_R - d_L) / b: the covariance's phi, already divided.
     cov_.step_sc_phi(s0, c0, d_left_, d_right_, k_.wheelbase(), dth_);
   }
@@ -185,16 +192,22 @@ class Odometry {
   // already converted from counts (count x metres_per_count, Eq. 6.35: the same bits as
   // advance computes), so that a fused tick converts its counts once.
   void advance_travel(double d_l, double d_r, double dt) noexcept {
-    const double s0 = sin_theta(), c0 = cos_theta();
-    update_travel(d_l, d_r, dt);
-    if (k_.x_icr() != 0.0) [[unlikely]] {
-      step_covariance_icr(s0, c0, false, 0.0);
+    if (k_.skid()) [[unlikely]] {
+      advance_travel_skid(d_l, d_r, dt);
       return;
     }
+    const double s0 = sin_theta(), c0 = cos_theta();
+    update_travel_plain(d_l, d_r, dt);
     cov_.step_sc_phi(s0, c0, d_left_, d_right_, k_.wheelbase(), dth_);
   }
   // update_travel: update() from wheel travels d_l, d_r [m] (the pose only).
-  void update_travel(double d_l, double d_r, double dt) noexcept;
+  void update_travel(double d_l, double d_r, double dt) noexcept {
+    if (k_.skid()) [[unlikely]] {
+      integrate_skid(d_l, d_r, 0.5 * (d_l + d_r), (d_r - d_l) / k_.wheelbase(), dt);
+      return;
+    }
+    update_travel_plain(d_l, d_r, dt);
+  }
   // advance_fused: from the wheel travels d_l, d_r [m] (as advance_travel), the heading changing
   // by dtheta [rad] and the centre travel by ds_correction [m] more than the wheels' mean (the
   // fusion's FusedTick), with the covariance step of the same tick: the wheels' arc when
@@ -222,9 +235,20 @@ class Odometry {
   const Cov3& covariance() const noexcept { return cov_.cov(); }
 
  private:
+  // update_plain, update_travel_plain: update() and update_travel() of a base without x_icr.
+  void update_plain(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept;
+  void update_travel_plain(double d_l, double d_r, double dt) noexcept;
+  // update_skid, advance_skid, advance_travel_skid: update(), advance() and advance_travel()
+  // with the sideways slide of x_icr != 0 (out of line: the plain tick stays as it was).
+  void update_skid(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept;
+  void advance_skid(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept;
+  void advance_travel_skid(double d_l, double d_r, double dt) noexcept;
   // integrate: one tick of wheel travels d_l, d_r [m], centre travel ds [m] and heading change
-  // dth [rad] (with the kinematics' sideways slide -x_icr * dth when x_icr != 0).
+  // dth [rad]; integrate_skid: the same with the kinematics' sideways slide -x_icr * dth.
   void integrate(double d_l, double d_r, double ds, double dth, double dt) noexcept;
+  void integrate_skid(double d_l, double d_r, double ds, double dth, double dt) noexcept;
+  // record: the tick's bookkeeping after its pose step (travels, distance, velocities).
+  void record(double d_l, double d_r, double ds, double dth, double dt) noexcept;
   // step_covariance_icr: the covariance step of the last tick (started at heading s0, c0) for
   // x_icr != 0: the plain arc's (gyro_heading: the gyro's, var_heading [rad^2]) about the
   // instantaneous centre of rotation (PoseCovariance::shift_point).
