@@ -51,6 +51,7 @@ void read_robot(TableReader t, KinematicParams& p) {
   p.wheelbase = p.wheelbase_nominal;
   p.c_l = num("c_l", p.c_l, L::kFactor, "");
   p.c_r = num("c_r", p.c_r, L::kFactor, "");
+  p.x_icr = num("x_icr", p.x_icr, L::kXIcr, "m");
   t.finish();
 }
 

@@ -452,6 +452,20 @@ void PoseCovariance::flush() noexcept {
   propagate_known(g.sin0, g.cos0, g.d_left, g.d_right, g.b, g.phi);
 }
 
+void PoseCovariance::shift_point(double sin_theta, double cos_theta, double e) noexcept {
+  // A point P e ahead of the centre C on the body's x axis: P = C + e (cos theta, sin theta), so
+  // d P / d (C, theta) = [1 0 -e sin; 0 1 e cos; 0 0 1]: propagate_local's F of a displacement
+  // (e, 0) in the frame of theta, with no input noise. Skid steer (Mandow et al. 2007): with
+  // the instantaneous centre of rotation x_icr ahead of C, the body's velocity at P = C + x_icr
+  // (cos, sin) is (v, -x_icr omega) + omega x (x_icr, 0) = (v, 0): P moves exactly as the centre
+  // of a plain differential drive with the same wheel travels and heading, so the wheel noise
+  // reaches (P, theta) through the plain arc's Cov(U) (above) and the skid base's covariance is
+  // the plain one conjugated by this shift at the tick's start (e = x_icr) and end (e = -x_icr)
+  // headings: no further integrals. Merged ticks are propagated first, from their own start.
+  flush();
+  propagate_local_impl(cov_, sin_theta, cos_theta, e, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+}
+
 void propagate_local(Cov3& cov, double sin_theta0, double cos_theta0, double lx, double ly,
                      const Cov3& q) noexcept {
   propagate_local_impl(cov, sin_theta0, cos_theta0, lx, ly, q[0], q[1], q[2], q[4], q[5], q[8]);

@@ -28,7 +28,8 @@ Result<Kinematics> Kinematics::create(const KinematicParams& p) {
                   check_range(bad, "wheelbase_nominal", "m", p.wheelbase_nominal, L::kWheelbase) &&
                   check_range(bad, "wheelbase", "m", p.wheelbase, L::kWheelbase) &&
                   check_range(bad, "c_l", "", p.c_l, L::kFactor) &&
-                  check_range(bad, "c_r", "", p.c_r, L::kFactor);
+                  check_range(bad, "c_r", "", p.c_r, L::kFactor) &&
+                  check_range(bad, "x_icr", "m", p.x_icr, L::kXIcr);
   if (!ok) return range_error(std::move(*bad));
   return Kinematics(p);
 }
@@ -41,6 +42,7 @@ Kinematics::Kinematics(const KinematicParams& p) : p_(p) {
   c_m_ = std::numbers::pi * p.wheel_diameter / (p.gear_ratio * p.counts_per_rev);
   m_per_count_l_ = p.c_l * c_m_;
   m_per_count_r_ = p.c_r * c_m_;
+  skid_ = p.x_icr != 0.0;
 }
 
 }  // namespace odo

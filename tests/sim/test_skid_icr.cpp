@@ -11,6 +11,7 @@
 #include <string>
 
 #include "odo/analysis/skid_tools.hpp"
+#include "odo/odometry/pose.hpp"
 
 namespace odo {
 namespace {
@@ -154,6 +155,46 @@ TEST(SkidIcr, UmbmarkSquareCannotSeeTheIcrOffset) {
     EXPECT_NEAR(b.y - a.y, 0.0, 1e-9);
     EXPECT_NEAR(std::remainder(b.theta - a.theta, 2.0 * std::numbers::pi), 0.0, 1e-12);
   }
+}
+
+// product_rms: rms end-position error [m] over the excursions of the firmware's own Odometry
+// with wheelbase b [m] and x_icr [m], fed each piece's rim travels in ticks of at most 1 ms,
+// against the friction model's end poses.
+double product_rms(const sim::SkidSteerParams& p, double b, double x_icr) {
+  KinematicParams kp{0.15, 2048, 16, b, b, 1.0, 1.0};
+  kp.x_icr = x_icr;
+  const Kinematics k = *Kinematics::create(kp);
+  double sum = 0.0;
+  for (const analysis::RimExcursion& e : excursions()) {
+    Pose2 truth;
+    Odometry o(k);
+    for (const analysis::RimPiece& r : e) {
+      truth =
+          sim::twist_step(truth, sim::solve_skid_twist(p, r.v_left, r.v_right).twist, r.duration);
+      const int n = static_cast<int>(std::ceil(r.duration / 1e-3));
+      const double dt = r.duration / n;
+      for (int i = 0; i < n; ++i) o.update_travel(r.v_left * dt, r.v_right * dt, dt);
+    }
+    sum += std::pow(o.pose().x - truth.x, 2) + std::pow(o.pose().y - truth.y, 2);
+  }
+  return std::sqrt(sum / static_cast<double>(excursions().size()));
+}
+
+TEST(SkidIcr, FirmwareOdometryWithXIcrIsTheFittedIcrModel) {
+  // The load 10 mm forward: the firmware's Odometry with [robot] x_icr and wheelbase set to the
+  // fitted symmetric ICR pair ends where that model does (the same constant-twist steps, cut
+  // into 1 ms ticks: exact arcs compose), so it inherits the pair's gain over the best single
+  // track, which the plain Odometry (x_icr = 0) reproduces in turn.
+  const sim::SkidSteerParams p = base(1.0, 0.01);
+  const analysis::SkidModelFit f = analysis::fit_skid_models(p, excursions());
+  const double plain = product_rms(p, f.track, 0.0);
+  const double icr = product_rms(p, track(f.icr_sym), f.icr_sym.x_icr);
+  EXPECT_NEAR(plain, f.rms_track, 1e-6 + 1e-3 * f.rms_track);
+  EXPECT_NEAR(icr, f.rms_icr_sym, 1e-6 + 1e-3 * f.rms_icr_sym);
+  EXPECT_GT(plain / icr, 4.0) << "plain " << plain << " m, with x_icr " << icr << " m";
+  RecordProperty("rms_plain_mm", std::to_string(1e3 * plain));
+  RecordProperty("rms_x_icr_mm", std::to_string(1e3 * icr));
+  RecordProperty("x_icr_mm", std::to_string(1e3 * f.icr_sym.x_icr));
 }
 
 }  // namespace

@@ -65,7 +65,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"wheelbase_nominal", [](KinematicParams& p) { p.wheelbase_nominal = INFINITY; }},
         BadCase{"wheelbase", [](KinematicParams& p) { p.wheelbase = 340.0; }},
         BadCase{"c_l", [](KinematicParams& p) { p.c_l = 0.0; }},
-        BadCase{"c_r", [](KinematicParams& p) { p.c_r = 2.0; }}));
+        BadCase{"c_r", [](KinematicParams& p) { p.c_r = 2.0; }},
+        BadCase{"x_icr", [](KinematicParams& p) { p.x_icr = 50.0; }},  // mm written for m
+        BadCase{"x_icr", [](KinematicParams& p) { p.x_icr = NAN; }}));
 
 }  // namespace
 }  // namespace odo

@@ -133,5 +133,93 @@ TEST(Odometry, CountsToPoseAndVelocity) {
   EXPECT_NEAR(o.distance(), d, 1e-15);
 }
 
+// Skid-steer ICR offset (Mandow et al. 2007): with x_icr the body turns about the point x_icr
+// ahead of its centre and (R further) to the side, i.e. a constant twist rotates the centre about
+// the body-frame point (x_icr, ds/dtheta).
+Odometry skid_odometry(double x_icr) {
+  KinematicParams p{0.15, 2048, 16, 0.5, 0.5, 1.0, 1.0};
+  p.x_icr = x_icr;
+  return Odometry(*Kinematics::create(p));
+}
+
+TEST(OdometryIcr, SpotTurnMovesCentreAlongChordAboutTheIcr) {
+  // b = 0.5, d_R = -d_L = pi b / 4 = pi/8: dtheta = pi/2, ds = 0. The centre rotates by pi/2
+  // about the ICR at (0.05, 0): (0, 0) - (0.05, 0) = (-0.05, 0) turned by 90 deg is (0, -0.05),
+  // so the centre ends at (0.05, -0.05), a chord of 0.05 sqrt(2) = 70.7 mm. The step's formula:
+  // across = -0.05 * (pi/2) * sinc(pi/4) = -0.05 * (pi/2) * (sqrt(2)/2) / (pi/4) = -0.05 sqrt(2)
+  // at the mean heading pi/4: (-sin, cos)(pi/4) * across = (0.05, -0.05).
+  Odometry o = skid_odometry(0.05);
+  o.update_travel(-kPi / 8, kPi / 8, 0.01);
+  EXPECT_NEAR(o.pose().x, 0.05, 1e-15);
+  EXPECT_NEAR(o.pose().y, -0.05, 1e-15);
+  EXPECT_NEAR(o.pose().theta, kPi / 2, 1e-15);
+  // The same turn in 1000 ticks (series half-angles, the rotor) lands on the same point: a
+  // constant twist's exact steps compose.
+  Odometry m = skid_odometry(0.05);
+  for (int i = 0; i < 1000; ++i) m.update_travel(-kPi / 8000, kPi / 8000, 0.001);
+  EXPECT_NEAR(m.pose().x, 0.05, 1e-13);
+  EXPECT_NEAR(m.pose().y, -0.05, 1e-13);
+}
+
+TEST(OdometryIcr, GyroHeadingDrivesTheSlide) {
+  // A spot turn whose heading change comes from the gyro (pi/2) while the wheels claim more
+  // (d = +-0.5 m on b = 0.5: 2 rad): the slide is -x_icr times the fused dtheta, so the centre
+  // ends at (0.05, -0.05) as in the wheels' spot turn above. The covariance, shifted to the ICR
+  // and back, grows and stays symmetric.
+  Odometry o = skid_odometry(0.05);
+  o.advance_fused(-0.5, 0.5, 0.01, kPi / 2, 0.0, true, 1e-4);
+  EXPECT_NEAR(o.pose().x, 0.05, 1e-15);
+  EXPECT_NEAR(o.pose().y, -0.05, 1e-15);
+  const Cov3& c = o.covariance();
+  EXPECT_GT(c[0], 0.0);
+  EXPECT_GT(c[8], 0.0);
+  EXPECT_EQ(c[1], c[3]);
+  EXPECT_EQ(c[2], c[6]);
+  EXPECT_EQ(c[5], c[7]);
+}
+
+TEST(OdometryIcr, QuarterArcRotatesAboutTheOffsetCentre) {
+  // R = ds/dtheta = 1 m to the left, b = 0.5, dtheta = pi/2: d_L = (1 - 0.25) pi/2,
+  // d_R = (1 + 0.25) pi/2. Centre of rotation at body (0.05, 1); the centre's offset from it,
+  // (-0.05, -1), turned by 90 deg is (1, -0.05): the centre ends at (1.05, 0.95) (without x_icr
+  // it would be (1, 1)). arc_step_icr is the same step on a Pose2.
+  Odometry o = skid_odometry(0.05);
+  o.update_travel(0.75 * kPi / 2, 1.25 * kPi / 2, 0.01);
+  EXPECT_NEAR(o.pose().x, 1.05, 1e-15);
+  EXPECT_NEAR(o.pose().y, 0.95, 1e-15);
+  const Pose2 a = arc_step_icr({}, 0.75 * kPi / 2, 1.25 * kPi / 2, 0.5, 0.05);
+  EXPECT_NEAR(a.x, 1.05, 1e-15);
+  EXPECT_NEAR(a.y, 0.95, 1e-15);
+  // A straight tick has no turn and so no slide.
+  Odometry s = skid_odometry(0.05);
+  s.update_travel(0.2, 0.2, 0.01);
+  EXPECT_EQ(s.pose().x, 0.2);
+  EXPECT_EQ(s.pose().y, 0.0);
+}
+
+TEST(OdometryIcr, ZeroOffsetIsBitIdenticalToThePlainStep) {
+  // x_icr = 0 takes step_arc: on random ticks the pose and covariance equal those of an Odometry
+  // built without the field bit for bit; arc_step_icr with 0 is arc_step (to rounding).
+  KinematicParams p{0.15, 2048, 16, 0.5, 0.5, 1.0, 1.0};
+  Odometry plain(*Kinematics::create(p));
+  Odometry zero = skid_odometry(0.0);
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> counts(-3000, 3000);
+  Pose2 a{}, b{};
+  for (int i = 0; i < 5000; ++i) {
+    const int l = counts(rng), r = counts(rng);
+    plain.advance(l, r, 0.001);
+    zero.advance(l, r, 0.001);
+    a = arc_step(a, l * 1e-5, r * 1e-5, 0.5);
+    b = arc_step_icr(b, l * 1e-5, r * 1e-5, 0.5, 0.0);
+  }
+  EXPECT_EQ(plain.pose().x, zero.pose().x);
+  EXPECT_EQ(plain.pose().y, zero.pose().y);
+  EXPECT_EQ(plain.pose().theta, zero.pose().theta);
+  EXPECT_EQ(plain.covariance(), zero.covariance());
+  EXPECT_NEAR(a.x, b.x, 1e-12);
+  EXPECT_NEAR(a.y, b.y, 1e-12);
+}
+
 }  // namespace
 }  // namespace odo

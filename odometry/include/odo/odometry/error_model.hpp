@@ -175,6 +175,10 @@ class PoseCovariance {
     flush();
     propagate_arc_slip(cov_, sin_theta0, cos_theta0, d_left, d_right, b, k_, var_left, var_right);
   }
+  // shift_point: flush, then make cov() that of the pose of the point e [m] ahead of the one it
+  // was of, on the body's x axis, at heading (sin_theta, cos_theta) (a skid-steer base's
+  // instantaneous centre of rotation, Odometry::advance).
+  void shift_point(double sin_theta, double cos_theta, double e) noexcept;
   // flush: propagate the ticks merged so far (none: nothing), so that cov() includes them.
   void flush() noexcept;
   // pending_ticks: ticks merged but not yet in cov() (0 with covariance_ticks = 1).

@@ -14,6 +14,11 @@ struct KinematicParams {
   double wheelbase = 0.0;          // effective wheelbase b used for integration [m] (UMBmark b_new)
   double c_l = 1.0;                // UMBmark correction factor of the left wheel (Eq. 6.33)
   double c_r = 1.0;                // UMBmark correction factor of the right wheel (Eq. 6.34)
+  // Longitudinal offset of the instantaneous centre of rotation of a skid-steer base (x_ICR of
+  // Mandow et al. 2007) [m], + ahead of the centre point: the centre slides sideways by
+  // -x_icr * dtheta when the body turns by dtheta. 0 (the default) is the plain differential
+  // drive, every output bit-identical to a base without it.
+  double x_icr = 0.0;
 };
 
 // KinematicLimits: the allowed range of each parameter, written once: Kinematics::create and
@@ -25,6 +30,9 @@ struct KinematicLimits {
   static constexpr Limit kGearRatio{1e-3, 1e4};
   static constexpr Limit kWheelbase{0.01, 20.0};  // nominal and effective [m]
   static constexpr Limit kFactor{0.5, 1.5};       // c_l, c_r
+  // x_icr [m]: a few times the load's offset from the centre on a 4WD base (a 20 mm offset
+  // gives ~60 mm); 2 m catches millimetres written for metres on any base up to 3 m.
+  static constexpr Limit kXIcr{-2.0, 2.0};
 };
 
 // counts_per_metre: encoder counts per metre of nominal wheel travel, Ce * n / (pi * Dn)
@@ -34,7 +42,8 @@ double counts_per_metre(const KinematicParams& p) noexcept;
 // Validated parameters plus the derived per-count distances.
 class Kinematics {
  public:
-  // create: validates every field (finite, positive, factors within [0.5, 1.5]) and derives
+  // create: validates every field (finite, positive, factors within [0.5, 1.5], x_icr within
+  // kXIcr) and derives
   // metres per count; the error names the field, its value and the allowed range.
   static Result<Kinematics> create(const KinematicParams& p);
 
@@ -44,6 +53,10 @@ class Kinematics {
   double metres_per_count_left() const noexcept { return m_per_count_l_; }   // c_L * c_m [m]
   double metres_per_count_right() const noexcept { return m_per_count_r_; }  // c_R * c_m [m]
   double wheelbase() const noexcept { return p_.wheelbase; }                 // b [m]
+  double x_icr() const noexcept { return p_.x_icr; }  // longitudinal ICR offset [m], 0 = none
+  // skid: x_icr != 0, kept as a flag so that the tick tests one byte (a compare of a double
+  // with 0 is five instructions on x86-64).
+  bool skid() const noexcept { return skid_; }
 
  private:
   explicit Kinematics(const KinematicParams& p);
@@ -51,6 +64,7 @@ class Kinematics {
   double c_m_ = 0.0;
   double m_per_count_l_ = 0.0;
   double m_per_count_r_ = 0.0;
+  bool skid_ = false;
 };
 
 }  // namespace odo

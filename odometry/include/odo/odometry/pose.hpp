@@ -64,6 +64,11 @@ inline HalfAngle half_angle(double h) noexcept {
 // of a base with wheelbase b [m]; stable for any turn, including none and on-the-spot.
 Pose2 arc_step(const Pose2& p, double d_left, double d_right, double b) noexcept;
 
+// arc_step_icr: arc_step for a skid-steer base whose instantaneous centre of rotation lies x_icr
+// [m] ahead of the centre point (Mandow et al. 2007): the centre also slides sideways by
+// -x_icr * dtheta over the arc. arc_step when x_icr is 0.
+Pose2 arc_step_icr(const Pose2& p, double d_left, double d_right, double b, double x_icr) noexcept;
+
 // report_step: UMBmark report Eq. 2.3-2.6 (heading updated first, then a straight chord along
 // the new heading); kept for comparison with the exact arc.
 Pose2 report_step(const Pose2& p, double d_left, double d_right, double b) noexcept;
@@ -121,6 +126,10 @@ class PoseIntegrator {
   // step_arc: advance along an arc of centre travel ds [m] and heading change dtheta [rad] (a
   // heading from elsewhere, e.g. the gyrodometry fusion; step() is step_arc of the wheels').
   void step_arc(double ds, double dtheta) noexcept;
+  // step_arc_icr: step_arc of a body whose instantaneous centre of rotation lies x_icr [m] ahead
+  // of the centre point, so that the centre slides sideways by -x_icr * dtheta [m] (x_icr != 0;
+  // the tick keeps step_arc for the plain base).
+  void step_arc_icr(double ds, double dtheta, double x_icr) noexcept;
   const Pose2& pose() const noexcept { return pose_; }
   double sin_theta() const noexcept { return heading_.sin(); }
   double cos_theta() const noexcept { return heading_.cos(); }
@@ -141,13 +150,24 @@ class Odometry {
       : k_(k), cov_(error_model) {}
   // update: integrate the count deltas of one tick of length dt [s] (dt <= 0: velocity kept);
   // the pose only.
-  void update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept;
+  void update(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
+    if (k_.skid()) [[unlikely]] {
+      update_skid(dn_left, dn_right, dt);
+      return;
+    }
+    update_plain(dn_left, dn_right, dt);
+  }
   // advance: update() and the covariance step of the same tick.
   void advance(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept {
     // The covariance needs the heading at the start of the tick; the integrator's cached sine
     // and cosine of it spare a trigonometric call.
+    // A plain base tests one flag per tick and takes no sideways slide (its bits and cost kept).
+    if (k_.skid()) [[unlikely]] {
+      advance_skid(dn_left, dn_right, dt);
+      return;
+    }
     const double s0 = sin_theta(), c0 = cos_theta();
-    update(dn_left, dn_right, dt);
+    update_plain(dn_left, dn_right, dt);
     // update's heading change is (d_R - d_L) / b: the covariance's phi, already divided.
     cov_.step_sc_phi(s0, c0, d_left_, d_right_, k_.wheelbase(), dth_);
   }
@@ -172,12 +192,22 @@ class Odometry {
   // already converted from counts (count x metres_per_count, Eq. 6.35: the same bits as
   // advance computes), so that a fused tick converts its counts once.
   void advance_travel(double d_l, double d_r, double dt) noexcept {
+    if (k_.skid()) [[unlikely]] {
+      advance_travel_skid(d_l, d_r, dt);
+      return;
+    }
     const double s0 = sin_theta(), c0 = cos_theta();
-    update_travel(d_l, d_r, dt);
+    update_travel_plain(d_l, d_r, dt);
     cov_.step_sc_phi(s0, c0, d_left_, d_right_, k_.wheelbase(), dth_);
   }
   // update_travel: update() from wheel travels d_l, d_r [m] (the pose only).
-  void update_travel(double d_l, double d_r, double dt) noexcept;
+  void update_travel(double d_l, double d_r, double dt) noexcept {
+    if (k_.skid()) [[unlikely]] {
+      integrate_skid(d_l, d_r, 0.5 * (d_l + d_r), (d_r - d_l) / k_.wheelbase(), dt);
+      return;
+    }
+    update_travel_plain(d_l, d_r, dt);
+  }
   // advance_fused: from the wheel travels d_l, d_r [m] (as advance_travel), the heading changing
   // by dtheta [rad] and the centre travel by ds_correction [m] more than the wheels' mean (the
   // fusion's FusedTick), with the covariance step of the same tick: the wheels' arc when
@@ -212,9 +242,24 @@ class Odometry {
   const Cov3& covariance() const noexcept { return cov_.cov(); }
 
  private:
+  // update_plain, update_travel_plain: update() and update_travel() of a base without x_icr.
+  void update_plain(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept;
+  void update_travel_plain(double d_l, double d_r, double dt) noexcept;
+  // update_skid, advance_skid, advance_travel_skid: update(), advance() and advance_travel()
+  // with the sideways slide of x_icr != 0 (out of line: the plain tick stays as it was).
+  void update_skid(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept;
+  void advance_skid(std::int64_t dn_left, std::int64_t dn_right, double dt) noexcept;
+  void advance_travel_skid(double d_l, double d_r, double dt) noexcept;
   // integrate: one tick of wheel travels d_l, d_r [m], centre travel ds [m] and heading change
-  // dth [rad].
+  // dth [rad]; integrate_skid: the same with the kinematics' sideways slide -x_icr * dth.
   void integrate(double d_l, double d_r, double ds, double dth, double dt) noexcept;
+  void integrate_skid(double d_l, double d_r, double ds, double dth, double dt) noexcept;
+  // record: the tick's bookkeeping after its pose step (travels, distance, velocities).
+  void record(double d_l, double d_r, double ds, double dth, double dt) noexcept;
+  // step_covariance_icr: the covariance step of the last tick (started at heading s0, c0) for
+  // x_icr != 0: the plain arc's (gyro_heading: the gyro's, var_heading [rad^2]) about the
+  // instantaneous centre of rotation (PoseCovariance::shift_point).
+  void step_covariance_icr(double s0, double c0, bool gyro_heading, double var_heading) noexcept;
   Kinematics k_;
   PoseCovariance cov_;
   PoseIntegrator integ_;
