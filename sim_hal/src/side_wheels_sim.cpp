@@ -5,6 +5,7 @@
 #include <string>
 
 #include "odo/hal/field_range.hpp"
+#include "odo/hal/side_sample.hpp"
 
 namespace odo::sim {
 namespace {
@@ -136,16 +137,8 @@ EncoderSample SimSideWheelsSource::read(TimeNs now) noexcept {
     }
   last_ = combiner_.step(r[0], r[1]);
   EncoderSample out;
-  out.left = last_.left;
-  out.right = last_.right;
   out.stamp = now;
-  out.flags = last_.flags;
-  out.spread_left = last_.spread_left;
-  out.spread_right = last_.spread_right;
-  const SideCounters& c = combiner_.counters();
-  out.counters.slip_events = c.slip_events;
-  out.counters.wheel_drops = c.wheel_drops;
-  out.counters.stale_events = c.stale_events;
+  apply_side_step(last_, combiner_.counters(), out);
   return out;
 }
 
