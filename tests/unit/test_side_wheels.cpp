@@ -81,6 +81,20 @@ TEST(SideCombiner, FaultedWheelIsDroppedAndReReferenced) {
   EXPECT_EQ(s.left, 50);
 }
 
+// A wheel faulted before it was ever read (a controller not yet heard from) is left out of its
+// side and flagged, but it dropped out of nothing: no wheel_drops event until it has counted.
+TEST(SideCombiner, AWheelFaultedFromTheStartIsNoDropEvent) {
+  SideCombiner d = make(two_wheels());
+  SideStep s = d.step(wheels(0, 0, 0b10), wheels(0, 0));
+  EXPECT_EQ(s.flags, static_cast<std::uint32_t>(kEncoderWheelDropped));
+  s = d.step(wheels(10, 0, 0b10), wheels(0, 0));
+  EXPECT_EQ(s.left, 10);  // wheel 0 alone
+  EXPECT_EQ(d.counters().wheel_drops, 0u);
+  (void)d.step(wheels(20, 300), wheels(0, 0));  // wheel 1 heard: its reference
+  (void)d.step(wheels(30, 310, 0b10), wheels(0, 0));
+  EXPECT_EQ(d.counters().wheel_drops, 1u);  // now it was counting: an event
+}
+
 TEST(SideCombiner, AllWheelsOfASideFaultedIsStale) {
   SideCombiner c = make(two_wheels());
   (void)c.step(wheels(0, 0), wheels(0, 0));

@@ -178,7 +178,7 @@ struct SideStep {
 // EncoderCounters: slip_events, wheel_drops; stale_events it adds to its own).
 struct SideCounters {
   std::uint64_t slip_events = 0;   // rising edges of kEncoderSlipLeft plus of kEncoderSlipRight
-  std::uint64_t wheel_drops = 0;   // wheels going from clean to faulted
+  std::uint64_t wheel_drops = 0;   // wheels going from clean (referenced) to faulted
   std::uint64_t stale_events = 0;  // sides going from live to stale (every wheel faulted)
 };
 
@@ -267,7 +267,9 @@ class SideCombiner {
       std::int64_t delta = 0;
       bool counted = false;
       if (faulted & bit) {
-        if (!(s.faulted & bit)) ++counters_.wheel_drops;
+        // An event only for a wheel that was counting: one not yet seen (a controller that
+        // has not sent since start) drops out of nothing, here rather than in each backend.
+        if (!(s.faulted & bit) && (s.have_ref & bit)) ++counters_.wheel_drops;
         s.clean[i] = 0;
         dropped = kEncoderWheelDropped;
       } else if (!(s.have_ref & bit) || (s.faulted & bit)) {
