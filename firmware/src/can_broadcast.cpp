@@ -119,6 +119,16 @@ void CanBroadcaster::send_encoder_faults(const loop::LoopSnapshot& s) noexcept {
   send(f, s.loop_time);
 }
 
+void CanBroadcaster::send_side_wheels(const loop::LoopSnapshot& s) noexcept {
+  protocol::SideWheelsMsg m;
+  m.encoder_flags = s.encoder_flags;
+  m.wheels_per_side = static_cast<std::uint8_t>(o_.wheels_per_side);
+  m.counters = s.encoder_counters;
+  CanFrame f;
+  protocol::encode_side_wheels(id(protocol::Msg::kSideWheels), m, f);
+  send(f, s.loop_time);
+}
+
 void CanBroadcaster::on_tick(const loop::LoopSnapshot& s) noexcept {
   // Commands taken last tick were applied at the start of this one: acknowledge them now, so a
   // receiver that sees the ack also sees the new pose in the same or a later pose group.
@@ -137,8 +147,10 @@ void CanBroadcaster::send_due(const loop::LoopSnapshot& s) noexcept {
   if (d.velocity != 0 && t % d.velocity == 0) send_velocity(s);
   if (d.uncertainty != 0 && t % d.uncertainty == 0) send_uncertainty(s);
   if (d.status != 0 && t % d.status == 0) {
-    // The counters behind the Status frame's encoder flags, at its rate and just before it.
+    // The counters behind the Status frame's encoder flags, at its rate and just before it;
+    // with several wheels per side, the flags (bits 8..10) that Status's byte cannot carry.
     send_encoder_faults(s);
+    if (o_.wheels_per_side > 1) send_side_wheels(s);
     send_status(s, false);
   }
   if (d.timing != 0 && t % d.timing == 0) send_timing(s);
@@ -158,6 +170,7 @@ void CanBroadcaster::send_final(const loop::LoopSnapshot& s) noexcept {
   send_uncertainty(s);
   send_timing(s);
   send_encoder_faults(s);
+  if (o_.wheels_per_side > 1) send_side_wheels(s);
   send_status(s, true);
 }
 

@@ -49,10 +49,10 @@ CanLink::~CanLink() {
   if (log_) log_->stop();
 }
 
-Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loop_hz,
-                                                 loop::OdometryLoop& loop,
-                                                 const std::string& can_log, bool virtual_time,
-                                                 std::string_view config_source) {
+Result<std::unique_ptr<CanLink>> CanLink::create(const Config& cfg, loop::OdometryLoop& loop,
+                                                 const std::string& can_log, bool virtual_time) {
+  const CanSection& s = cfg.can;
+  const std::string_view config_source = cfg.source;
   // The config's faults are reported under its file name; the log file's under the option.
   auto config_error = [&](Error e) {
     if (!config_source.empty()) e.message = std::string(config_source) + ": " + e.message;
@@ -84,7 +84,8 @@ Result<std::unique_ptr<CanLink>> CanLink::create(const CanSection& s, double loo
     if (!w) return make_error(w.error().code, "--can-log " + w.error().message);
     link->log_ = std::move(w).value();
   }
-  const CanBroadcastOptions o = broadcast_options(s, loop_hz, virtual_time);
+  CanBroadcastOptions o = broadcast_options(s, cfg.loop.rate_hz, virtual_time);
+  o.wheels_per_side = cfg.encoder.side.wheels_per_side;
   link->bc_ = std::make_unique<CanBroadcaster>(o, *link->bus_, &loop.commands(),
                                                link->log_ ? &link->log_->ring() : nullptr);
   if (!loop.add_observer(link->bc_.get()))

@@ -81,8 +81,7 @@ int Daemon::configure() {
   loop_ = std::move(created).value();
   if (sim::TruthRecorder* t = rig_->truth()) loop_->add_observer(t);
   // CAN pose broadcast ([can], --can-log).
-  auto can = CanLink::create(cfg_->can, cfg_->loop.rate_hz, *loop_, o_.can_log, o_.virtual_time,
-                             cfg_->source);
+  auto can = CanLink::create(*cfg_, *loop_, o_.can_log, o_.virtual_time);
   if (!can) return fail(can.error().message);
   can_ = std::move(can).value();
   // ROS 2 output ([ros2] enabled): an observer of the loop plus the DDS thread.

@@ -141,6 +141,14 @@ void encode_encoder_faults(std::uint32_t id, const EncoderCounters& c, CanFrame&
   for (const auto& s : sig::kEncoderFaultFields) put_count(f, *s.signal, c.*s.field);
 }
 
+void encode_side_wheels(std::uint32_t id, const SideWheelsMsg& m, CanFrame& f) noexcept {
+  start(id, f);
+  for (const auto& s : sig::kSideWheelFlags)
+    put_raw(f, *s.signal, (m.encoder_flags & s.flag) ? 1 : 0);
+  put_count(f, sig::wheels_per_side, m.wheels_per_side);
+  for (const auto& s : sig::kSideWheelCounters) put_count(f, *s.signal, m.counters.*s.field);
+}
+
 void encode_set_pose(std::uint32_t id, const SetPose& c, CanFrame& f) noexcept {
   start(id, f);
   put_value(f, sig::set_x, c.pose.x);
@@ -212,6 +220,18 @@ bool decode_encoder_faults(const CanFrame& f, EncoderCounters& c) noexcept {
   if (f.len != 8) return false;
   for (const auto& s : sig::kEncoderFaultFields)
     c.*s.field = static_cast<std::uint64_t>(get_raw(f, *s.signal));
+  return true;
+}
+
+bool decode_side_wheels(const CanFrame& f, SideWheelsMsg& m) noexcept {
+  if (f.len != 8) return false;
+  m.encoder_flags = 0;
+  for (const auto& s : sig::kSideWheelFlags)
+    if (get_raw(f, *s.signal) != 0) m.encoder_flags |= s.flag;
+  m.wheels_per_side = static_cast<std::uint8_t>(get_raw(f, sig::wheels_per_side));
+  m.counters = EncoderCounters{};
+  for (const auto& s : sig::kSideWheelCounters)
+    m.counters.*s.field = static_cast<std::uint64_t>(get_raw(f, *s.signal));
   return true;
 }
 

@@ -54,6 +54,33 @@ else
   echo "note: node or candied missing (tools/setup.sh --tests): DBC check with candied skipped"
 fi
 
+# 1c. Several wheels per side (issue 38): SideWheels goes with every Status (the flag bits 8-10
+# that Status's byte cannot carry, and their counters), read with the DBC by the independent
+# decoder and equal to --json; the two-wheel run above sent none.
+"$py" -c "import json,sys; assert 'SideWheels' not in json.load(open(sys.argv[1]))['messages']" \
+  "$tmp/dbc.json"
+check "one wheel per side: no SideWheels frame" $?
+printf '[encoder]\nwheels_per_side = 2\n' >"$tmp/skid.toml"
+run "$ODOMETRYD" --config "$tmp/skid.toml" --virtual-time --duration 20 --json \
+  --can-log "$tmp/skid.log" >"$tmp/skid.json" 2>"$tmp/err"
+check "odometryd wheels_per_side = 2 --can-log exit 0" $?
+"$py" "$src/tests/tools/dbc_decode.py" "$dbc" "$tmp/skid.log" >"$tmp/skid_dbc.json"
+"$py" - "$tmp/skid_dbc.json" "$tmp/skid.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1])); j = json.load(open(sys.argv[2]))
+assert d["unknown_frames"] == 0 and not d["out_of_range"], d
+m = d["messages"]
+assert m["SideWheels"] == m["Status"] > 0, m
+last = d["last"]
+assert last["wheels_per_side"] == j["wheels"]["wheels_per_side"] == 2, (last, j["wheels"])
+assert last["slip_events"] == j["wheels"]["slip_events"], (last, j["wheels"])
+assert last["wheel_drops"] == j["wheels"]["wheel_drops"], (last, j["wheels"])
+f = j["encoder_flags"]  # the last sample's EncoderFlag bits, as the stopping group carries them
+assert last["slip_left"] == (f >> 8) & 1 and last["slip_right"] == (f >> 9) & 1, (last, f)
+assert last["wheel_dropped"] == (f >> 10) & 1, (last, f)
+PY
+check "wheels_per_side = 2: SideWheels with every Status, its counters and flags equal --json" $?
+
 # 2. odomctl decode: table with a summary, CSV with one row per signal.
 run "$ODOMCTL" decode "$tmp/can.log" >"$tmp/table" 2>"$tmp/err2"
 check "odomctl decode exit 0" $?

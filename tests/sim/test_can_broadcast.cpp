@@ -232,6 +232,49 @@ TEST(CanBroadcast, EncoderFaultsCarryTheBackendsCountersJustBeforeStatus) {
   }
 }
 
+// SideWheels (issue 38): with several wheels per side, the side flags (encoder flag bits 8-10,
+// beyond Status's byte) and their counters go between EncoderFaults and Status, at the Status
+// rate and in the final group; with one wheel per side the frame is never sent (the bus as
+// before).
+TEST(CanBroadcast, SideWheelsGoWithStatusOnlyWithSeveralWheelsPerSide) {
+  for (const int wheels : {1, 3}) {
+    sim::SimCanPort port{64, 16};
+    port.connect_wire();
+    fw::CanFrameRing ring{1 << 10};
+    fw::CanBroadcastOptions o = StatusBench::opts();
+    o.wheels_per_side = wheels;
+    fw::CanBroadcaster bc{o, port, nullptr, &ring};
+    loop::LoopSnapshot s;
+    s.tick = 1;
+    s.encoder_flags = kEncoderSlipLeft | kEncoderStaleRight;
+    s.encoder_counters.slip_events = 4;
+    s.encoder_counters.wheel_drops = 1;
+    bc.on_tick(s);
+    bc.send_final(s);
+    std::vector<std::uint32_t> ids;
+    CanFrame f;
+    while (ring.pop(f)) {
+      ids.push_back(f.id);
+      if (f.id != id(Msg::kSideWheels)) continue;
+      protocol::SideWheelsMsg m;
+      ASSERT_TRUE(protocol::decode_side_wheels(f, m));
+      EXPECT_EQ(m.encoder_flags, std::uint32_t{kEncoderSlipLeft});
+      EXPECT_EQ(m.wheels_per_side, wheels);
+      EXPECT_EQ(m.counters.slip_events, 4u);
+      EXPECT_EQ(m.counters.wheel_drops, 1u);
+    }
+    const auto n_side = std::count(ids.begin(), ids.end(), id(Msg::kSideWheels));
+    EXPECT_EQ(n_side, wheels > 1 ? 2 : 0) << wheels;  // the tick's and the final group's
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      if (ids[i] != id(Msg::kSideWheels)) continue;
+      ASSERT_GT(i, 0u);
+      ASSERT_LT(i + 1, ids.size());
+      EXPECT_EQ(ids[i - 1], id(Msg::kEncoderFaults));
+      EXPECT_EQ(ids[i + 1], id(Msg::kStatus));
+    }
+  }
+}
+
 TEST(CanBroadcast, LinkDownDropsCountsKeepsTheLoopAndResumes) {
   Bench b;
   const auto before = b.ticks(50);

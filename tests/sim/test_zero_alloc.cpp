@@ -395,7 +395,7 @@ TEST(ZeroAlloc, LoopRunsTwoHundredThousandTicksWithoutAllocating) {
   // The CAN broadcast at the default rates on the simulated bus, with the candump log (its
   // writer thread formats and writes frames while the window is open) and set-pose commands.
   const std::string can_log = ::testing::TempDir() + "zero_alloc_can.log";
-  auto can = fw::CanLink::create(cfg.can, cfg.loop.rate_hz, *loop, can_log);
+  auto can = fw::CanLink::create(cfg, *loop, can_log);
   ASSERT_TRUE(can.ok()) << can.error().message;
   ASSERT_NE((*can)->sim_port(), nullptr);
   (*can)->start(0);
@@ -501,7 +501,7 @@ TEST(ZeroAlloc, CanReceiveFloodWithoutAllocating) {
   loop::LoopConfig lc;
   lc.rate_hz = cfg.loop.rate_hz;
   auto loop = loop::OdometryLoop::create(lc, *kin, rig->encoder(), rig->clock()).value();
-  auto can = fw::CanLink::create(cfg.can, cfg.loop.rate_hz, *loop, "");
+  auto can = fw::CanLink::create(cfg, *loop, "");
   ASSERT_TRUE(can.ok()) << can.error().message;
   sim::SimCanPort* port = (*can)->sim_port();
   ASSERT_NE(port, nullptr);

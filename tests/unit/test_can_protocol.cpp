@@ -39,7 +39,10 @@ TEST(CanIds, NodeBlocksAndSplit) {
   f.id = 0x436;
   ASSERT_TRUE(split_id(0x400, f, node, m));
   EXPECT_EQ(m, Msg::kEncoderFaults);
-  for (std::uint32_t off : {7u, 11u, 12u, 15u}) {  // offsets the message table does not list
+  f.id = 0x437;
+  ASSERT_TRUE(split_id(0x400, f, node, m));
+  EXPECT_EQ(m, Msg::kSideWheels);
+  for (std::uint32_t off : {11u, 12u, 15u}) {  // offsets the message table does not list
     f.id = 0x430 + off;
     EXPECT_FALSE(split_id(0x400, f, node, m)) << off;
   }
@@ -274,6 +277,36 @@ TEST(CanEncoderFaults, OneByteEachInOrderSaturating) {
   EXPECT_EQ(c.reconnects, 255u);
   f.len = 7;
   EXPECT_FALSE(decode_encoder_faults(f, c));
+}
+
+// SideWheels (issue 38), bytes by hand: byte 0 = slip_left (bit 0) | slip_right (bit 1) |
+// wheel_dropped (bit 2) | wheels_per_side << 4; bytes 1-2 slip_events, bytes 3-4 wheel_drops,
+// little-endian u16, saturating; bytes 5-7 zero. Flags slip-right + wheel-dropped, 2 per side:
+// 0b010 | 0b100 | 2 << 4 = 0x26; 300 slip events = 0x012C; 70000 drops saturate at 0xFFFF.
+// Status's own flags (stale-left) are not carried.
+TEST(CanSideWheels, FlagBitsWheelsAndSaturatingCounters) {
+  SideWheelsMsg m;
+  m.encoder_flags = kEncoderSlipRight | kEncoderWheelDropped | kEncoderStaleLeft;
+  m.wheels_per_side = 2;
+  m.counters.slip_events = 300;
+  m.counters.wheel_drops = 70000;
+  m.counters.link_errors = 9;  // an EncoderFaults counter: not in this frame
+  CanFrame f;
+  encode_side_wheels(kId + 7, m, f);
+  EXPECT_EQ(f.id, kId + 7);
+  ASSERT_EQ(f.len, 8);
+  const std::array<std::uint8_t, 8> want{0x26, 0x2C, 0x01, 0xFF, 0xFF, 0x00, 0x00, 0x00};
+  for (std::size_t i = 0; i < 8; ++i) EXPECT_EQ(f.data[i], want[i]) << i;
+  SideWheelsMsg got;
+  got.counters.link_errors = 5;  // decoding clears what the frame does not carry
+  ASSERT_TRUE(decode_side_wheels(f, got));
+  EXPECT_EQ(got.encoder_flags, std::uint32_t{kEncoderSlipRight | kEncoderWheelDropped});
+  EXPECT_EQ(got.wheels_per_side, 2);
+  EXPECT_EQ(got.counters.slip_events, 300u);
+  EXPECT_EQ(got.counters.wheel_drops, 65535u);
+  EXPECT_EQ(got.counters.link_errors, 0u);
+  f.len = 7;
+  EXPECT_FALSE(decode_side_wheels(f, got));
 }
 
 TEST(CanSetPose, SetResetAndRejects) {

@@ -41,6 +41,8 @@ struct CanDivisors {
 // The node's identity and what it receives (CanReceiveOptions), and what it sends.
 struct CanBroadcastOptions : CanReceiveOptions {
   CanDivisors div;
+  // [encoder] wheels_per_side: above 1, SideWheels goes with each Status (issue 38).
+  int wheels_per_side = 1;
   bool lossless_log = false;  // virtual time: wait for the log writer instead of dropping
 };
 
@@ -72,6 +74,8 @@ class CanBroadcaster final : public loop::TickObserver {
   void send_timing(const loop::LoopSnapshot& s) noexcept;
   // send_encoder_faults: the EncoderFaults frame (the backend's counters, saturating at 255).
   void send_encoder_faults(const loop::LoopSnapshot& s) noexcept;
+  // send_side_wheels: the SideWheels frame (slip and dropped-wheel flags and counters).
+  void send_side_wheels(const loop::LoopSnapshot& s) noexcept;
   void log_frame(const CanFrame& f) noexcept {
     if (o_.lossless_log)
       log_->push_wait(f, [] { std::this_thread::yield(); });

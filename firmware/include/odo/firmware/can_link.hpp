@@ -26,14 +26,13 @@ namespace odo::fw {
 class CanLink {
  public:
   ~CanLink();
-  // create: null (and ok) for bus = "none" with no log; errors name the interface, and begin
-  // with `config_source` ("file: ") when the config is at fault, with "--can-log FILE" when the
-  // log file is. virtual_time: the log waits for its writer rather than dropping.
-  static Result<std::unique_ptr<CanLink>> create(const CanSection& s, double loop_hz,
-                                                 loop::OdometryLoop& loop,
+  // create: [can] of cfg (the loop rate and [encoder] wheels_per_side with it); null (and ok) for
+  // bus = "none" with no log; errors name the interface, and begin with cfg.source ("file: ")
+  // when the config is at fault, with "--can-log FILE" when the log file is. virtual_time: the
+  // log waits for its writer rather than dropping.
+  static Result<std::unique_ptr<CanLink>> create(const Config& cfg, loop::OdometryLoop& loop,
                                                  const std::string& can_log,
-                                                 bool virtual_time = false,
-                                                 std::string_view config_source = {});
+                                                 bool virtual_time = false);
   // start: the log thread (call just before the loop runs).
   void start(std::int64_t epoch_ns);
   // send_final: final frames with the stopping status (loop thread, after run()).

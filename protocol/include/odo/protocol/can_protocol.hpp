@@ -25,6 +25,7 @@ enum class Msg : std::uint8_t {
   kStatus = 4,         // encoder flags, calibration state, stopping, set-pose ack, missed, uptime
   kTiming = 5,         // wake-up latency p99/max, compute max, transmit drops
   kEncoderFaults = 6,  // the encoder backend's eight fault counters (saturating at 255)
+  kSideWheels = 7,     // several encoders per side: slip and dropped-wheel flags and counters
   kSetPose = 8,        // command to the node: set (DLC 8) or reset to zero (DLC 0)
   kFixPose = 9,        // absolute fix to the node, part 1: x, y, seq (self-calibration, issue 18)
   kFixSigma = 10,      // part 2: theta, sigma_xy, sigma_theta (0 = theta unknown), age, seq
@@ -82,6 +83,13 @@ struct StatusMsg {
   std::uint32_t missed_deadlines = 0;  // saturates at 65535 on the wire
   double uptime = 0.0;                 // [s] loop time, 1 s resolution, saturates at 2^24-1
 };
+// SideWheelsMsg (issue 38): what several encoders per side add to Status's encoder flags (bits
+// 0..7 only): the slip and dropped-wheel flags of the last sample and their event counters.
+struct SideWheelsMsg {
+  std::uint32_t encoder_flags = 0;   // EncoderFlag bits; only kSideWheelFlags' are carried
+  std::uint8_t wheels_per_side = 2;  // 1..7 on the wire (the configuration caps it at 4)
+  EncoderCounters counters;  // only slip_events and wheel_drops are carried, saturating at 65535
+};
 struct TimingMsg {
   double wakeup_p99 = 0.0;       // [s]
   double wakeup_max = 0.0;       // [s]
@@ -111,6 +119,8 @@ void encode_status(std::uint32_t id, const StatusMsg& s, CanFrame& f) noexcept;
 void encode_timing(std::uint32_t id, const TimingMsg& t, CanFrame& f) noexcept;
 // encode_encoder_faults: the backend's counters, each saturating at 255.
 void encode_encoder_faults(std::uint32_t id, const EncoderCounters& c, CanFrame& f) noexcept;
+// encode_side_wheels: the SideWheels frame (flags, wheels per side, counters saturating).
+void encode_side_wheels(std::uint32_t id, const SideWheelsMsg& m, CanFrame& f) noexcept;
 // encode_set_pose: DLC 8 with x, y at 1 mm and theta (wrapped to (-pi, pi]) at 1e-4 rad.
 void encode_set_pose(std::uint32_t id, const SetPose& c, CanFrame& f) noexcept;
 // encode_set_pose_reset: the short form of SetPose{} (pose to (0, 0, 0)): DLC 0.
@@ -125,6 +135,8 @@ bool decode_status(const CanFrame& f, StatusMsg& s) noexcept;
 bool decode_timing(const CanFrame& f, TimingMsg& t) noexcept;
 // decode_encoder_faults: the counters as sent (255 = at least 255).
 bool decode_encoder_faults(const CanFrame& f, EncoderCounters& c) noexcept;
+// decode_side_wheels: the flags as EncoderFlag bits, the counters as sent (65535 = at least).
+bool decode_side_wheels(const CanFrame& f, SideWheelsMsg& m) noexcept;
 // encode_fix: the two frames of a fix (ids id_pose, id_sigma).
 void encode_fix(std::uint32_t id_pose, std::uint32_t id_sigma, const FixMsg& m, CanFrame& pose,
                 CanFrame& sigma) noexcept;

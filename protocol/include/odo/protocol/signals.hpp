@@ -70,6 +70,13 @@ inline constexpr Signal link_errors{"link_errors", 32, 8, 1.0, false, 0, 255, ""
 inline constexpr Signal sequence_gaps{"sequence_gaps", 40, 8, 1.0, false, 0, 255, ""};
 inline constexpr Signal controller_resets{"controller_resets", 48, 8, 1.0, false, 0, 255, ""};
 inline constexpr Signal reconnects{"reconnects", 56, 8, 1.0, false, 0, 255, ""};
+// SideWheels (issue 38): the side flags as single bits, then the side's counters.
+inline constexpr Signal slip_left{"slip_left", 0, 1, 1.0, false, 0, 1, ""};
+inline constexpr Signal slip_right{"slip_right", 1, 1, 1.0, false, 0, 1, ""};
+inline constexpr Signal wheel_dropped{"wheel_dropped", 2, 1, 1.0, false, 0, 1, ""};
+inline constexpr Signal wheels_per_side{"wheels_per_side", 4, 3, 1.0, false, 1, 7, ""};
+inline constexpr Signal slip_events{"slip_events", 8, 16, 1.0, false, 0, 65535, ""};
+inline constexpr Signal wheel_drops{"wheel_drops", 24, 16, 1.0, false, 0, 65535, ""};
 inline constexpr Signal set_x{"set_x", 0, 24, kSetPosScale, true, kI24Min, kI24Max, "m"};
 inline constexpr Signal set_y{"set_y", 24, 24, kSetPosScale, true, kI24Min, kI24Max, "m"};
 inline constexpr Signal set_theta{"set_theta",   48,           16,   kThetaScale, true,
@@ -113,6 +120,25 @@ inline constexpr auto kEncoderFaults = [] {
   for (std::size_t i = 0; i < a.size(); ++i) a[i] = kEncoderFaultFields[i].signal;
   return a;
 }();
+// kSideWheelFlags: each SideWheels flag signal and the EncoderFlag bit it carries.
+struct FlagSignal {
+  const Signal* signal;
+  EncoderFlag flag;
+};
+inline constexpr FlagSignal kSideWheelFlags[] = {{&slip_left, kEncoderSlipLeft},
+                                                 {&slip_right, kEncoderSlipRight},
+                                                 {&wheel_dropped, kEncoderWheelDropped}};
+// kSideWheelCounters: the SideWheels counters and the EncoderCounters field each carries.
+inline constexpr CounterSignal kSideWheelCounters[] = {
+    {&slip_events, &EncoderCounters::slip_events}, {&wheel_drops, &EncoderCounters::wheel_drops}};
+inline constexpr auto kSideWheels = [] {
+  std::array<const Signal*, std::size(kSideWheelFlags) + 1 + std::size(kSideWheelCounters)> a{};
+  std::size_t i = 0;
+  for (const FlagSignal& f : kSideWheelFlags) a[i++] = f.signal;
+  a[i++] = &wheels_per_side;
+  for (const CounterSignal& c : kSideWheelCounters) a[i++] = c.signal;
+  return a;
+}();
 inline constexpr const Signal* kSetPose[] = {&set_x, &set_y, &set_theta};
 inline constexpr const Signal* kFixPose[] = {&fix_x, &fix_y, &fix_seq};
 inline constexpr const Signal* kFixSigma[] = {&fix_theta, &fix_sigma_xy, &fix_sigma_theta, &fix_age,
@@ -135,6 +161,7 @@ inline constexpr MessageSpec kMessages[] = {
     {Msg::kStatus, "Status", false, sig::kStatus},
     {Msg::kTiming, "Timing", false, sig::kTiming},
     {Msg::kEncoderFaults, "EncoderFaults", false, sig::kEncoderFaults},
+    {Msg::kSideWheels, "SideWheels", false, sig::kSideWheels},
     {Msg::kSetPose, "SetPose", true, sig::kSetPose},
     {Msg::kFixPose, "FixPose", true, sig::kFixPose},
     {Msg::kFixSigma, "FixSigma", true, sig::kFixSigma},
