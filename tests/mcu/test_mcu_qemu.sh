@@ -47,6 +47,16 @@ check "no missed deadline, no dropped frame: $(cat "$tmp/end")" $rc
 check "odometryd --virtual-time exit 0" $?
 python3 "$tool" candump "$tmp/usart1.txt" "$tmp/mcu.log"
 pose() { grep -E ' (410|411)#' "$1" | sed 's/.* //'; }
+# frames_equal_unlike_default CAPTURE TAG: the firmware's pose frames in its USART1 CAPTURE
+# ($tmp/mcuTAG.log as candump -L) equal odometryd's in $tmp/hostTAG.log and differ from the
+# default run's ($tmp/host.pose).
+frames_equal_unlike_default() {
+  python3 "$tool" candump "$1" "$tmp/mcu$2.log"
+  pose "$tmp/host$2.log" >"$tmp/host$2.pose"
+  pose "$tmp/mcu$2.log" >"$tmp/mcu$2.pose"
+  [ -s "$tmp/host$2.pose" ] && cmp -s "$tmp/host$2.pose" "$tmp/mcu$2.pose" &&
+    ! cmp -s "$tmp/host$2.pose" "$tmp/host.pose"
+}
 pose "$tmp/host.log" >"$tmp/host.pose"
 pose "$tmp/mcu.log" >"$tmp/mcu.pose"
 [ -s "$tmp/host.pose" ] && cmp -s "$tmp/host.pose" "$tmp/mcu.pose"
@@ -118,11 +128,7 @@ timeout 300 qemu-system-arm -M netduinoplus2 -display none -monitor none \
 check "calibrated firmware exits 0" $?
 tr '\r' '\n' <"$tmp/cal.txt" | grep -q '^# calibration (flash sectors 10-11): ok, sequence 1'
 check "firmware loads the record from flash" $?
-python3 "$tool" candump "$tmp/cal.txt" "$tmp/mcucal.log"
-pose "$tmp/hostcal.log" >"$tmp/hostcal.pose"
-pose "$tmp/mcucal.log" >"$tmp/mcucal.pose"
-[ -s "$tmp/hostcal.pose" ] && cmp -s "$tmp/hostcal.pose" "$tmp/mcucal.pose" &&
-  ! cmp -s "$tmp/hostcal.pose" "$tmp/host.pose"
+frames_equal_unlike_default "$tmp/cal.txt" cal
 rc=$?  # before the name is expanded: its $(...) would set $? to its own status
 check "calibrated: $(wc -l <"$tmp/mcucal.pose") pose frames equal odometryd's, unlike the uncalibrated run" $rc
 "$ODOMCTL" decode --csv "$tmp/mcucal.log" | grep 'Status,calibration_state,' | tail -1 | grep -q ',1$'
@@ -172,11 +178,7 @@ tr '\r' '\n' <"$tmp/w2.txt" | grep '^# end' >"$tmp/w2.end"
 grep -q ' missed=0 ' "$tmp/w2.end" && grep -q ' dropped=0 ' "$tmp/w2.end"
 rc=$?  # before the name is expanded: its $(...) would set $? to its own status
 check "two wheels: no missed deadline, no dropped frame: $(cat "$tmp/w2.end")" $rc
-python3 "$tool" candump "$tmp/w2.txt" "$tmp/mcuw2.log"
-pose "$tmp/hostw2.log" >"$tmp/hostw2.pose"
-pose "$tmp/mcuw2.log" >"$tmp/mcuw2.pose"
-[ -s "$tmp/hostw2.pose" ] && cmp -s "$tmp/hostw2.pose" "$tmp/mcuw2.pose" &&
-  ! cmp -s "$tmp/hostw2.pose" "$tmp/host.pose"
+frames_equal_unlike_default "$tmp/w2.txt" w2
 rc=$?  # before the name is expanded: its $(...) would set $? to its own status
 check "two wheels: $(wc -l <"$tmp/mcuw2.pose") pose frames equal odometryd's with wheels_per_side = 2, unlike one wheel's" $rc
 read -r n f0 fmax seq_ok dts ver wps faults lefts rights <<<"$(python3 "$tool" serial "$tmp/w2.txt.usart2")"
