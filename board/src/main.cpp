@@ -125,8 +125,8 @@ EncoderWiring make_encoders(const BoardConfig& cfg, const Kinematics& k) noexcep
   enc.emplace(*robot, cfg.counter_bits);
   return {&*enc, sim::scenario_duration(robot->scenario())};
 #else
-  // Two wheels per side at most: the timers with an encoder mode are six (README "The
-  // microcontroller firmware").
+  // Wired for two wheels per side at most (the chip's six encoder timers would allow three:
+  // README "On a real STM32F405 board").
   static_assert(kBoardWheelsPerSide <= 2, "a real board counts at most 2 wheels per side");
   (void)k;
   static MmioBus mmio;
