@@ -6,7 +6,8 @@
 #                    [--duration S] [--rate-hz HZ] [--covariance-ticks N] [--virtual] [--fault]
 #                    [-- extra qemu-system-arm args]
 #
-#   --elf PATH      the image (default build/mcu-stm32f405/board/odo_mcu_qemu.elf; build it with
+#   --elf PATH      the image (default build/mcu-stm32f405/board/odo_mcu_qemu.elf; odo_mcu_qemu_w2.elf:
+#                   two wheels per side, serial counts version 2; build them with
 #                   cmake --preset mcu-stm32f405 && cmake --build --preset mcu-stm32f405)
 #   --usart1 SPEC   USART1: the CAN pose protocol as SLCAN plus '#' report lines (default stdio)
 #   --usart2 SPEC   USART2: the serial counts stream (protocol/serial_counts.hpp; default null)

@@ -5,7 +5,9 @@
 #               study: UMBmark noise, self-calibration over 300 seeds)
 #   soak        the `soak` tier of the default build: 24 h of simulated driving with random
 #               faults in virtual time (ODO_SOAK=0 skips it)
-#   mcu         (after default) the microcontroller firmware: preset mcu-stm32f405 built, then
+#   mcu         (after default) the microcontroller firmware: preset mcu-stm32f405 built, the
+#               real-board images' flash checked against board/flash_limit.txt (tools/mcu_size.sh:
+#               over it, the stage fails), then
 #               tests/mcu/test_mcu_qemu.sh in qemu-system-arm (ODO_MCU=0 skips it; under CI a
 #               missing toolchain or QEMU fails it); the kernel tier's kernel_mcu_slcan uses its
 #               image
@@ -428,7 +430,7 @@ stage_mcu() {  # the microcontroller firmware (issue 36): its preset's build, th
   } >"$log" 2>&1
   local rc=$?
   set -e
-  grep -E '^(FAIL|test_mcu_qemu)|odo_mcu(_qemu)?\.elf$' "$log" || true
+  grep -E '^(FAIL|test_mcu_qemu)|odo_mcu(_qemu(_w2)?)?\.elf$' "$log" || true
   line=$(grep -E '^test_mcu_qemu: [0-9]+ passed, [0-9]+ failed' "$log" | tail -1 || true)
   if [[ -n $line ]]; then
     p=$(sed -E 's/.*: ([0-9]+) passed.*/\1/' <<<"$line") f=$(sed -E 's/.* ([0-9]+) failed.*/\1/' <<<"$line")
@@ -438,6 +440,15 @@ stage_mcu() {  # the microcontroller firmware (issue 36): its preset's build, th
     r="FAILED (see $log)"; status=1
     [[ -n $line ]] || n_fail=$((n_fail + 1))  # the build failed before any check ran
   fi
+  # The real-board images' flash (one and two wheels per side) against board/flash_limit.txt
+  # (BENCHMARKS.md's < 128 KB): over it, the stage fails, whatever the QEMU tests said.
+  # (An image the build did not make: the build's failure above says so.)
+  for p in odo_mcu odo_mcu_w2; do
+    [[ -f build/mcu-stm32f405/board/$p.elf ]] || continue
+    if tools/mcu_size.sh "build/mcu-stm32f405/board/$p.elf"; then n_pass=$((n_pass + 1))
+    else r="FAILED ($p.elf's flash not below board/flash_limit.txt)"; status=1
+      n_fail=$((n_fail + 1)) failures+=("mcu: $p.elf's flash not below board/flash_limit.txt"); fi
+  done
   # The default tree's tests that need the image (label mcu: odometryd's serial backend against
   # the firmware in QEMU); gated, so a skip (no image) fails under CI.
   if ! gated "mcu" build/mcu-ctest.log ctest --test-dir build/default -L '^mcu$' \

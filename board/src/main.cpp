@@ -7,6 +7,7 @@
 //   --serial-hz H the serial counts stream's rate on USART2 [Hz], loop rate / whole number, 0 off
 //   --rate-hz H   the loop rate [Hz] (default 100; the CAN and serial rates must divide it)
 //   --covariance-ticks N  error_model.covariance_ticks (loop ticks merged into one covariance step)
+#include <array>
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
@@ -30,6 +31,7 @@
 #include "odo/loop/loop.hpp"
 #if ODO_BOARD_SIM
 #include "odo/sim/robot.hpp"
+#include "odo/sim/side_wheels_sim.hpp"
 #include "odo/sim/sim_encoder.hpp"
 #endif
 
@@ -79,11 +81,31 @@ void say(Line& l) noexcept {
   std::exit(2);
 }
 
-// EncoderWiring: the board's encoder source and the scenario's length [s] (0: none).
+// EncoderWiring: the board's encoder source, the scenario's length [s] (0: none) and, with
+// several wheels per side, the source's per-wheel readings of its last read.
 struct EncoderWiring {
   EncoderSource* source = nullptr;
   double scenario = 0.0;
+  const std::array<SideReadings, 2>* wheels = nullptr;
 };
+
+#if ODO_BOARD_SIM
+// sim_wheels: several wheels per side on the simulated robot, as odometryd's sim backend with
+// encoder.wheels_per_side > 1 (SimSideWheelsSource, the wheel model's documented defaults).
+EncoderWiring sim_wheels(const BoardConfig& cfg, sim::SimRobot& robot) noexcept {
+  static std::optional<sim::SimSideWheelsSource> enc;
+  sim::SideWheelsSimParams p;
+  p.wheels_per_side = cfg.wheels.wheels_per_side;
+  auto model = sim::SideWheelsSim::create(p, robot.geometry());
+  if (!model) fail("simulated wheels");
+  SideWheelsConfig w = cfg.wheels;
+  w.read_period = 1.0 / cfg.rate_hz;  // the combiner's slip window in this loop's ticks
+  auto src = sim::SimSideWheelsSource::create(robot, std::move(model).value(), w, cfg.counter_bits);
+  if (!src) fail(src.error().message.c_str());
+  enc.emplace(std::move(src).value());
+  return {&*enc, sim::scenario_duration(robot.scenario()), &enc->readings()};
+}
+#endif
 
 EncoderWiring make_encoders(const BoardConfig& cfg, const Kinematics& k) noexcept {
 #if ODO_BOARD_SIM
@@ -99,12 +121,26 @@ EncoderWiring make_encoders(const BoardConfig& cfg, const Kinematics& k) noexcep
                                  sim::squares_scenario(k, so, sim::SquareSet::kCcw));
   if (!r) fail("simulated robot");
   robot.emplace(std::move(r).value());
+  if (kBoardWheelsPerSide > 1) return sim_wheels(cfg, *robot);
   enc.emplace(*robot, cfg.counter_bits);
   return {&*enc, sim::scenario_duration(robot->scenario())};
 #else
-  (void)cfg;
+  // Wired for two wheels per side at most (the chip's six encoder timers would allow three:
+  // README "On a real STM32F405 board").
+  static_assert(kBoardWheelsPerSide <= 2, "a real board counts at most 2 wheels per side");
   (void)k;
   static MmioBus mmio;
+  if constexpr (kBoardWheelsPerSide == 2) {
+    SideWheelsConfig w = cfg.wheels;
+    w.read_period = 1.0 / cfg.rate_hz;  // the combiner's slip window in this loop's ticks
+    static std::optional<Stm32SideTimers> side;
+    auto t = Stm32SideTimers::create(mmio, w);
+    if (!t)
+      fail("encoder: wheels_per_side, slip_window, slip_counts or slip_fraction out of range");
+    side.emplace(std::move(*t));
+    side->init();
+    return {&*side, 0.0, &side->readings()};
+  }
   static Stm32EncoderTimers enc(mmio);
   enc.init();
   return {&enc, 0.0};
@@ -247,7 +283,7 @@ int main() {
   const StoredCalibration cal = load_calibration(cfg.robot);
   auto kc = Kinematics::create(cal.params);
   if (!kc) fail("calibrated kinematics");
-  static LatchedEncoder latched(*enc.source);
+  static LatchedEncoder latched(*enc.source, enc.wheels);
   loop::LoopConfig lc;
   lc.rate_hz = cfg.rate_hz;
   lc.error_model = cfg.error_model;
@@ -263,7 +299,8 @@ int main() {
   const double serial_hz = opt.serial_hz >= 0.0 ? opt.serial_hz : cfg.serial_hz;
   const std::int64_t serial_div = protocol::divisor_for(cfg.rate_hz, serial_hz);
   if (serial_div < 0) fail("--serial-hz: not the loop rate divided by a whole number");
-  static SerialStream stream(*lp, uart2(), static_cast<std::uint32_t>(serial_div));
+  static SerialStream stream(*lp, uart2(), static_cast<std::uint32_t>(serial_div),
+                             enc.wheels ? &latched.wheels() : nullptr, cfg.wheels.wheels_per_side);
   lp->add_observer(&stream);
   clock.configure(lp->period(), ci.tim_hz);
   latched.latch(0);  // the reference reading: time 0, where the clock stands until the first sleep

@@ -1,12 +1,13 @@
 #include "odo/board/pins.hpp"
 
+#include "odo/board/board_config.hpp"
 #include "odo/board/stm32f4.hpp"
 
 namespace odo::board {
 
 namespace {
 
-constexpr std::uintptr_t kGpioA = 0x40020000, kGpioB = 0x40020400;
+constexpr std::uintptr_t kGpioA = 0x40020000, kGpioB = 0x40020400, kGpioC = 0x40020800;
 constexpr std::uintptr_t kModer = 0x00, kPupdr = 0x0C, kAfrl = 0x20, kAfrh = 0x24;
 
 // alternate: pin `pin` of the port at `port` to alternate function `af`, with a pull-up (an
@@ -33,6 +34,13 @@ void pins_init() noexcept {
   alternate(kGpioB, 7, 2);                      // TIM4 CH2: right encoder B
   alternate(kGpioB, 8, 9);                      // CAN1 RX (pulled up: recessive when unwired)
   alternate(kGpioB, 9, 9);                      // CAN1 TX
+  if (kBoardWheelsPerSide > 1) {                // the second wheel of each side (Stm32SideTimers)
+    reg(rcc::kAhb1Enr) |= 1u << 2;              // GPIOC
+    alternate(kGpioA, 0, 2);                    // TIM5 CH1: left wheel 2 A
+    alternate(kGpioA, 1, 2);                    // TIM5 CH2: left wheel 2 B
+    alternate(kGpioC, 6, 3);                    // TIM8 CH1: right wheel 2 A
+    alternate(kGpioC, 7, 3);                    // TIM8 CH2: right wheel 2 B
+  }
 }
 
 }  // namespace odo::board

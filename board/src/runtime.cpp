@@ -5,10 +5,17 @@
 // (picolibc's, built for size, copies a byte at a time: 4 instructions a byte, 1.8k a tick for
 // the loop's snapshot copies; a word at a time when both ends are aligned is 4x fewer), and
 // double division (libgcc's bit-at-a-time __aeabi_ddiv is wrapped, -Wl,--wrap: soft_divide.hpp
-// takes normal operands, libgcc's the rest).
+// takes normal operands, libgcc's the rest), operator new and delete and the helpers that
+// libstdc++'s headers call for a throw (std::__throw_*). The last two replace libstdc++'s own,
+// which are built with exceptions: linking them (new_op.o, functexcept.o) linked the exception
+// classes, the C++ personality routine and libgcc's ARM unwinder into a firmware built with
+// -fno-exceptions, 6 KB that can never run. Here an allocation failure or a violated
+// precondition is a fatal report, as abort() is.
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <new>
 
 #include "odo/board/fault.hpp"
 #include "odo/board/soft_divide.hpp"
@@ -115,3 +122,53 @@ void __aeabi_memcpy8(void* d, const void* s, std::size_t n) {
 }
 
 }  // extern "C"
+
+// Allocation: malloc (counted and refused after start-up, system.cpp) and, over-aligned,
+// aligned_alloc with the size rounded up to the alignment as libstdc++'s operator new does; a
+// failure is fatal (nothing could catch std::bad_alloc here).
+void* operator new(std::size_t n) {
+  void* p = std::malloc(n == 0 ? 1 : n);
+  if (p == nullptr) odo::board::report_fatal("out of memory", n);
+  return p;
+}
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
+  return std::malloc(n == 0 ? 1 : n);
+}
+void* operator new(std::size_t n, std::align_val_t a) {
+  const auto al = static_cast<std::size_t>(a);
+  void* p = ::aligned_alloc(al, (n + al - 1) & ~(al - 1));
+  if (p == nullptr) odo::board::report_fatal("out of memory", n);
+  return p;
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::align_val_t) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept {
+  std::free(p);
+}
+
+// What libstdc++'s headers call where they would throw (bits/functexcept.h): a string or vector
+// grown past max_size(), an index out of range (the core rooms do neither on purpose).
+namespace std {
+[[noreturn]] void __throw_bad_alloc() {
+  odo::board::report_fatal("bad_alloc", 0);
+}
+[[noreturn]] void __throw_bad_array_new_length() {
+  odo::board::report_fatal("bad_array_new_length", 0);
+}
+[[noreturn]] void __throw_length_error(const char*) {
+  odo::board::report_fatal("length_error", 0);
+}
+[[noreturn]] void __throw_logic_error(const char*) {
+  odo::board::report_fatal("logic_error", 0);
+}
+[[noreturn]] void __throw_out_of_range_fmt(const char*, ...) {
+  odo::board::report_fatal("out_of_range", 0);
+}
+}  // namespace std

@@ -1,5 +1,7 @@
 #include "odo/board/stm32_encoder_timers.hpp"
 
+#include "odo/hal/side_sample.hpp"
+
 namespace odo::board {
 
 namespace {
@@ -13,26 +15,60 @@ constexpr std::uint32_t kSmsEncoder3 = 3u;  // counts on TI1 and TI2 edges
 constexpr std::uint32_t kCcmr1Inputs = (1u << 0) | (3u << 4) | (1u << 8) | (3u << 12);
 }  // namespace
 
-void Stm32EncoderTimers::init_timer(std::uint32_t base) noexcept {
-  bus_->write(base + kCr1, 0);  // stopped while configured
-  bus_->write(base + kCcmr1, kCcmr1Inputs);
-  bus_->write(base + kCcer, 0);  // both inputs non-inverted (a mirrored motor: swap A and B)
-  bus_->write(base + kSmcr, kSmsEncoder3);
-  bus_->write(base + kArr, 0xFFFF);
-  bus_->write(base + kCnt, 0);
-  bus_->write(base + kCr1, kCr1Cen);
+void init_encoder_timer(RegisterBus& bus, std::uint32_t base) noexcept {
+  bus.write(base + kCr1, 0);  // stopped while configured
+  bus.write(base + kCcmr1, kCcmr1Inputs);
+  bus.write(base + kCcer, 0);  // both inputs non-inverted (a mirrored motor: swap A and B)
+  bus.write(base + kSmcr, kSmsEncoder3);
+  // 16 bits also on TIM5 (a 32-bit timer): every wheel of a side wraps alike.
+  bus.write(base + kArr, 0xFFFF);
+  bus.write(base + kCnt, 0);
+  bus.write(base + kCr1, kCr1Cen);
+}
+
+std::int64_t read_encoder_timer(RegisterBus& bus, std::uint32_t base) noexcept {
+  return static_cast<std::int64_t>(bus.read(base + kCnt) & 0xFFFFu);
 }
 
 void Stm32EncoderTimers::init() noexcept {
-  init_timer(kTim3);
-  init_timer(kTim4);
+  init_encoder_timer(*bus_, kTim3);
+  init_encoder_timer(*bus_, kTim4);
 }
 
 EncoderSample Stm32EncoderTimers::read(TimeNs now) noexcept {
   EncoderSample s;
-  s.left = static_cast<std::int64_t>(bus_->read(kTim3 + kCnt) & 0xFFFFu);
-  s.right = static_cast<std::int64_t>(bus_->read(kTim4 + kCnt) & 0xFFFFu);
+  s.left = read_encoder_timer(*bus_, kTim3);
+  s.right = read_encoder_timer(*bus_, kTim4);
   s.stamp = now;
+  return s;
+}
+
+std::optional<Stm32SideTimers> Stm32SideTimers::create(RegisterBus& bus,
+                                                       SideWheelsConfig c) noexcept {
+  c.wheels_per_side = 2;
+  c.counter_bits = 16;
+  auto combiner = SideCombiner::make(c);
+  if (!combiner) return std::nullopt;
+  return Stm32SideTimers(bus, *combiner);
+}
+
+void Stm32SideTimers::init() noexcept {
+  for (std::size_t i = 0; i < kLeft.size(); ++i) {
+    init_encoder_timer(*bus_, kLeft[i]);
+    init_encoder_timer(*bus_, kRight[i]);
+  }
+}
+
+EncoderSample Stm32SideTimers::read(TimeNs now) noexcept {
+  // A timer's counter cannot fault (no decoder error is reported): faulted stays 0.
+  for (std::size_t i = 0; i < kLeft.size(); ++i) {
+    readings_[0].counts[i] = read_encoder_timer(*bus_, kLeft[i]);
+    readings_[1].counts[i] = read_encoder_timer(*bus_, kRight[i]);
+  }
+  const SideStep step = combiner_.step(readings_[0], readings_[1]);
+  EncoderSample s;
+  s.stamp = now;
+  apply_side_step(step, combiner_.counters(), s);
   return s;
 }
 

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <cstdlib>
 
+#include "odo/board/board_config.hpp"
 #include "odo/board/fault.hpp"
 #include "odo/board/stm32f4.hpp"
 
@@ -35,8 +36,12 @@ ClockInfo clock_init() noexcept {
   ClockInfo info;
   reg(rcc::kApb1Enr) |= (1u << 1) | (1u << 2) | (1u << 17) | (1u << 28);  // TIM3/4, USART2, PWR
   reg(rcc::kApb2Enr) |= 1u << 4;                                          // USART1
-  reg(rcc::kCr) |= 1u << 16;                                              // HSEON
-  if (!wait_bit(rcc::kCr, 1u << 17, 1u << 17, 100000)) {                  // HSERDY
+  if (kBoardWheelsPerSide > 1) {  // the second wheel of each side: TIM5 (APB1), TIM8 (APB2)
+    reg(rcc::kApb1Enr) |= 1u << 3;
+    reg(rcc::kApb2Enr) |= 1u << 1;
+  }
+  reg(rcc::kCr) |= 1u << 16;                              // HSEON
+  if (!wait_bit(rcc::kCr, 1u << 17, 1u << 17, 100000)) {  // HSERDY
     // No crystal, or QEMU (no RCC model): its SysTick counts at 168 MHz whatever RCC says.
     if (ODO_BOARD_QEMU) info.tim_hz = 168000000u;
     return info;

@@ -66,11 +66,13 @@ void TimerClock::on_update() noexcept {
 
 void LatchedEncoder::latch(TimeNs t) noexcept {
   sample_ = inner_->read(t);
+  if (wheels_in_ != nullptr) wheels_latched_ = *wheels_in_;
 }
 
 EncoderSample LatchedEncoder::read(TimeNs) noexcept {
   asm volatile("cpsid i" ::: "memory");
   const EncoderSample s = sample_;
+  if (wheels_in_ != nullptr) wheels_read_ = wheels_latched_;
   asm volatile("cpsie i" ::: "memory");
   return s;
 }

@@ -128,14 +128,16 @@ Result<SimSideWheelsSource> SimSideWheelsSource::create(SimRobot& robot, SideWhe
 EncoderSample SimSideWheelsSource::read(TimeNs now) noexcept {
   robot_->advance_to(now);
   model_.update(now, robot_->wheel_angle_left(), robot_->wheel_angle_right());
-  SideReadings r[2];
-  for (int s = 0; s < 2; ++s)
+  for (int s = 0; s < 2; ++s) {
+    SideReadings& r = readings_[static_cast<std::size_t>(s)];
+    r.faulted = 0;
     for (int i = 0; i < model_.params().wheels_per_side; ++i) {
       // The register keeps the low bits_ bits; wrap_delta from 0 sign-extends them.
-      r[s].counts[static_cast<std::size_t>(i)] = wrap_delta(0, model_.counts(s, i), bits_);
-      if (model_.faulted(s, i)) r[s].faulted |= static_cast<std::uint8_t>(1u << i);
+      r.counts[static_cast<std::size_t>(i)] = wrap_delta(0, model_.counts(s, i), bits_);
+      if (model_.faulted(s, i)) r.faulted |= static_cast<std::uint8_t>(1u << i);
     }
-  last_ = combiner_.step(r[0], r[1]);
+  }
+  last_ = combiner_.step(readings_[0], readings_[1]);
   EncoderSample out;
   out.stamp = now;
   apply_side_step(last_, combiner_.counters(), out);

@@ -9,13 +9,17 @@ Stm32TimerModel::Timer* Stm32TimerModel::timer(std::uint32_t addr, std::uint32_t
   const std::uint32_t base = addr - off;
   if (base == kTim3) return &t_[0];
   if (base == kTim4) return &t_[1];
+  if (base == kTim5) return &t_[2];
+  if (base == kTim8) return &t_[3];
   return nullptr;
 }
 
 namespace {
 
 // Offsets, model fields and the bits a write keeps (RM0090 18.4.1-18.4.12; TIM3 and TIM4 are
-// 16-bit: CNT's and ARR's bits 31..16 read 0).
+// 16-bit: CNT's and ARR's bits 31..16 read 0). TIM5 (32-bit) and TIM8 (advanced, 17.4) are
+// modelled alike: the driver sets their range to 16 bits, and their further registers (TIM8's
+// RCR, BDTR) are outputs' the encoder mode does not use.
 struct Field {
   std::uint32_t off;
   std::uint32_t mask;

@@ -9,6 +9,11 @@
                                          protocol's DBC layout: int24 mm, int24 mm, int16 1e-4 rad)
                                          as SLCAN to node 1 (id 0x418), prints the frames after it
                                          as candump -L lines and the '#'-lines on stderr
+  slcan_tool.py serial FILE              the serial counts records of a USART2 capture (below)
+  slcan_tool.py pace FILE LINK AFTER     a pty linked at LINK; AFTER seconds later the frames of
+                                         FILE (a USART2 capture) written to it one every 10 ms of
+                                         the host's clock (the records' own spacing), whole frames
+                                         as the UART sent them; then 1 s of quiet and exit
 """
 import subprocess
 import sys
@@ -102,7 +107,10 @@ def cobs_decode(block):
 def serial_records(path):
     """The serial counts records (issue 37's wire format, written from its spec, not its code):
     COBS frames ending in 0x00; u8 version, u8 flags, u16 seq, u32 time_us, i32 left, i32 right
-    little-endian, then CRC-16/CCITT-FALSE of those bytes, little-endian."""
+    little-endian, then CRC-16/CCITT-FALSE of those bytes, little-endian. Version 2 (issue 38):
+    u8 version, u8 flags, u16 seq, u32 time_us, u8 wheels_per_side N, u8 wheel_faults, i32
+    left[N], i32 right[N], CRC. Each record as (version, flags, seq, time_us, lefts, rights,
+    wheel_faults), lefts and rights tuples of N counters."""
     import struct
     recs = []
     for block in open(path, "rb").read().split(b"\0")[:-1]:
@@ -110,14 +118,55 @@ def serial_records(path):
         body, crc = rec[:-2], struct.unpack("<H", rec[-2:])[0]
         if crc != crc16_ccitt_false(body):
             raise ValueError(f"CRC mismatch in record {len(recs)}")
-        recs.append(struct.unpack("<BBHIii", body[:16]))
+        if body[0] == 2:
+            version, flags, seq, time_us, n, faults = struct.unpack("<BBHIBB", body[:10])
+            if len(body) != 10 + 8 * n:
+                raise ValueError(f"record {len(recs)}: {len(body)} bytes for {n} wheels a side")
+            counts = struct.unpack(f"<{2 * n}i", body[10:])
+            recs.append((version, flags, seq, time_us, counts[:n], counts[n:], faults))
+        else:
+            version, flags, seq, time_us, left, right = struct.unpack("<BBHIii", body[:16])
+            recs.append((version, flags, seq, time_us, (left,), (right,), 0))
     return recs
 
 
 if __name__ == "__main__" and sys.argv[1] == "serial":
-    # serial FILE: prints "records first_flags other_flags seq_ok time_ok last_left last_right"
+    # serial FILE: prints "records first_flags other_flags seq_ok time_steps versions
+    # wheels_per_side wheel_faults last_lefts last_rights" (versions: the set of versions seen;
+    # wheel_faults: the OR of every record's; the counters comma-separated)
     r = serial_records(sys.argv[2])
     seq_ok = all(r[i][2] == (r[0][2] + i) & 0xFFFF for i in range(len(r)))
     dt = {r[i + 1][3] - r[i][3] for i in range(len(r) - 1)}
-    print(len(r), r[0][1], max((x[1] for x in r[1:]), default=0), int(seq_ok), sorted(dt),
-          r[-1][0], r[-1][4], r[-1][5])
+    faults = 0
+    for x in r:
+        faults |= x[6]
+    print(len(r), r[0][1], max((x[1] for x in r[1:]), default=0), int(seq_ok),
+          str(sorted(dt)).replace(" ", ""), ",".join(str(v) for v in sorted({x[0] for x in r})),
+          ",".join(str(v) for v in sorted({len(x[4]) for x in r})), faults,
+          ",".join(map(str, r[-1][4])), ",".join(map(str, r[-1][5])))
+
+
+def pace(path, link, after):
+    """A USART2 capture replayed on a pty at the firmware's record rate (see the top)."""
+    import os
+    import termios
+    import time
+    import tty
+    master, slave = os.openpty()
+    tty.setraw(slave, termios.TCSANOW)
+    tmp = link + ".new"
+    if os.path.lexists(tmp):
+        os.unlink(tmp)
+    os.symlink(os.ttyname(slave), tmp)
+    os.rename(tmp, link)
+    frames_ = [b + b"\0" for b in open(path, "rb").read().split(b"\0")[:-1]]
+    t0 = time.monotonic() + after
+    for i, f in enumerate(frames_):
+        time.sleep(max(0.0, t0 + 0.01 * i - time.monotonic()))
+        os.write(master, f)
+    time.sleep(1.0)
+    print(f"pace: {len(frames_)} frames in {time.monotonic() - t0:.2f} s", file=sys.stderr)
+
+
+if __name__ == "__main__" and sys.argv[1] == "pace":
+    pace(sys.argv[2], sys.argv[3], float(sys.argv[4]))

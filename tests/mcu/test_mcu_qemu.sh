@@ -13,6 +13,12 @@
 #     same store file; without the image the firmware runs uncalibrated.
 #  5. At 1 kHz with the covariance merged ten ticks at a time (--rate-hz 1000 --covariance-ticks
 #     10): pose frames equal odometryd's with the same [loop] and [error_model], no missed deadline.
+#  6. Two wheels per side (the image MCU_ELF's name + _w2, issue 38): in virtual time its pose
+#     frames equal odometryd --virtual-time's with [encoder] wheels_per_side = 2 (the same
+#     simulated wheels, combined on the board) and USART2 carries version 2 records, two counters a
+#     side; then paced at real time, USART2 on a pty, odometryd's serial backend with
+#     wheels_per_side = 2 reads those records and combines each side itself: its final pose
+#     equals the board's final pose frame.
 # usage: test_mcu_qemu.sh SOURCE_DIR MCU_ELF   (env ODOMETRYD, ODOMCTL)
 set -u
 src=$1
@@ -41,6 +47,16 @@ check "no missed deadline, no dropped frame: $(cat "$tmp/end")" $rc
 check "odometryd --virtual-time exit 0" $?
 python3 "$tool" candump "$tmp/usart1.txt" "$tmp/mcu.log"
 pose() { grep -E ' (410|411)#' "$1" | sed 's/.* //'; }
+# frames_equal_unlike_default CAPTURE TAG: the firmware's pose frames in its USART1 CAPTURE
+# ($tmp/mcuTAG.log as candump -L) equal odometryd's in $tmp/hostTAG.log and differ from the
+# default run's ($tmp/host.pose).
+frames_equal_unlike_default() {
+  python3 "$tool" candump "$1" "$tmp/mcu$2.log"
+  pose "$tmp/host$2.log" >"$tmp/host$2.pose"
+  pose "$tmp/mcu$2.log" >"$tmp/mcu$2.pose"
+  [ -s "$tmp/host$2.pose" ] && cmp -s "$tmp/host$2.pose" "$tmp/mcu$2.pose" &&
+    ! cmp -s "$tmp/host$2.pose" "$tmp/host.pose"
+}
 pose "$tmp/host.log" >"$tmp/host.pose"
 pose "$tmp/mcu.log" >"$tmp/mcu.pose"
 [ -s "$tmp/host.pose" ] && cmp -s "$tmp/host.pose" "$tmp/mcu.pose"
@@ -57,11 +73,12 @@ check "odomctl decode reads the firmware's frames" $?
 check "stopping status frame" $?
 
 # USART2: the serial counts stream (issue 37's format, decoded from its spec by slcan_tool.py):
-# one record a tick at the default 100 Hz, the first flagged 'booted', seq +1 and time +10 ms.
-read -r n f0 fmax seq_ok dts ver _ <<<"$(python3 "$tool" serial "$tmp/usart1.txt.usart2")"
+# one record a tick at the default 100 Hz, the first flagged 'booted', seq +1 and time +10 ms;
+# version 1 (one wheel per side: what every host reads).
+read -r n f0 fmax seq_ok dts ver wps _ <<<"$(python3 "$tool" serial "$tmp/usart1.txt.usart2")"
 ticks=$(sed -E 's/.* ticks=([0-9]+) .*/\1/' "$tmp/end")
-[ "$n" = "$ticks" ] && [ "$f0" = 4 ] && [ "$fmax" = 0 ] && [ "$seq_ok" = 1 ] && [ "$dts" = "[10000]" ] && [ "$ver" = 1 ]
-check "serial counts on USART2: $n records of $ticks ticks, CRC and COBS valid, seq and 10 ms steps" $?
+[ "$n" = "$ticks" ] && [ "$f0" = 4 ] && [ "$fmax" = 0 ] && [ "$seq_ok" = 1 ] && [ "$dts" = "[10000]" ] && [ "$ver" = 1 ] && [ "$wps" = 1 ]
+check "serial counts on USART2: $n version $ver records of $ticks ticks, CRC and COBS valid, seq and 10 ms steps" $?
 
 # 2. Set-pose (10 m, 20 m, 1 rad) after 100 pose frames.
 python3 "$tool" setpose "$elf" 10 20 1 >"$tmp/after.log" 2>"$tmp/after.err"
@@ -111,11 +128,7 @@ timeout 300 qemu-system-arm -M netduinoplus2 -display none -monitor none \
 check "calibrated firmware exits 0" $?
 tr '\r' '\n' <"$tmp/cal.txt" | grep -q '^# calibration (flash sectors 10-11): ok, sequence 1'
 check "firmware loads the record from flash" $?
-python3 "$tool" candump "$tmp/cal.txt" "$tmp/mcucal.log"
-pose "$tmp/hostcal.log" >"$tmp/hostcal.pose"
-pose "$tmp/mcucal.log" >"$tmp/mcucal.pose"
-[ -s "$tmp/hostcal.pose" ] && cmp -s "$tmp/hostcal.pose" "$tmp/mcucal.pose" &&
-  ! cmp -s "$tmp/hostcal.pose" "$tmp/host.pose"
+frames_equal_unlike_default "$tmp/cal.txt" cal
 rc=$?  # before the name is expanded: its $(...) would set $? to its own status
 check "calibrated: $(wc -l <"$tmp/mcucal.pose") pose frames equal odometryd's, unlike the uncalibrated run" $rc
 "$ODOMCTL" decode --csv "$tmp/mcucal.log" | grep 'Status,calibration_state,' | tail -1 | grep -q ',1$'
@@ -149,6 +162,88 @@ qemu "$tmp/khzbad.txt" --covariance-ticks 0 --duration 1
 [ $? = 2 ] && tr '\r' '\n' <"$tmp/khzbad.txt" |
   grep -q '^# error: error_model.covariance_ticks = 0 is outside the allowed range \[1, 100\]'
 check "--covariance-ticks 0 refused (exit 2) naming the setting and its range" $?
+
+# 6. Two wheels per side.
+elf2=${elf%.elf}_w2.elf
+sed 's/^wheels_per_side = 1 /wheels_per_side = 2 /' "$src/firmware/config/odometryd.toml" >"$tmp/w2.toml"
+grep -q '^wheels_per_side = 2 ' "$tmp/w2.toml"
+check "two-wheel config written" $?
+"$ODOMETRYD" --config "$tmp/w2.toml" --virtual-time --can-log "$tmp/hostw2.log" >/dev/null 2>&1
+check "odometryd --virtual-time with two wheels per side exit 0" $?
+elf_one=$elf
+elf=$elf2 qemu "$tmp/w2.txt"
+check "two-wheel firmware exits 0 after the square" $?
+elf=$elf_one
+tr '\r' '\n' <"$tmp/w2.txt" | grep '^# end' >"$tmp/w2.end"
+grep -q ' missed=0 ' "$tmp/w2.end" && grep -q ' dropped=0 ' "$tmp/w2.end"
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "two wheels: no missed deadline, no dropped frame: $(cat "$tmp/w2.end")" $rc
+frames_equal_unlike_default "$tmp/w2.txt" w2
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "two wheels: $(wc -l <"$tmp/mcuw2.pose") pose frames equal odometryd's with wheels_per_side = 2, unlike one wheel's" $rc
+read -r n f0 fmax seq_ok dts ver wps faults lefts rights <<<"$(python3 "$tool" serial "$tmp/w2.txt.usart2")"
+ticks=$(sed -E 's/.* ticks=([0-9]+) .*/\1/' "$tmp/w2.end")
+# The two wheels of a side differ by their radii (sim_hal's 0.3 % tolerance), never by more than
+# 1 % over the square.
+python3 - "$lefts" "$rights" <<'PY'
+import sys
+for side in sys.argv[1:]:
+    a, b = (int(v) for v in side.split(","))
+    assert a != b and abs(a - b) < 0.01 * max(abs(a), abs(b)), side
+PY
+rc=$?
+[ $rc = 0 ] && [ "$n" = "$ticks" ] && [ "$f0" = 4 ] && [ "$fmax" = 0 ] && [ "$seq_ok" = 1 ] &&
+  [ "$dts" = "[10000]" ] && [ "$ver" = 2 ] && [ "$wps" = 2 ] && [ "$faults" = 0 ]
+check "two wheels: $n version $ver records, $wps counters a side (last: left $lefts, right $rights), no wheel fault" $?
+# The daemon on the serial line: the firmware's USART2 bytes of a 24 s run (the first side, the
+# turn, ending in the pause after it) on a pty at the records' own pace, 10 ms apart, and
+# odometryd's serial backend with wheels_per_side = 2 reading them and combining each side
+# itself. (Not QEMU paced at real time onto the pty: on a loaded machine QEMU falls behind in
+# bursts, the host maps the controller's clock onto its own from arrival times, and a burst
+# after a stall of over 100 ms read as stale and as implausible jumps, seen on this two-core
+# machine.)
+elf=$elf2 qemu "$tmp/w2rt.txt" --duration 24
+check "two-wheel firmware, 24 s, exits 0" $?
+serial_config diffodom "$tmp/u2w2" 115200
+# Two wheels per side; a store and a state file of its own (part 4's store is calibrated).
+sed -i -e 's/^backend = "serial"$/backend = "serial"\nwheels_per_side = 2/' \
+  -e 's|/cal.bin"$|/w2cal.bin"|' -e 's|/state.bin"$|/w2state.bin"|' "$tmp/serial.toml"
+python3 "$tool" pace "$tmp/w2rt.txt.usart2" "$tmp/u2w2" 2.0 2>"$tmp/pace.err" &
+ppid=$!
+poll 5 test -e "$tmp/u2w2"
+"$ODOMETRYD" --config "$tmp/serial.toml" --json --quiet >"$tmp/w2rt.json" 2>"$tmp/w2rt.err" &
+opid=$!
+wait "$ppid"
+check "the firmware's records written to the pty: $(cat "$tmp/pace.err")" $?
+kill -TERM "$opid"
+wait "$opid"
+check "odometryd on the serial line (two wheels per side) exit 0 after SIGTERM" $?
+python3 "$tool" candump "$tmp/w2rt.txt" "$tmp/w2rt.log"
+"$ODOMCTL" decode --csv "$tmp/w2rt.log" >"$tmp/w2rt.csv"
+python3 - "$tmp/w2rt.json" "$tmp/w2rt.csv" "$tmp/w2rt.txt.usart2" "$src/tests/mcu" <<'PY'
+import csv, json, math, sys
+sys.path.insert(0, sys.argv[4])
+import slcan_tool
+d = json.load(open(sys.argv[1]))
+rows = list(csv.reader(open(sys.argv[2])))
+# odometryd's pose starts at the first record it reads (10 ms after the board's reference at
+# boot): the board's first 10 ms, straight ahead along x, are not in it. That record's travel:
+# the mean of its four counters (from 0 at boot) times pi 0.15 m / (2048 * 16) a count.
+first = slcan_tool.serial_records(sys.argv[3])[0]
+d0 = (sum(first[4]) + sum(first[5])) / 4 * math.pi * 0.15 / (2048 * 16)
+x = [float(r[6]) for r in rows if r[4] == "PoseX" and r[5] == "x"][-1]
+y = [float(r[6]) for r in rows if r[4] == "PoseYTheta" and r[5] == "y"][-1]
+th = [float(r[6]) for r in rows if r[4] == "PoseYTheta" and r[5] == "theta"][-1]
+print("odometryd", {k: d[k] for k in ("x", "y", "theta", "link_errors", "sequence_gaps",
+      "implausible_jumps")}, d.get("wheels"), "board", (x, y, th), "first record", d0)
+# The board's frames carry 0.1 mm and 1e-4 rad; the robot drove 4 m and turned 90 degrees.
+assert d["x"] > 3.9 and abs(d["x"] + d0 - x) <= 2e-4 and abs(d["y"] - y) <= 2e-4, (d, d0, x, y)
+assert abs(math.remainder(d["theta"] - th, 2 * math.pi)) <= 2e-4 and th > 1.5, (d, th)
+assert d["wheels"]["wheels_per_side"] == 2 and d["wheels"]["wheel_drops"] == 0, d
+assert d["wheels"]["slip_events"] == 0 and d["link_errors"] == 0, d
+assert d["sequence_gaps"] == 0 and d["implausible_jumps"] == 0, d
+PY
+check "odometryd combining the board's version 2 records per side: final pose equals the board's (less its first 10 ms)" $?
 
 # 3. Fault report.
 qemu "$tmp/fault.txt" --fault

@@ -61,4 +61,48 @@ TEST(Stm32EncoderTimers, WrapAwareDeltaRecoversEveryCountOverManyWraps) {
   EXPECT_EQ(sum_r, right);
 }
 
+// Two wheels per side (Stm32SideTimers): TIM3 and TIM5 left, TIM4 and TIM8 right, each wheel
+// wrapped on its own and the side's count the mean of its wheels (SideCombiner's default).
+TEST(Stm32SideTimers, FourTimersCountedAndEachSideTheMeanOfItsWheels) {
+  Stm32TimerModel m;
+  auto made = odo::board::Stm32SideTimers::create(m, odo::SideWheelsConfig{});
+  ASSERT_TRUE(made);
+  odo::board::Stm32SideTimers enc = std::move(*made);
+  enc.init();
+  for (int unit = 0; unit < 4; ++unit) EXPECT_TRUE(m.counting(unit)) << unit;
+  EXPECT_EQ(m.unknown_writes(), 0);
+  EXPECT_EQ(m.read(Stm32TimerModel::kTim8 + Stm32TimerModel::kSmcr), 3u);
+  EXPECT_EQ(m.read(Stm32TimerModel::kTim5 + Stm32TimerModel::kArr), 0xFFFFu);
+  enc.read(0);  // the reference reading of every wheel
+  // 300 reads; between two the left wheels move +20000 and +20004 counts (TIM3, TIM5), the
+  // right ones -1000 and -998 (TIM4, TIM8): 6000000 and 6001200 counts left (91 wraps of the
+  // 16-bit counters), -300000 and -299400 right. Each side's count is the mean of its wheels'
+  // travels: (6000000 + 6001200) / 2 = 6000600 and (-300000 - 299400) / 2 = -299700.
+  odo::EncoderSample s;
+  for (int i = 0; i < 300; ++i) {
+    m.edges(0, 20000);
+    m.edges(2, 20004);
+    m.edges(1, -1000);
+    m.edges(3, -998);
+    s = enc.read(i + 1);
+  }
+  EXPECT_EQ(s.left, 6000600);
+  EXPECT_EQ(s.right, -299700);
+  EXPECT_EQ(s.flags & (odo::kEncoderSlipLeft | odo::kEncoderSlipRight), 0u);
+  // The readings the serial counts records carry: the counters as the registers hold them.
+  EXPECT_EQ(enc.readings()[0].counts[0], 6000000 % 65536);
+  EXPECT_EQ(enc.readings()[0].counts[1], 6001200 % 65536);
+  EXPECT_EQ(enc.readings()[1].counts[0], 65536 - 300000 % 65536);
+  EXPECT_EQ(enc.readings()[1].counts[1], 65536 - 299400 % 65536);
+  EXPECT_EQ(enc.counter_bits(), 64);
+}
+
+TEST(Stm32SideTimers, ACombinationOutOfRangeIsRefused) {
+  Stm32TimerModel m;
+  odo::SideWheelsConfig c;
+  c.slip_counts = 0.0;  // the threshold's absolute part must be > 0 (side_wheels_range)
+  EXPECT_FALSE(odo::board::Stm32SideTimers::create(m, c));
+  EXPECT_FALSE(odo::check_side_wheels(c));  // the same verdict as the checked create()
+}
+
 }  // namespace

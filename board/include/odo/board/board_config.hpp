@@ -5,11 +5,21 @@
 
 #include <cstdint>
 
+#include "odo/hal/side_wheels.hpp"
 #include "odo/odometry/error_model.hpp"
 #include "odo/odometry/kinematics.hpp"
 #include "odo/protocol/can_protocol.hpp"
 
+// The wheels per side this image is built for (board/CMakeLists.txt, ODO_BOARD_WHEELS_PER_SIDE):
+// a build choice, since the encoder wiring and the serial record's version follow from it.
+#ifndef ODO_BOARD_WHEELS_PER_SIDE
+#define ODO_BOARD_WHEELS_PER_SIDE 1
+#endif
+
 namespace odo::board {
+
+inline constexpr int kBoardWheelsPerSide = ODO_BOARD_WHEELS_PER_SIDE;
+static_assert(kBoardWheelsPerSide >= 1 && kBoardWheelsPerSide <= kMaxWheelsPerSide);
 
 struct BoardConfig {
   double rate_hz = 100.0;  // [Hz] loop rate ([loop] rate_hz)
@@ -19,6 +29,9 @@ struct BoardConfig {
   bool sim_labmate = true;
   double side = 4.0, speed = 0.2, turn_rate = 0.5, pause = 0.5;  // [m], [m/s], [rad/s], [s]
   int counter_bits = 32;
+  // [encoder] wheels_per_side (1..4; several: version 2 serial records) and the combination's
+  // other keys at their defaults (odometryd's [encoder] defaults).
+  SideWheelsConfig wheels{kBoardWheelsPerSide};
   // [can]
   std::uint32_t base_id = protocol::kDefaultBaseId;
   int node_id = protocol::kDefaultNodeId;

@@ -15,11 +15,13 @@
 // round to reading them.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 
 #include "odo/hal/clock.hpp"
 #include "odo/hal/encoder.hpp"
+#include "odo/hal/side_wheels.hpp"
 
 namespace odo::board {
 
@@ -46,18 +48,29 @@ class TimerClock final : public Clock {
 };
 
 // LatchedEncoder: an EncoderSource whose read() returns the sample the timer interrupt took at
-// the last update (the inner source read at that update's time).
+// the last update (the inner source read at that update's time). With several wheels per side,
+// the inner source's per-wheel readings are latched with its sample, so that wheels() belongs to
+// the sample read() returned even when a late tick reads after the next update.
 class LatchedEncoder final : public EncoderSource {
  public:
-  explicit LatchedEncoder(EncoderSource& inner) noexcept : inner_(&inner) {}
+  // `wheels`: the inner source's per-wheel readings of its last read ([0] left, [1] right), or
+  // null with one wheel per side.
+  explicit LatchedEncoder(EncoderSource& inner,
+                          const std::array<SideReadings, 2>* wheels = nullptr) noexcept
+      : inner_(&inner), wheels_in_(wheels) {}
   // latch: reads the inner source at `t` [ns] (interrupt context, or before the timer runs).
   void latch(TimeNs t) noexcept;
   EncoderSample read(TimeNs now) noexcept override;
   int counter_bits() const noexcept override { return inner_->counter_bits(); }
+  // wheels: the per-wheel readings of the sample the last read() returned (all zero without).
+  const std::array<SideReadings, 2>& wheels() const noexcept { return wheels_read_; }
 
  private:
   EncoderSource* inner_;
+  const std::array<SideReadings, 2>* wheels_in_;
   EncoderSample sample_{};
+  std::array<SideReadings, 2> wheels_latched_{};
+  std::array<SideReadings, 2> wheels_read_{};
 };
 
 TimerClock& timer_clock() noexcept;

@@ -48,6 +48,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string_view>
 
 #include "odo/hal/choice.hpp"
@@ -143,14 +144,29 @@ constexpr double side_wheels_value(const SideWheelsConfig& c, SideParam k) noexc
   return c.read_period;
 }
 
+// side_wheels_outside: the first SideParam of `c` outside its side_wheels_range, or kSideParams
+// when every number is within.
+constexpr std::size_t side_wheels_outside(const SideWheelsConfig& c) noexcept {
+  for (std::size_t i = 0; i < kSideParams; ++i) {
+    const auto k = static_cast<SideParam>(i);
+    if (!side_wheels_range(k, c.read_period).contains(side_wheels_value(c, k))) return i;
+  }
+  return kSideParams;
+}
+
+// side_wheels_ok: whether check_side_wheels(c) passes, without forming its message (a firmware
+// whose configuration is built in carries no text for an error it cannot have: board/).
+constexpr bool side_wheels_ok(const SideWheelsConfig& c) noexcept {
+  return side_wheels_outside(c) == kSideParams && choice_name(kSideCombineNames, c.combine) != "?";
+}
+
 // check_side_wheels: every number in its side_wheels_range (a range error under its key) and the
 // combination one of kSideCombineNames.
 inline Status check_side_wheels(const SideWheelsConfig& c) {
-  for (std::size_t i = 0; i < kSideParams; ++i) {
+  if (const std::size_t i = side_wheels_outside(c); i < kSideParams) {
     const auto k = static_cast<SideParam>(i);
     const RangeRow r = side_wheels_range(k, c.read_period);
-    const double v = side_wheels_value(c, k);
-    if (!r.contains(v)) return range_error(r.range(r.key, v));
+    return range_error(r.range(r.key, side_wheels_value(c, k)));
   }
   if (choice_name(kSideCombineNames, c.combine) == "?")
     return make_error(Errc::kInvalidArgument,
@@ -187,6 +203,11 @@ class SideCombiner {
   // create: validates `c` (check_side_wheels); the combiner holds fixed-size state only.
   static Result<SideCombiner> create(const SideWheelsConfig& c) {
     if (auto s = check_side_wheels(c); !s) return std::move(s).error();
+    return SideCombiner(c);
+  }
+  // make: create() without the error's text (side_wheels_ok): nullopt when `c` is outside it.
+  static std::optional<SideCombiner> make(const SideWheelsConfig& c) noexcept {
+    if (!side_wheels_ok(c)) return std::nullopt;
     return SideCombiner(c);
   }
 

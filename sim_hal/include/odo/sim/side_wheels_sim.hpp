@@ -130,6 +130,9 @@ class SimSideWheelsSource final : public EncoderSource {
   const SideCombiner& combiner() const noexcept { return combiner_; }
   // last: the combiner's output of the last read (window spreads and ratios, for benchmarks).
   const SideStep& last() const noexcept { return last_; }
+  // readings: every wheel's counter (low `bits` bits, sign-extended) and fault at the last read,
+  // [0] left, [1] right (what a board sends the host as serial counts version 2).
+  const std::array<SideReadings, 2>& readings() const noexcept { return readings_; }
 
  private:
   SimSideWheelsSource(SimRobot& robot, SideWheelsSim model, SideCombiner combiner, int bits)
@@ -139,6 +142,7 @@ class SimSideWheelsSource final : public EncoderSource {
   SideCombiner combiner_;
   int bits_;
   SideStep last_;
+  std::array<SideReadings, 2> readings_{};
 };
 
 }  // namespace odo::sim

@@ -16,14 +16,16 @@ namespace odo::sim {
 class Stm32TimerModel final : public RegisterBus {
  public:
   static constexpr std::uint32_t kTim3 = 0x40000400, kTim4 = 0x40000800;
+  static constexpr std::uint32_t kTim5 = 0x40000C00, kTim8 = 0x40010400;
   static constexpr std::uint32_t kCr1 = 0x00, kSmcr = 0x08, kCcmr1 = 0x18, kCcer = 0x20;
   static constexpr std::uint32_t kCnt = 0x24, kPsc = 0x28, kArr = 0x2C;
 
   std::uint32_t read(std::uint32_t addr) noexcept override;
   void write(std::uint32_t addr, std::uint32_t value) noexcept override;
 
-  // edges: `n` quadrature edges on timer `unit` (0: TIM3, 1: TIM4), forward n > 0, backward n < 0
-  // (the A/B phase order); in encoder mode 3 each edge counts. Ignored unless configured.
+  // edges: `n` quadrature edges on timer `unit` (0: TIM3, 1: TIM4, 2: TIM5, 3: TIM8), forward
+  // n > 0, backward n < 0 (the A/B phase order); in encoder mode 3 each edge counts. Ignored
+  // unless configured.
   void edges(int unit, std::int64_t n) noexcept;
   // counting: whether timer `unit` is configured to count its encoder (see above).
   bool counting(int unit) const noexcept;
@@ -40,7 +42,7 @@ class Stm32TimerModel final : public RegisterBus {
   Timer* timer(std::uint32_t addr, std::uint32_t& off) noexcept;
   // field: the register at `addr` and the bits a write keeps; null for one the model lacks.
   std::uint32_t* field(std::uint32_t addr, std::uint32_t& mask) noexcept;
-  std::array<Timer, 2> t_{};
+  std::array<Timer, 4> t_{};
   int unknown_writes_ = 0;
 };
 
