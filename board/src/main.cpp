@@ -226,6 +226,7 @@ BroadcastOptions broadcast_options(const BoardConfig& cfg) {
   bo.node_id = cfg.node_id;
   bo.pose_div = static_cast<std::uint32_t>(pose_div);
   bo.status_div = static_cast<std::uint32_t>(status_div);
+  bo.wheels_per_side = cfg.wheels.wheels_per_side;
   return bo;
 }
 

@@ -55,13 +55,17 @@ void PoseBroadcaster::on_tick(const loop::LoopSnapshot& s) noexcept {
   pending_ack_ = 0;
   take_commands();
   if (o_.pose_div != 0 && s.tick % o_.pose_div == 0) send_pose_group(s);
-  if (o_.status_div != 0 && s.tick % o_.status_div == 0) send_status(s, false);
+  if (o_.status_div != 0 && s.tick % o_.status_div == 0) {
+    if (several_wheels()) send_side_wheels(s);
+    send_status(s, false);
+  }
 }
 
 void PoseBroadcaster::send_final(const loop::LoopSnapshot& s) noexcept {
   ack_ = static_cast<std::uint8_t>(ack_ + pending_ack_);
   pending_ack_ = 0;
   send_pose_group(s);
+  if (several_wheels()) send_side_wheels(s);
   send_status(s, true);
 }
 
@@ -86,6 +90,16 @@ void PoseBroadcaster::send_status(const loop::LoopSnapshot& s, bool stopping) no
   m.uptime = to_seconds(s.loop_time);
   CanFrame f;
   protocol::encode_status(id(protocol::Msg::kStatus), m, f);
+  send(f);
+}
+
+void PoseBroadcaster::send_side_wheels(const loop::LoopSnapshot& s) noexcept {
+  protocol::SideWheelsMsg m;
+  m.encoder_flags = s.encoder_flags;
+  m.wheels_per_side = static_cast<std::uint8_t>(o_.wheels_per_side);
+  m.counters = s.encoder_counters;
+  CanFrame f;
+  protocol::encode_side_wheels(id(protocol::Msg::kSideWheels), m, f);
   send(f);
 }
 

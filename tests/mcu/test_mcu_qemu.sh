@@ -181,6 +181,15 @@ check "two wheels: no missed deadline, no dropped frame: $(cat "$tmp/w2.end")" $
 frames_equal_unlike_default "$tmp/w2.txt" w2
 rc=$?  # before the name is expanded: its $(...) would set $? to its own status
 check "two wheels: $(wc -l <"$tmp/mcuw2.pose") pose frames equal odometryd's with wheels_per_side = 2, unlike one wheel's" $rc
+# Its SideWheels frames (0x417: slip and dropped-wheel flags, wheels per side, counters) are
+# odometryd's, one before each Status; the one-wheel image sends none.
+grep -o ' 417#[0-9A-F]*$' "$tmp/hostw2.log" >"$tmp/hostw2.side"
+grep -o ' 417#[0-9A-F]*$' "$tmp/mcuw2.log" >"$tmp/mcuw2.side"
+[ -s "$tmp/mcuw2.side" ] && cmp -s "$tmp/hostw2.side" "$tmp/mcuw2.side" &&
+  [ "$(wc -l <"$tmp/mcuw2.side")" = "$(grep -c ' 414#' "$tmp/mcuw2.log")" ] &&
+  ! grep -q ' 417#' "$tmp/mcu.log"
+rc=$?  # before the name is expanded: its $(...) would set $? to its own status
+check "two wheels: $(wc -l <"$tmp/mcuw2.side") SideWheels frames equal odometryd's, one per Status; none from one wheel's image" $rc
 read -r n f0 fmax seq_ok dts ver wps faults lefts rights <<<"$(python3 "$tool" serial "$tmp/w2.txt.usart2")"
 ticks=$(sed -E 's/.* ticks=([0-9]+) .*/\1/' "$tmp/w2.end")
 # The two wheels of a side differ by their radii (sim_hal's 0.3 % tolerance), never by more than

@@ -1,11 +1,13 @@
 // The firmware's CAN side in QEMU: SlcanBus is a CanBus over a UART in SLCAN framing
 // (protocol/slcan.hpp), and PoseBroadcaster the loop's observer that sends the protocol's pose
-// group and status frames at their rates and posts received set-pose commands into the loop.
-// On a real board the same broadcaster sends through bxCAN instead.
+// group and status frames (with SideWheels when it has several wheels per side) at their rates and
+// posts received set-pose commands into the loop. On a real board the same broadcaster sends
+// through bxCAN instead.
 #pragma once
 
 #include <cstdint>
 
+#include "odo/board/board_config.hpp"
 #include "odo/board/uart.hpp"
 #include "odo/hal/can_bus.hpp"
 #include "odo/loop/command.hpp"
@@ -35,6 +37,7 @@ struct BroadcastOptions {
   int node_id = protocol::kDefaultNodeId;
   std::uint32_t pose_div = 2;     // loop ticks per pose group (protocol::divisor_for)
   std::uint32_t status_div = 10;  // loop ticks per status frame
+  int wheels_per_side = 1;        // above 1, SideWheels goes with each Status (as odometryd's)
 };
 
 class PoseBroadcaster final : public loop::TickObserver {
@@ -55,6 +58,11 @@ class PoseBroadcaster final : public loop::TickObserver {
   void send(const CanFrame& f) noexcept;
   void send_pose_group(const loop::LoopSnapshot& s) noexcept;
   void send_status(const loop::LoopSnapshot& s, bool stopping) noexcept;
+  // send_side_wheels: the slip and dropped-wheel flags and counters (before each Status).
+  void send_side_wheels(const loop::LoopSnapshot& s) noexcept;
+  // several_wheels: constant false in an image built for one wheel per side, so that its flash
+  // carries no SideWheels code.
+  bool several_wheels() const noexcept { return kBoardWheelsPerSide > 1 && o_.wheels_per_side > 1; }
   std::uint32_t id(protocol::Msg m) const noexcept {
     return protocol::frame_id(o_.base_id, o_.node_id, m);
   }
