@@ -94,12 +94,10 @@ void PoseBroadcaster::send_status(const loop::LoopSnapshot& s, bool stopping) no
 }
 
 void PoseBroadcaster::send_side_wheels(const loop::LoopSnapshot& s) noexcept {
-  protocol::SideWheelsMsg m;
-  m.encoder_flags = s.encoder_flags;
-  m.wheels_per_side = static_cast<std::uint8_t>(o_.wheels_per_side);
-  m.counters = s.encoder_counters;
+  const auto n = static_cast<std::uint8_t>(o_.wheels_per_side);
   CanFrame f;
-  protocol::encode_side_wheels(id(protocol::Msg::kSideWheels), m, f);
+  protocol::encode_side_wheels(id(protocol::Msg::kSideWheels),
+                               protocol::SideWheelsMsg{s.encoder_flags, n, s.encoder_counters}, f);
   send(f);
 }
 

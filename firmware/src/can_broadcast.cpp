@@ -120,12 +120,10 @@ void CanBroadcaster::send_encoder_faults(const loop::LoopSnapshot& s) noexcept {
 }
 
 void CanBroadcaster::send_side_wheels(const loop::LoopSnapshot& s) noexcept {
-  protocol::SideWheelsMsg m;
-  m.encoder_flags = s.encoder_flags;
-  m.wheels_per_side = static_cast<std::uint8_t>(o_.wheels_per_side);
-  m.counters = s.encoder_counters;
+  const auto n = static_cast<std::uint8_t>(o_.wheels_per_side);
   CanFrame f;
-  protocol::encode_side_wheels(id(protocol::Msg::kSideWheels), m, f);
+  protocol::encode_side_wheels(id(protocol::Msg::kSideWheels),
+                               protocol::SideWheelsMsg{s.encoder_flags, n, s.encoder_counters}, f);
   send(f, s.loop_time);
 }
 
