@@ -71,6 +71,7 @@
 #include <vector>
 
 #include "odo/calibration/count_recorder.hpp"
+#include "odo/calibration/icr_fit.hpp"
 #include "odo/calibration/umbmark.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/hal/time.hpp"
@@ -113,14 +114,6 @@ enum class Acceptance : std::uint8_t {
   kHoldOut = 0,         // one fold held out; the candidate is the fit on the rest
   kCrossValidated = 1,  // every fold held out in turn; the candidate is the fit on all
 };
-
-// Whether the ICR offset x_ICR (Mandow et al. 2007; Kinematics::x_icr) is a fitted parameter.
-// kFixed (default): the fit is over (c_L, c_R, b) with SelfCalConfig::x_icr held (0: the plain
-// arcs, bit for bit as before x_ICR existed). kFit: x_ICR is a 4th parameter with a prior at the
-// value in use; for skid-steer bases (README "Self-calibration from fixes": when it is
-// observable).
-enum class IcrFit : std::uint8_t { kFixed = 0, kFit = 1 };
-inline constexpr Choice<IcrFit> kIcrFitNames[] = {{IcrFit::kFixed, "fixed"}, {IcrFit::kFit, "fit"}};
 
 // Covariance of (c_L, c_R, b, x_ICR), row-major 4 x 4 [-, -, m, m; ...; m^2]; the x_ICR row and
 // column are zero when it is not fitted (IcrFit::kFixed).
