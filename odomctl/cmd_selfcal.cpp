@@ -31,6 +31,7 @@ struct FitFixesOpts {
   KinematicsOpts kin;
   calib::SelfCalConfig fit;
   bool json = false;
+  std::string icr_text = "fixed";  // --x-icr as typed; parsed into fit.icr
 };
 
 // fixes_in_span: every fix lies within the count log's time span (a fix outside it has no
@@ -90,6 +91,7 @@ bool fit_input(const FitFixesOpts& o, calib::FixTrack& track, calib::SelfCalConf
   nominal.cl = nominal.cr = 1.0;
   c.metres_per_count = make_kinematics(nominal)->metres_per_count();
   c.in_use = {o.kin.cl, o.kin.cr, o.kin.wheelbase};
+  c.x_icr = k->x_icr();  // --config's [robot] x_icr (0 without): the model the log ran with
   if (auto s = calib::check_selfcal_config(c); !s) {
     std::cerr << cmd << s.error().message << "\n";
     return false;
@@ -189,7 +191,10 @@ void print_result(const calib::SelfCalResult& r, const calib::SelfCalConfig& c, 
   if (c.icr == calib::IcrFit::kFit) print_icr(r, c, nullptr);
 }
 
-void run_fit_fixes(const FitFixesOpts& o, int& exit_code) {
+void run_fit_fixes(FitFixesOpts& o, int& exit_code) {
+  if (!take_choice(parse_choice_of<calib::IcrFit>(calib::kIcrFitNames, "--x-icr", o.icr_text),
+                   o.fit.icr, "calib fit-fixes", exit_code))
+    return;
   calib::FixTrack track;
   calib::SelfCalConfig c;
   if (!fit_input(o, track, c)) {
@@ -418,6 +423,7 @@ std::string fit_fixes_command(const SelfcalOpts& o, const analysis::FixDrive& d,
     << d.geometry.counts_per_rev << " --gear-ratio " << d.geometry.gear_ratio << " --wheelbase "
     << d.nominal.wheelbase << " --k-left " << c.odometry_noise.k_left << " --k-right "
     << c.odometry_noise.k_right;
+  if (c.icr == calib::IcrFit::kFit) m << " --x-icr fit";
   return m.str();
 }
 
@@ -763,6 +769,16 @@ void add_calib_fit_fixes(CLI::App& calib, int& exit_code) {
   fw::say_range(c->add_option("--min-improvement", o->fit.min_improvement,
                               "held-out score below (1 - this) x the values in use"),
                 0.0, 0.9)
+      ->capture_default_str();
+  c->add_option("--x-icr", o->icr_text,
+                "skid steer: fixed (the ICR offset in use, --config's [robot] x_icr or 0) or fit "
+                "(a 4th parameter, applied when its sigma is below --max-sigma-x-icr)")
+      ->capture_default_str();
+  c->add_option("--prior-sigma-x-icr", o->fit.prior_sigma_x_icr,
+                "prior standard deviation of x_icr around the value in use [m]")
+      ->capture_default_str();
+  c->add_option("--max-sigma-x-icr", o->fit.max_sigma_x_icr,
+                "x_icr is observable (applied) when its sigma is below this [m]")
       ->capture_default_str();
   c->add_flag("--json", o->json, "print one JSON object");
   c->callback([o, &exit_code] { run_fit_fixes(*o, exit_code); });
