@@ -119,7 +119,7 @@ std::string icr_reason(const calib::SelfCalResult& r, const calib::SelfCalConfig
   std::ostringstream m;
   m << "not observable from these fixes: sigma(x_icr) = " << r.sigma_x_icr
     << " m > max_sigma_x_icr = " << c.max_sigma_x_icr
-    << " m (it needs excursions whose net turn is not 0 or 360 deg)";
+    << " m (only excursions whose net turn is not 0 or 360 deg show it: more of those)";
   return m.str();
 }
 
