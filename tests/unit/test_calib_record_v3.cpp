@@ -5,6 +5,7 @@
 #include <bit>
 #include <string>
 
+#include "calib_record_test_util.hpp"
 #include "odo/calibration/record.hpp"
 #include "odo/calibration/store.hpp"
 #include "odo/hal/crc.hpp"
@@ -14,14 +15,12 @@
 namespace odo::calib {
 namespace {
 
+using test::le;
+
+// online_record: a self-calibration record of the skid-steer base (version 2).
 CalibrationRecord online_record() {
-  CalibrationRecord r;
-  r.c_l = 0.99925;
-  r.c_r = 1.00075;
+  CalibrationRecord r = test::online_record();
   r.wheelbase = 0.5481;
-  r.time = 1795000000;
-  r.method = "online";
-  r.fit = FixFitProvenance{19, 2, 0.76, 3.2e-5, 3.1e-5, 1.6e-4};
   return r;
 }
 
@@ -30,12 +29,6 @@ CalibrationRecord icr_record() {
   r.x_icr = 0.0309;
   r.sigma_x_icr = 0.0016;
   return r;
-}
-
-std::uint64_t le(const std::vector<std::uint8_t>& b, std::size_t off, int n) {
-  std::uint64_t v = 0;
-  for (int i = 0; i < n; ++i) v |= static_cast<std::uint64_t>(b[off + i]) << (8 * i);
-  return v;
 }
 
 TEST(CalibRecordV3, ByteLayoutAndRoundTrip) {
@@ -95,21 +88,11 @@ TEST(CalibRecordV3, OlderVersionsAreWrittenAndReadAsBefore) {
 TEST(CalibRecordV3, EveryBitFlipDetectedAndFlagNeedsTheFields) {
   auto b = encode_record(icr_record());
   ASSERT_TRUE(b);
-  for (std::size_t byte = 0; byte < b->size(); ++byte)
-    for (int bit = 0; bit < 8; ++bit) {
-      auto c = *b;
-      c[byte] ^= static_cast<std::uint8_t>(1U << bit);
-      ASSERT_FALSE(decode_record(c)) << "byte " << byte << " bit " << bit;
-    }
+  test::expect_every_bit_flip_detected(*b);
   // The x_icr flag on a 148-byte version-2 record (CRC recomputed): corrupt, named.
   auto v2 = encode_record(online_record());
   ASSERT_TRUE(v2);
-  (*v2)[16] |= 0x80;
-  const std::uint32_t crc = crc32(std::span<const std::uint8_t>(v2->data(), 144));
-  for (int i = 0; i < 4; ++i) (*v2)[144 + i] = static_cast<std::uint8_t>(crc >> (8 * i));
-  auto d = decode_record(*v2);
-  ASSERT_FALSE(d);
-  EXPECT_NE(d.error().message.find("x_icr flagged"), std::string::npos) << d.error().message;
+  test::expect_flag_needs_fields(*v2, 0x80, "x_icr flagged");
 }
 
 TEST(CalibRecordV3, ValidationAndApply) {
@@ -148,9 +131,7 @@ TEST(CalibRecordV3, StoreRoundTripOverAnOldRecordAndAFailedSaveKeepsIt) {
   ASSERT_TRUE(l->record->x_icr);
   EXPECT_EQ(*l->record->x_icr, 0.0309);
   EXPECT_EQ(l->record->sigma_x_icr, 0.0016);
-  std::vector<std::uint8_t> other(512);
-  ASSERT_TRUE(big.read(l->slot == 0 ? 512 : 0, other));
-  auto old = decode_record(other);
+  auto old = test::other_slot(big, *l);
   ASSERT_TRUE(old);
   EXPECT_FALSE(old->x_icr);
   ASSERT_TRUE(old->fit);
