@@ -183,7 +183,9 @@ void SelfCalEstimator::apply(const calib::SelfCalResult& r) {
     ++counters_.accepted;
   }
   log_ << s_.log_prefix << "applied c_l=" << p.c_l << " c_r=" << p.c_r << " b=" << p.wheelbase
-       << " m" << (store_ != nullptr ? s_.stored_note : " (no store configured)") << std::endl;
+       << " m";
+  if (r.x_icr_observable) log_ << " x_icr=" << p.x_icr << " m";
+  log_ << (store_ != nullptr ? s_.stored_note : " (no store configured)") << std::endl;
   window_.restart_at_newest();
 }
 
