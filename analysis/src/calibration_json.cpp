@@ -159,6 +159,10 @@ std::string export_json(const CalibrationRecord& r) {
          {"wheel_diameter", opt(r.wheel_diameter)},
          {"e_s", opt(r.e_s)},
          {"provenance", provenance_json(r)}};
+  if (r.x_icr) {  // only when stored: two-wheel exports are unchanged
+    j["x_icr"] = *r.x_icr;
+    j["sigma_x_icr"] = r.sigma_x_icr;
+  }
   return j.dump(2);
 }
 
@@ -191,6 +195,8 @@ Result<CalibrationRecord> parse_calibration_json(std::string_view text, std::str
   r.wheel_diameter = top.number("wheel_diameter");
   if (!r.wheel_diameter) r.wheel_diameter = top.number("wheel_diameter_new");
   r.e_s = top.number("e_s");
+  r.x_icr = top.number("x_icr");  // skid steer (record version 3); absent: none
+  if (r.x_icr) r.sigma_x_icr = top.number("sigma_x_icr").value_or(0.0);
 
   const json* pj = &j;
   if (auto p = j.find("provenance"); p != j.end() && !p->is_null()) {

@@ -66,6 +66,25 @@ TEST(CalibrationIo, ExportImportRoundTrip) {
   EXPECT_EQ(*back, r);
 }
 
+TEST(CalibrationIo, ExportImportCarriesTheIcrOffset) {
+  // A skid-steer record (version 3): x_icr and its sigma survive export and import; without
+  // them the export has no such keys (two-wheel exports as before).
+  CalibrationRecord r;
+  r.c_l = 1.0;
+  r.c_r = 1.0;
+  r.wheelbase = 0.548;
+  r.x_icr = 0.0309;
+  r.sigma_x_icr = 0.0016;
+  r.time = 1790000000;
+  r.method = "online";
+  auto back = analysis::parse_calibration_json(analysis::export_json(r), "e.json", 0);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(*back, r);
+  r.x_icr.reset();
+  r.sigma_x_icr = 0.0;
+  EXPECT_EQ(analysis::export_json(r).find("x_icr"), std::string::npos);
+}
+
 TEST(CalibrationIo, BadInputNamesTheField) {
   auto r = analysis::parse_calibration_json(R"({"c_l":1.3,"c_r":1.0})", "x.json", 0);
   ASSERT_FALSE(r);
