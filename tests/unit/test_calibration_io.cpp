@@ -4,6 +4,7 @@
 #include <atomic>
 #include <nlohmann/json.hpp>
 
+#include "calib_record_test_util.hpp"
 #include "odo/analysis/calibration_json.hpp"
 #include "odo/calibration/store.hpp"
 #include "odo/firmware/calibration_reload.hpp"
@@ -69,14 +70,9 @@ TEST(CalibrationIo, ExportImportRoundTrip) {
 TEST(CalibrationIo, ExportImportCarriesTheIcrOffset) {
   // A skid-steer record (version 3): x_icr and its sigma survive export and import; without
   // them the export has no such keys (two-wheel exports as before).
-  CalibrationRecord r;
-  r.c_l = 1.0;
-  r.c_r = 1.0;
-  r.wheelbase = 0.548;
+  CalibrationRecord r = calib::test::umbmark_record();
   r.x_icr = 0.0309;
   r.sigma_x_icr = 0.0016;
-  r.time = 1790000000;
-  r.method = "online";
   auto back = analysis::parse_calibration_json(analysis::export_json(r), "e.json", 0);
   ASSERT_TRUE(back) << back.error().message;
   EXPECT_EQ(*back, r);
