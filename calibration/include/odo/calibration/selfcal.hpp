@@ -57,6 +57,10 @@
 //     E_max,syst). The bounds do not apply to the scale: its posterior is never wider than the
 //     prior, so a dock drive writes the ratio and the turn rates with the prior's scale, and an
 //     open drive writes the scale as far as its fixes determined it.
+// x_ICR (issue 38, IcrFit::kFit): a 4th parameter, the skid-steer ICR offset; an excursion from
+// heading theta0 to theta1 then ends x (u(theta0) - u(theta1)) from the plain arcs' end
+// (selfcal_model.cpp), so only net turns other than 0 and 2 pi show it; it is reported
+// observable (to be applied) when its posterior sigma is at most max_sigma_x_icr.
 // Fix headings are used where present. A fix without heading contributes x, y only; the next
 // excursion then starts with the heading predicted by the previous one (its derivative carried
 // along, its variance taken as that of the last heading fix: that heading's correlation with
