@@ -124,13 +124,20 @@ Result<std::vector<std::uint8_t>> encode_record(const CalibrationRecord& r) {
 
 namespace {
 
+// too_old: a flag whose fields need version >= need_v and length >= need_len set in a record
+// of `version` and `length`: corrupt, named (shared by the fit and the x_icr fields).
+Error too_old(const char* what, std::uint16_t version, std::uint16_t length, int need_v,
+              std::size_t need_len) {
+  return corrupt(std::string(what) + " flagged in a record of version " + std::to_string(version) +
+                 " and length " + std::to_string(length) + " (needs >= " + std::to_string(need_v) +
+                 " and >= " + std::to_string(need_len) + ")");
+}
+
 // decode_fit: the fit provenance of a record whose flags say it has one (version >= 2).
 Result<FixFitProvenance> decode_fit(std::span<const std::uint8_t> bytes, std::uint16_t version,
                                     std::uint16_t length) {
   if (version < kRecordVersionFit || length < kRecordV2Bytes)
-    return corrupt("fit fields flagged in a record of version " + std::to_string(version) +
-                   " and length " + std::to_string(length) +
-                   " (needs >= 2 and >= " + std::to_string(kRecordV2Bytes) + ")");
+    return too_old("fit fields", version, length, kRecordVersionFit, kRecordV2Bytes);
   FixFitProvenance f;
   f.fixes_used = get<std::uint32_t>(bytes, 104);
   f.fixes_rejected = get<std::uint32_t>(bytes, 108);
@@ -146,9 +153,7 @@ Result<FixFitProvenance> decode_fit(std::span<const std::uint8_t> bytes, std::ui
 Status decode_icr(std::span<const std::uint8_t> bytes, std::uint16_t version, std::uint16_t length,
                   CalibrationRecord& r) {
   if (version < kRecordVersionIcr || length < kRecordV3Bytes)
-    return corrupt("x_icr flagged in a record of version " + std::to_string(version) +
-                   " and length " + std::to_string(length) +
-                   " (needs >= 3 and >= " + std::to_string(kRecordV3Bytes) + ")");
+    return too_old("x_icr", version, length, kRecordVersionIcr, kRecordV3Bytes);
   const double x = get<double>(bytes, 144), sx = get<double>(bytes, 152);
   if (!std::isfinite(x) || !std::isfinite(sx)) return corrupt("a stored x_icr is not finite");
   r.x_icr = x;
