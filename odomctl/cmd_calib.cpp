@@ -226,6 +226,10 @@ nlohmann::json history_json(const calib::CalibrationRecord& r) {
     j["fit"] = {{"fixes_used", r.fit->fixes_used}, {"fixes_rejected", r.fit->fixes_rejected},
                 {"residual", r.fit->residual},     {"sigma_c_l", r.fit->sigma_c_l},
                 {"sigma_c_r", r.fit->sigma_c_r},   {"sigma_wheelbase", r.fit->sigma_wheelbase}};
+  if (r.x_icr) {
+    j["x_icr"] = *r.x_icr;
+    j["sigma_x_icr"] = r.sigma_x_icr;
+  }
   return j;
 }
 

@@ -31,6 +31,7 @@ struct FitFixesOpts {
   KinematicsOpts kin;
   calib::SelfCalConfig fit;
   bool json = false;
+  std::string icr_text = "fixed";  // --x-icr as typed; parsed into fit.icr
 };
 
 // fixes_in_span: every fix lies within the count log's time span (a fix outside it has no
@@ -90,6 +91,7 @@ bool fit_input(const FitFixesOpts& o, calib::FixTrack& track, calib::SelfCalConf
   nominal.cl = nominal.cr = 1.0;
   c.metres_per_count = make_kinematics(nominal)->metres_per_count();
   c.in_use = {o.kin.cl, o.kin.cr, o.kin.wheelbase};
+  c.x_icr = k->x_icr();  // --config's [robot] x_icr (0 without): the model the log ran with
   if (auto s = calib::check_selfcal_config(c); !s) {
     std::cerr << cmd << s.error().message << "\n";
     return false;
@@ -108,6 +110,37 @@ std::string failed_bound(const calib::SelfCalResult& r, const calib::SelfCalConf
     << (b ? "max_sigma_wheelbase = " : "max_sigma_factor = ")
     << (b ? c.max_sigma_wheelbase : c.max_sigma_factor) << (b ? " m" : "");
   return m.str();
+}
+
+// icr_reason: why a fitted x_ICR is not applied, e.g. "not observable from these fixes:
+// sigma(x_icr) = 0.0031 m > max_sigma_x_icr = 0.002 m"; empty when it is.
+std::string icr_reason(const calib::SelfCalResult& r, const calib::SelfCalConfig& c) {
+  if (r.x_icr_observable) return {};
+  std::ostringstream m;
+  m << "not observable from these fixes: sigma(x_icr) = " << r.sigma_x_icr
+    << " m > max_sigma_x_icr = " << c.max_sigma_x_icr
+    << " m (only excursions whose net turn is not 0 or 360 deg show it: more of those)";
+  return m.str();
+}
+
+// add_icr_json: x_ICR's estimate, sigma and whether it is applied (with the reason) into j.
+void add_icr_json(nlohmann::json& j, const calib::SelfCalResult& r, const calib::SelfCalConfig& c) {
+  j["x_icr"] = r.x_icr;
+  j["sigma_x_icr"] = r.sigma_x_icr;
+  j["x_icr_observable"] = r.x_icr_observable;
+  if (!r.x_icr_observable) j["x_icr_reason"] = icr_reason(r, c);
+}
+
+// print_icr: the x_ICR line: estimate and sigma [mm], the simulator's value when known, and
+// whether an accepted calibration carries it.
+void print_icr(const calib::SelfCalResult& r, const calib::SelfCalConfig& c, const double* truth) {
+  std::ostringstream m;
+  m << std::fixed << std::setprecision(2) << "x_icr       " << r.x_icr * 1e3 << " mm (sigma "
+    << r.sigma_x_icr * 1e3 << " mm";
+  if (truth) m << ", friction model's spot turn " << *truth * 1e3 << " mm";
+  m << "): " << (r.x_icr_observable ? "observable, applied with the rest" : icr_reason(r, c))
+    << "\n";
+  std::cout << m.str();
 }
 
 void print_result(const calib::SelfCalResult& r, const calib::SelfCalConfig& c, bool as_json) {
@@ -133,6 +166,7 @@ void print_result(const calib::SelfCalResult& r, const calib::SelfCalConfig& c, 
                      {"held_out_in_use", r.score_in_use},
                      {"verdict", calib::verdict_name(r.verdict)}};
     if (r.too_uncertain >= 0) j["failed_bound"] = failed_bound(r, c);
+    if (c.icr == calib::IcrFit::kFit) add_icr_json(j, r, c);
     std::cout << j.dump() << "\n";
     return;
   }
@@ -154,9 +188,13 @@ void print_result(const calib::SelfCalResult& r, const calib::SelfCalConfig& c, 
             << "verdict     " << calib::verdict_name(r.verdict);
   if (r.too_uncertain >= 0) std::cout << ": " << failed_bound(r, c);
   std::cout << "\n";
+  if (c.icr == calib::IcrFit::kFit) print_icr(r, c, nullptr);
 }
 
-void run_fit_fixes(const FitFixesOpts& o, int& exit_code) {
+void run_fit_fixes(FitFixesOpts& o, int& exit_code) {
+  if (!take_choice(parse_choice_of<calib::IcrFit>(calib::kIcrFitNames, "--x-icr", o.icr_text),
+                   o.fit.icr, "calib fit-fixes", exit_code))
+    return;
   calib::FixTrack track;
   calib::SelfCalConfig c;
   if (!fit_input(o, track, c)) {
@@ -192,6 +230,7 @@ struct SelfcalOpts {
   std::string ticks_out, fixes_out;    // open: the count log and fixes fit-fixes reads
   std::string robot_text = "labmate";  // as typed; parsed into `robot`
   analysis::UmbmarkRobot robot = analysis::UmbmarkRobot::kLabmate;
+  double com_x = 0.0;  // skid4: centre of mass ahead of the geometric centre [m]
 };
 
 // SimDrive: the random excursions as one scenario and the fix moments (ticks in the final
@@ -384,6 +423,7 @@ std::string fit_fixes_command(const SelfcalOpts& o, const analysis::FixDrive& d,
     << d.geometry.counts_per_rev << " --gear-ratio " << d.geometry.gear_ratio << " --wheelbase "
     << d.nominal.wheelbase << " --k-left " << c.odometry_noise.k_left << " --k-right "
     << c.odometry_noise.k_right;
+  if (c.icr == calib::IcrFit::kFit) m << " --x-icr fit";
   return m.str();
 }
 
@@ -467,6 +507,11 @@ void print_open(const SelfcalOpts& o, const analysis::FixDrive& d, const calib::
                      {"truth_wheelbase", d.truth.wheelbase},
                      {"verdict", calib::verdict_name(r.verdict)}};
     if (k) j["skid"] = skid_score_json(d, r.estimate, *k);
+    if (c.icr == calib::IcrFit::kFit) {
+      add_icr_json(j, r, c);
+      j["truth_x_icr"] = d.truth_x_icr;
+      j["com_x"] = o.com_x;
+    }
     std::cout << j.dump() << "\n";
   } else {
     std::cout << "excursions  " << o.excursions << " open, fixes " << d.fixes.size() << " ("
@@ -481,6 +526,7 @@ void print_open(const SelfcalOpts& o, const analysis::FixDrive& d, const calib::
               << " % of its information from the fixes\n"
               << "verdict     " << calib::verdict_name(r.verdict)
               << (r.too_uncertain >= 0 ? ": " + failed_bound(r, c) : std::string()) << "\n";
+    if (c.icr == calib::IcrFit::kFit) print_icr(r, c, &d.truth_x_icr);
     if (k) print_skid_score(d, r.estimate, *k);
     if (!o.ticks_out.empty() && !o.fixes_out.empty())
       std::cout << "fit them    " << fit_fixes_command(o, d, c) << "\n";
@@ -499,6 +545,7 @@ void run_open(const SelfcalOpts& o, int& exit_code) {
   fo.direct_drive = o.direct_drive;
   fo.seed = o.seed;
   fo.robot = o.robot;
+  fo.com_x = o.com_x;
   const analysis::FixDrive d = analysis::simulate_fix_drive(fo);
   const calib::SelfCalConfig c = analysis::fix_drive_config(d, fo);
   const char* cmd = "selfcal simulate";
@@ -516,7 +563,9 @@ void run_open(const SelfcalOpts& o, int& exit_code) {
     exit_code = kExitFailed;
     return;
   }
-  const bool skid = o.robot == analysis::UmbmarkRobot::kSkid4;
+  // The square is scored on the centred base (UMBmark's skid4): with a load off centre it would
+  // score the estimate on another robot, so then x_ICR is the figure.
+  const bool skid = o.robot == analysis::UmbmarkRobot::kSkid4 && o.com_x == 0.0;
   SkidScore k;
   if (skid && !skid_score(d, r->estimate, k)) {
     exit_code = kExitFailed;
@@ -574,6 +623,11 @@ void print_dock(const SelfcalOpts& o, const SimOutcome& r, const calib::Factors&
 
 void run_simulate(const SelfcalOpts& o, int& exit_code) {
   if (!output_paths_ok({o.plot, o.ticks_out, o.fixes_out}, "selfcal simulate")) {
+    exit_code = kExitBadInput;
+    return;
+  }
+  if (o.com_x != 0.0 && o.robot != analysis::UmbmarkRobot::kSkid4) {
+    std::cerr << "odomctl selfcal simulate: --com-x needs --robot skid4\n";
     exit_code = kExitBadInput;
     return;
   }
@@ -671,6 +725,12 @@ void add_selfcal(CLI::App& app, int& exit_code) {
                 "labmate; skid4: the Jackal-sized 4WD skid-steer base, open scenario (its track "
                 "found against the geometric track x 1.5)")
       ->capture_default_str();
+  fw::with_range(
+      c->add_option("--com-x", o->com_x,
+                    "skid4: centre of mass ahead of the geometric centre [m] (x_ICR "
+                    "found against the friction model's; the square is then not scored)"),
+      -0.12, 0.12)
+      ->capture_default_str();
   c->add_flag("--direct-drive", o->direct_drive, "open: 4096-count encoders on the wheels");
   c->add_option("--ticks-out", o->ticks_out, "open: write the count log (calib fit-fixes --ticks)");
   c->add_option("--fixes-out", o->fixes_out, "open: write the fixes (calib fit-fixes --fixes)");
@@ -709,6 +769,16 @@ void add_calib_fit_fixes(CLI::App& calib, int& exit_code) {
   fw::say_range(c->add_option("--min-improvement", o->fit.min_improvement,
                               "held-out score below (1 - this) x the values in use"),
                 0.0, 0.9)
+      ->capture_default_str();
+  c->add_option("--x-icr", o->icr_text,
+                "skid steer: fixed (the ICR offset in use, --config's [robot] x_icr or 0) or fit "
+                "(a 4th parameter, applied when its sigma is below --max-sigma-x-icr)")
+      ->capture_default_str();
+  c->add_option("--prior-sigma-x-icr", o->fit.prior_sigma_x_icr,
+                "prior standard deviation of x_icr around the value in use [m]")
+      ->capture_default_str();
+  c->add_option("--max-sigma-x-icr", o->fit.max_sigma_x_icr,
+                "x_icr is observable (applied) when its sigma is below this [m]")
       ->capture_default_str();
   c->add_flag("--json", o->json, "print one JSON object");
   c->callback([o, &exit_code] { run_fit_fixes(*o, exit_code); });

@@ -84,6 +84,11 @@ std::string show_json(const LoadResult& l) {
   j["wheelbase"] = ok ? opt(l.record->wheelbase) : json(nullptr);
   j["wheel_diameter"] = ok ? opt(l.record->wheel_diameter) : json(nullptr);
   j["e_s"] = ok ? opt(l.record->e_s) : json(nullptr);
+  // Skid steer (record version 3): only when stored, so that two-wheel output is unchanged.
+  if (ok && l.record->x_icr) {
+    j["x_icr"] = *l.record->x_icr;
+    j["sigma_x_icr"] = l.record->sigma_x_icr;
+  }
   j["provenance"] = ok ? provenance_json(*l.record) : json(nullptr);
   json slots = json::array();
   for (const auto& s : l.slots)
@@ -120,6 +125,11 @@ std::string show_text(const LoadResult& l) {
       o << "wheel_diameter: not stored (nominal from the config)\n";
     }
     if (r.e_s) o << "e_s: " << *r.e_s << "\n";
+    if (r.x_icr) {
+      std::snprintf(line, sizeof line, "x_icr: %.6f m (%.2f mm, sigma %.2f mm)\n", *r.x_icr,
+                    *r.x_icr * 1e3, r.sigma_x_icr * 1e3);
+      o << line;
+    }
     o << "obtained: " << calib::utc_text(r.time) << " by " << (r.method.empty() ? "?" : r.method);
     if (r.runs > 0) o << " from " << r.runs << " runs";
     o << "\n";
@@ -149,6 +159,10 @@ std::string export_json(const CalibrationRecord& r) {
          {"wheel_diameter", opt(r.wheel_diameter)},
          {"e_s", opt(r.e_s)},
          {"provenance", provenance_json(r)}};
+  if (r.x_icr) {  // only when stored: two-wheel exports are unchanged
+    j["x_icr"] = *r.x_icr;
+    j["sigma_x_icr"] = r.sigma_x_icr;
+  }
   return j.dump(2);
 }
 
@@ -181,6 +195,8 @@ Result<CalibrationRecord> parse_calibration_json(std::string_view text, std::str
   r.wheel_diameter = top.number("wheel_diameter");
   if (!r.wheel_diameter) r.wheel_diameter = top.number("wheel_diameter_new");
   r.e_s = top.number("e_s");
+  r.x_icr = top.number("x_icr");  // skid steer (record version 3); absent: none
+  if (r.x_icr) r.sigma_x_icr = top.number("sigma_x_icr").value_or(0.0);
 
   const json* pj = &j;
   if (auto p = j.find("provenance"); p != j.end() && !p->is_null()) {

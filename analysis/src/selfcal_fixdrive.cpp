@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "odo/analysis/selfcal_tools.hpp"
+#include "odo/analysis/skid_tools.hpp"
 #include "odo/sim/skid_steer.hpp"
 #include "odo/sim/wheel_noise.hpp"
 
@@ -121,7 +122,11 @@ calib::PoseFix make_fix(const FixDriveOptions& o, const Pose2& truth, TimeNs t, 
 // skid_body: the friction body of a kSkid4 drive (none for the LabMate).
 std::optional<sim::SkidSteerBody> skid_body(const FixDriveOptions& o) {
   if (o.robot != UmbmarkRobot::kSkid4) return std::nullopt;
-  return *sim::SkidSteerBody::create(sim::jackal_skid_params());  // valid by construction
+  sim::SkidSteerParams p = sim::jackal_skid_params();
+  p.com_x = o.com_x;
+  auto body = sim::SkidSteerBody::create(p);
+  if (!body) return std::nullopt;  // com_x out of range: the caller checks it first
+  return std::move(body).value();
 }
 
 }  // namespace
@@ -135,6 +140,8 @@ FixDrive simulate_fix_drive(const FixDriveOptions& o) {
     d.geometry = sim::skid4_geometry();
     const double dn = d.geometry.wheel_diameter_left, t = d.geometry.wheelbase;
     d.truth = {1.0, 1.0, sim::skid_effective_track(body->params(), -0.2, 0.2)};
+    const sim::SkidSolution spot = sim::solve_skid_twist(body->params(), -0.2, 0.2);
+    d.truth_x_icr = icr_of(spot.twist, -0.2, 0.2).x_icr + 0.0;  // + 0.0: -0 (centred) as 0
     d.nominal = sim::nominal_params(dn, kSkidTrackMultiplier * t, d.geometry);
   } else {
     d.geometry = draw_truth(o, rng);
@@ -184,6 +191,7 @@ calib::SelfCalConfig fix_drive_config(const FixDrive& d, const FixDriveOptions& 
   base.metres_per_count = Kinematics::create(k)->metres_per_count();
   base.in_use = {1.0, 1.0, d.nominal.wheelbase};
   base.odometry_noise = o.wheel_noise;
+  if (o.robot == UmbmarkRobot::kSkid4) base.icr = calib::IcrFit::kFit;
   return base;
 }
 

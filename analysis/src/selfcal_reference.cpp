@@ -118,7 +118,8 @@ ReferenceFit reference_fit(const calib::FixTrack& t, const calib::SelfCalConfig&
   out.iterations = std::min(out.iterations, 50);
   out.estimate = {x(0), x(1), x(2)};
   const Mat3 cov = s.h.inverse().topLeftCorner<3, 3>();
-  for (int i = 0; i < 9; ++i) out.covariance[static_cast<std::size_t>(i)] = cov(i / 3, i % 3);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) calib::cov_at(out.covariance, i, j) = cov(i, j);
   return out;
 }
 

@@ -24,6 +24,7 @@ constexpr std::uint32_t kFlagScaling = 1U << 3;
 constexpr std::uint32_t kFlagEmaxBefore = 1U << 4;
 constexpr std::uint32_t kFlagEmaxAfter = 1U << 5;
 constexpr std::uint32_t kFlagFit = 1U << 6;  // version 2: the fit fields at 104 .. 143
+constexpr std::uint32_t kFlagIcr = 1U << 7;  // version 3: x_icr, sigma_x_icr at 144 .. 159
 
 template <class T>
 void put(std::vector<std::uint8_t>& b, std::size_t off, T v) {
@@ -84,11 +85,16 @@ Result<std::vector<std::uint8_t>> encode_record(const CalibrationRecord& r) {
   if (r.e_max_before) flags |= kFlagEmaxBefore;
   if (r.e_max_after) flags |= kFlagEmaxAfter;
   if (r.fit) flags |= kFlagFit;
+  if (r.x_icr) flags |= kFlagIcr;
 
-  const std::size_t len = r.fit ? kRecordV2Bytes : kRecordV1Bytes;
+  // The oldest version that holds the record's fields: older readers keep reading it.
+  const std::uint16_t version = r.x_icr ? kRecordVersionIcr
+                                : r.fit ? kRecordVersionFit
+                                        : kRecordVersion;
+  const std::size_t len = r.x_icr ? kRecordV3Bytes : r.fit ? kRecordV2Bytes : kRecordV1Bytes;
   std::vector<std::uint8_t> b(len, 0);
   put<std::uint32_t>(b, 0, kRecordMagic);
-  put<std::uint16_t>(b, 4, r.fit ? kRecordVersionFit : kRecordVersion);
+  put<std::uint16_t>(b, 4, version);
   put<std::uint16_t>(b, 6, static_cast<std::uint16_t>(len));
   put<std::uint64_t>(b, 8, r.sequence);
   put<std::uint32_t>(b, 16, flags);
@@ -105,19 +111,33 @@ Result<std::vector<std::uint8_t>> encode_record(const CalibrationRecord& r) {
     put<std::uint32_t>(b, 108, f.fixes_rejected);
     for (std::size_t i = 0; i < 4; ++i) put<double>(b, 112 + 8 * i, fv[i]);
   }
+  if (r.x_icr) {
+    const double sx = r.sigma_x_icr;
+    if (!std::isfinite(*r.x_icr) || !std::isfinite(sx))
+      return make_error(Errc::kInvalidArgument, "x_icr is not finite");
+    put<double>(b, 144, *r.x_icr);
+    put<double>(b, 152, sx);
+  }
   put<std::uint32_t>(b, len - 4, crc32(std::span<const std::uint8_t>(b.data(), len - 4)));
   return b;
 }
 
 namespace {
 
+// too_old: a flag whose fields need version >= need_v and length >= need_len set in a record
+// of `version` and `length`: corrupt, named (shared by the fit and the x_icr fields).
+Error too_old(const char* what, std::uint16_t version, std::uint16_t length, int need_v,
+              std::size_t need_len) {
+  return corrupt(std::string(what) + " flagged in a record of version " + std::to_string(version) +
+                 " and length " + std::to_string(length) + " (needs >= " + std::to_string(need_v) +
+                 " and >= " + std::to_string(need_len) + ")");
+}
+
 // decode_fit: the fit provenance of a record whose flags say it has one (version >= 2).
 Result<FixFitProvenance> decode_fit(std::span<const std::uint8_t> bytes, std::uint16_t version,
                                     std::uint16_t length) {
   if (version < kRecordVersionFit || length < kRecordV2Bytes)
-    return corrupt("fit fields flagged in a record of version " + std::to_string(version) +
-                   " and length " + std::to_string(length) +
-                   " (needs >= 2 and >= " + std::to_string(kRecordV2Bytes) + ")");
+    return too_old("fit fields", version, length, kRecordVersionFit, kRecordV2Bytes);
   FixFitProvenance f;
   f.fixes_used = get<std::uint32_t>(bytes, 104);
   f.fixes_rejected = get<std::uint32_t>(bytes, 108);
@@ -127,6 +147,18 @@ Result<FixFitProvenance> decode_fit(std::span<const std::uint8_t> bytes, std::ui
     if (!std::isfinite(*fv[i])) return corrupt("a stored fit value is not finite");
   }
   return f;
+}
+
+// decode_icr: x_icr and its sigma of a record whose flags say it has them (version >= 3).
+Status decode_icr(std::span<const std::uint8_t> bytes, std::uint16_t version, std::uint16_t length,
+                  CalibrationRecord& r) {
+  if (version < kRecordVersionIcr || length < kRecordV3Bytes)
+    return too_old("x_icr", version, length, kRecordVersionIcr, kRecordV3Bytes);
+  const double x = get<double>(bytes, 144), sx = get<double>(bytes, 152);
+  if (!std::isfinite(x) || !std::isfinite(sx)) return corrupt("a stored x_icr is not finite");
+  r.x_icr = x;
+  r.sigma_x_icr = sx;
+  return Ok{};
 }
 
 }  // namespace
@@ -178,6 +210,8 @@ Result<CalibrationRecord> decode_record(std::span<const std::uint8_t> bytes) {
     if (!f) return std::move(f).error();
     r.fit = *f;
   }
+  if (flags & kFlagIcr)
+    if (auto s = decode_icr(bytes, version, length, r); !s) return std::move(s).error();
   return r;
 }
 
@@ -188,6 +222,7 @@ Result<KinematicParams> apply_record(const KinematicParams& nominal, const Calib
   p.c_r = r.c_r;
   if (r.wheelbase) p.wheelbase = *r.wheelbase;
   if (r.wheel_diameter) p.wheel_diameter = *r.wheel_diameter;
+  if (r.x_icr) p.x_icr = *r.x_icr;
   if (auto ok = Kinematics::create(p); !ok) return std::move(ok).error();
   return p;
 }
@@ -214,6 +249,11 @@ Status validate_record(const CalibrationRecord& r) {
   if (r.e_max_after)
     if (auto s = check_range("e_max_syst_after", *r.e_max_after, L::kEmaxMin, L::kEmaxMax, "m"); !s)
       return s;
+  if (r.x_icr)
+    if (auto s = check_range("x_icr", *r.x_icr, L::kXIcrMin, L::kXIcrMax, "m"); !s) return s;
+  if (auto s = check_range("sigma_x_icr", r.sigma_x_icr, 0.0, L::kXIcrMax, "m"); !s) return s;
+  if (!r.x_icr && r.sigma_x_icr != 0.0)
+    return make_error(Errc::kInvalidArgument, "sigma_x_icr is given without x_icr");
   if (auto s = check_count("runs", r.runs); !s) return s;
   if (r.time < 0)
     return make_error(Errc::kInvalidArgument,

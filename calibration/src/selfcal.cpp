@@ -14,7 +14,9 @@ namespace {
 
 using detail::Eval;
 using detail::Mat3;
+using detail::MatP;
 using detail::Vec3;
+using detail::VecP;
 using Vec2 = Eigen::Vector2d;
 using Mat2 = Eigen::Matrix2d;
 
@@ -39,9 +41,13 @@ Status check_fixes(std::span<const PoseFix> fixes) {
   return Ok{};
 }
 
-Mat3 prior_information(const SelfCalConfig& c) {
+template <int N>
+MatP<N> prior_information(const SelfCalConfig& c) {
   const double sf = c.prior_sigma_factor, sb = c.prior_sigma_wheelbase;
-  return Vec3(1.0 / (sf * sf), 1.0 / (sf * sf), 1.0 / (sb * sb)).asDiagonal();
+  VecP<N> d;
+  d.template head<3>() = Vec3(1.0 / (sf * sf), 1.0 / (sf * sf), 1.0 / (sb * sb));
+  if constexpr (N == 4) d(3) = 1.0 / (c.prior_sigma_x_icr * c.prior_sigma_x_icr);
+  return d.asDiagonal();
 }
 
 // Sums of the counts of an excursion (legs[from .. to)).
@@ -103,17 +109,24 @@ Vec2 linear_position(const FixTrack& t, std::span<const int> acc, const SelfCalC
   return h.ldlt().solve(g);
 }
 
-bool plausible(const Vec3& p, double b0) {
+// plausible: p inside the box (factors 0.5 .. 1.5, b within 0.5 .. 2 b0, x_ICR what the
+// kinematics accept).
+template <int N>
+bool plausible(const VecP<N>& p, double b0) {
+  bool icr = true;
+  if constexpr (N == 4) icr = KinematicLimits::kXIcr.contains(p(3));
   return p.allFinite() && p(0) > 0.5 && p(0) < 1.5 && p(1) > 0.5 && p(1) < 1.5 && p(2) > 0.5 * b0 &&
-         p(2) < 2.0 * b0;
+         p(2) < 2.0 * b0 && icr;
 }
 
-Vec3 linear_initial(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c) {
+// linear_initial: Antonelli et al.'s (c_L, c_R, b) (the plain arcs); x_ICR the value in use.
+template <int N>
+VecP<N> linear_initial(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c) {
   const Vec2 u = linear_heading(t, acc, c);
   const Vec2 cf = linear_position(t, acc, c, u);
   // (c_L, c_R) = b (u_L, u_R) in the least-squares sense.
-  const Vec3 p(cf(0), cf(1), cf.dot(u) / u.squaredNorm());
-  return plausible(p, c.in_use.wheelbase) ? p : detail::to_vec(c.in_use);
+  const VecP<N> p = detail::to_vec<N>({cf(0), cf(1), cf.dot(u) / u.squaredNorm()}, c.x_icr);
+  return plausible<N>(p, c.in_use.wheelbase) ? p : detail::in_use<N>(c);
 }
 
 // The stacked residual rows of the excursions a fit uses, and their joint covariance: each
@@ -126,7 +139,8 @@ struct Joint {
   int rows = 0;
 };
 
-Joint joint_covariance(const FixTrack& t, const std::vector<Eval>& s0,
+template <int N>
+Joint joint_covariance(const FixTrack& t, const std::vector<Eval<N>>& s0,
                        const std::vector<bool>& train) {
   Joint j;
   std::vector<int> offset;
@@ -138,10 +152,10 @@ Joint joint_covariance(const FixTrack& t, const std::vector<Eval>& s0,
   }
   Eigen::MatrixXd sigma = Eigen::MatrixXd::Zero(j.rows, j.rows);
   for (std::size_t i = 0; i < j.index.size(); ++i) {
-    const Eval& e = s0[j.index[i]];
+    const Eval<N>& e = s0[j.index[i]];
     sigma.block(offset[i], offset[i], e.dof, e.dof) = e.s.topLeftCorner(e.dof, e.dof);
     if (i + 1 == j.index.size() || s0[j.index[i + 1]].from != e.to) continue;
-    const Eval& n = s0[j.index[i + 1]];
+    const Eval<N>& n = s0[j.index[i + 1]];
     const PoseFix& f = t.fixes[static_cast<std::size_t>(e.to)];
     const double v = f.sigma_xy * f.sigma_xy;
     const Vec3 d(v, v, f.theta ? f.sigma_theta * f.sigma_theta : 0.0);
@@ -163,16 +177,17 @@ constexpr int kWeightPasses = 3;
 
 // gn_pass: Gauss-Newton iterations from p with the joint covariance `jc`; f.p, f.cov (the
 // inverse of the posterior information at the last linearisation) and the counts in f.
+template <int N>
 void gn_pass(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c, const Joint& jc,
-             detail::FitOut& f) {
-  const Mat3 p_inf = prior_information(c);
-  const Vec3 prior = detail::to_vec(c.in_use);
-  Eigen::MatrixXd jac(jc.rows, 3);
+             detail::FitOut<N>& f) {
+  const MatP<N> p_inf = prior_information<N>(c);
+  const VecP<N> prior = detail::in_use<N>(c);
+  Eigen::MatrixXd jac(jc.rows, N);
   Eigen::VectorXd res(jc.rows);
-  Mat3 h = p_inf;
+  MatP<N> h = p_inf;
   for (int it = 1; it <= c.max_iterations; ++it) {
     ++f.iterations;
-    const std::vector<Eval> ev = detail::evaluate_chain(t, acc, f.p, c, false);
+    const std::vector<Eval<N>> ev = detail::evaluate_chain<N>(t, acc, f.p, c, false);
     int row = 0;
     for (std::size_t k : jc.index) {
       jac.middleRows(row, ev[k].dof) = ev[k].j.topRows(ev[k].dof);
@@ -183,13 +198,13 @@ void gn_pass(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c
     const Eigen::MatrixXd a = jc.llt.matrixL().solve(jac);
     const Eigen::VectorXd b = jc.llt.matrixL().solve(res);
     h = p_inf + a.transpose() * a;
-    Vec3 step = h.ldlt().solve(p_inf * (prior - f.p) + a.transpose() * b);
+    VecP<N> step = h.ldlt().solve(p_inf * (prior - f.p) + a.transpose() * b);
     // Outliers not yet rejected can pull the estimate far out: shorten the step to stay in the
     // plausible box and stop there; the rejection that follows needs an estimate to score the
     // fixes with, not a failure.
     int halve = 0;
-    for (; halve < 40 && !plausible(f.p + step, c.in_use.wheelbase); ++halve) step *= 0.5;
-    if (!plausible(f.p + step, c.in_use.wheelbase)) break;
+    for (; halve < 40 && !plausible<N>(f.p + step, c.in_use.wheelbase); ++halve) step *= 0.5;
+    if (!plausible<N>(f.p + step, c.in_use.wheelbase)) break;
     f.bounded = f.bounded || halve > 0;
     f.p += step;
     if (step.cwiseAbs().maxCoeff() < 1e-13) break;
@@ -200,12 +215,14 @@ void gn_pass(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c
 // gauss_newton: exact-model refinement over the excursions of `acc` that `train` admits
 // (train empty: all) from p, with the prior N(in use, sigma_prior); the joint covariance is
 // re-evaluated at the estimate between passes.
-detail::FitOut gauss_newton(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c,
-                            const Vec3& p, const std::vector<bool>& train) {
-  detail::FitOut f;
+template <int N>
+detail::FitOut<N> gauss_newton(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c,
+                               const VecP<N>& p, const std::vector<bool>& train) {
+  detail::FitOut<N> f;
   f.p = p;
   for (int pass = 0; pass < kWeightPasses; ++pass)
-    gn_pass(t, acc, c, joint_covariance(t, detail::evaluate_chain(t, acc, f.p, c, true), train), f);
+    gn_pass<N>(t, acc, c,
+               joint_covariance<N>(t, detail::evaluate_chain<N>(t, acc, f.p, c, true), train), f);
   f.ok = true;
   return f;
 }
@@ -214,14 +231,20 @@ detail::FitOut gauss_newton(const FixTrack& t, std::span<const int> acc, const S
 
 namespace detail {
 
-FitOut fit_once(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c,
-                const std::vector<bool>& train) {
+template <int N>
+FitOut<N> fit_once(const FixTrack& t, std::span<const int> acc, const SelfCalConfig& c,
+                   const std::vector<bool>& train) {
   // Start from the values in use (the prior's mean), not from the linear estimate: that one
   // was 3-12 % off on open drives and Gauss-Newton stalled at the box's edge from there.
-  FitOut f = gauss_newton(t, acc, c, detail::to_vec(c.in_use), train);
-  f.initial = linear_initial(t, acc, c);
+  FitOut<N> f = gauss_newton<N>(t, acc, c, in_use<N>(c), train);
+  f.initial = linear_initial<N>(t, acc, c);
   return f;
 }
+
+template FitOut<3> fit_once<3>(const FixTrack&, std::span<const int>, const SelfCalConfig&,
+                               const std::vector<bool>&);
+template FitOut<4> fit_once<4>(const FixTrack&, std::span<const int>, const SelfCalConfig&,
+                               const std::vector<bool>&);
 
 Status check_track(const FixTrack& t) {
   if (t.fixes.size() < 2)
@@ -250,9 +273,13 @@ Status check_selfcal_config(const SelfCalConfig& c) {
   for (auto [f, v] : {std::pair{"prior_sigma_factor", c.prior_sigma_factor},
                       {"prior_sigma_wheelbase", c.prior_sigma_wheelbase},
                       {"max_sigma_factor", c.max_sigma_factor},
-                      {"max_sigma_wheelbase", c.max_sigma_wheelbase}}) {
+                      {"max_sigma_wheelbase", c.max_sigma_wheelbase},
+                      {"prior_sigma_x_icr", c.prior_sigma_x_icr},
+                      {"max_sigma_x_icr", c.max_sigma_x_icr}}) {
     if (!(std::isfinite(v) && v > 0.0)) return positive(f, v);
   }
+  if (const Limit x = KinematicLimits::kXIcr; !x.contains(c.x_icr))
+    return range_error({"x_icr", c.x_icr, x.lo, x.hi, "m"});
   if (!(c.min_improvement >= 0.0 && c.min_improvement <= 0.9))
     return range_error({"min_improvement", c.min_improvement, 0.0, 0.9});
   if (auto s = check_error_model(c.odometry_noise); !s) return s;
@@ -267,11 +294,11 @@ Status check_selfcal_config(const SelfCalConfig& c) {
 }
 
 Pose2 predict_excursion(const Pose2& start, std::span<const LegCounts> legs, const Factors& f,
-                        double metres_per_count) {
+                        double metres_per_count, double x_icr) {
   Pose2 q = start;
   for (const LegCounts& s : legs)
-    q = arc_step(q, f.c_l * metres_per_count * s.n_left, f.c_r * metres_per_count * s.n_right,
-                 f.wheelbase);
+    q = arc_step_icr(q, f.c_l * metres_per_count * s.n_left, f.c_r * metres_per_count * s.n_right,
+                     f.wheelbase, x_icr);
   return q;
 }
 

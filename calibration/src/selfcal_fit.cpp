@@ -15,13 +15,16 @@ namespace {
 using detail::Eval;
 using detail::FitOut;
 using detail::Mat3;
+using detail::MatP;
 using detail::Vec3;
+using detail::VecP;
 
 // fix_scores: per fix, the mean of chi2 / gate over the usable excursions touching it.
-std::vector<double> fix_scores(const std::vector<Eval>& ev, std::size_t n_fixes) {
+template <int N>
+std::vector<double> fix_scores(const std::vector<Eval<N>>& ev, std::size_t n_fixes) {
   std::vector<double> sum(n_fixes, 0.0);
   std::vector<int> n(n_fixes, 0);
-  for (const Eval& e : ev) {
+  for (const Eval<N>& e : ev) {
     if (!e.usable) continue;
     const double q = detail::chi2(e) / detail::gate(e);
     for (int f : {e.from, e.to}) {
@@ -35,11 +38,12 @@ std::vector<double> fix_scores(const std::vector<Eval>& ev, std::size_t n_fixes)
 }
 
 // chi2_per_dof: of the usable excursions between the fixes of `acc` at the estimate of f.
+template <int N>
 double chi2_per_dof(const FixTrack& t, const SelfCalConfig& c, const std::vector<int>& acc,
-                    const FitOut& f) {
+                    const FitOut<N>& f) {
   double chi = 0.0;
   int dof = 0;
-  for (const Eval& e : detail::evaluate_chain(t, acc, f.p, c, true)) {
+  for (const Eval<N>& e : detail::evaluate_chain<N>(t, acc, f.p, c, true)) {
     if (!e.usable) continue;
     chi += detail::chi2(e);
     dof += e.dof;
@@ -48,10 +52,11 @@ double chi2_per_dof(const FixTrack& t, const SelfCalConfig& c, const std::vector
 }
 
 // worst_fix: the fix with the largest score above 1 at the estimate of f (-1: none).
+template <int N>
 int worst_fix(const FixTrack& t, const SelfCalConfig& c, const std::vector<int>& acc,
-              const FitOut& f) {
+              const FitOut<N>& f) {
   const std::vector<double> sc =
-      fix_scores(detail::evaluate_chain(t, acc, f.p, c, true), t.fixes.size());
+      fix_scores(detail::evaluate_chain<N>(t, acc, f.p, c, true), t.fixes.size());
   int worst = -1;
   for (int i : acc)
     if (sc[static_cast<std::size_t>(i)] > 1.0 &&
@@ -61,13 +66,14 @@ int worst_fix(const FixTrack& t, const SelfCalConfig& c, const std::vector<int>&
 }
 
 // leave_one_out: the fix of `acc` whose removal leaves the smallest chi2 per dof (one fit each).
+template <int N>
 int leave_one_out(const FixTrack& t, const SelfCalConfig& c, const std::vector<int>& acc) {
   int best = -1;
   double best_chi = 0.0;
   for (int i : acc) {
     std::vector<int> trial;
     std::copy_if(acc.begin(), acc.end(), std::back_inserter(trial), [i](int k) { return k != i; });
-    const FitOut f = detail::fit_once(t, trial, c, {});
+    const FitOut<N> f = detail::fit_once<N>(t, trial, c, {});
     if (!f.ok) continue;
     const double chi = chi2_per_dof(t, c, trial, f);
     if (best < 0 || chi < best_chi) {
@@ -85,17 +91,18 @@ int leave_one_out(const FixTrack& t, const SelfCalConfig& c, const std::vector<i
 // least 3) would go, the rejection starts again and each time removes the fix whose removal
 // leaves the smallest chi2 per dof (leave-one-out: a fit per fix; with 10 % of the fixes
 // corrupted, half of a window of 21 is almost never outliers, so this is rare).
-Result<FitOut> reject_outliers(const FixTrack& t, const SelfCalConfig& c, std::vector<int>& acc,
-                               std::vector<int>& rejected) {
+template <int N>
+Result<FitOut<N>> reject_outliers(const FixTrack& t, const SelfCalConfig& c, std::vector<int>& acc,
+                                  std::vector<int>& rejected) {
   const std::vector<int> all = acc;
   const std::size_t give_up = std::max<std::size_t>(3, all.size() / 2);
   bool loo = false;
   for (;;) {
-    FitOut f = detail::fit_once(t, acc, c, {});
+    FitOut<N> f = detail::fit_once<N>(t, acc, c, {});
     if (!f.ok)
       return make_error(Errc::kInvalidArgument, "the fit diverged (factors left [0.5, 1.5])");
     if (acc.size() <= 2) return f;
-    int worst = worst_fix(t, c, acc, f);
+    int worst = worst_fix<N>(t, c, acc, f);
     if (worst < 0) return f;
     if (!loo && rejected.size() >= give_up) {
       loo = true;
@@ -103,7 +110,7 @@ Result<FitOut> reject_outliers(const FixTrack& t, const SelfCalConfig& c, std::v
       rejected.clear();
       continue;
     }
-    if (loo) worst = leave_one_out(t, c, acc);
+    if (loo) worst = leave_one_out<N>(t, c, acc);
     rejected.push_back(worst);
     acc.erase(std::find(acc.begin(), acc.end(), worst));
   }
@@ -111,14 +118,15 @@ Result<FitOut> reject_outliers(const FixTrack& t, const SelfCalConfig& c, std::v
 
 // recheck: a rejected fix comes back when both of its excursions pass the gate against the
 // final estimate, with the estimate's own uncertainty added to S. True when any came back.
-bool recheck(const FixTrack& t, const SelfCalConfig& c, const FitOut& f, std::vector<int>& acc,
+template <int N>
+bool recheck(const FixTrack& t, const SelfCalConfig& c, const FitOut<N>& f, std::vector<int>& acc,
              std::vector<int>& rejected) {
   bool any = false;
   for (auto it = rejected.begin(); it != rejected.end();) {
     std::vector<int> trial = acc;
     trial.insert(std::upper_bound(trial.begin(), trial.end(), *it), *it);
     bool pass = true;
-    for (const Eval& e : detail::evaluate_chain(t, trial, f.p, c, true)) {
+    for (const Eval<N>& e : detail::evaluate_chain<N>(t, trial, f.p, c, true)) {
       if (!e.usable || (e.from != *it && e.to != *it)) continue;
       pass = pass && detail::chi2(e, e.j * f.cov * e.j.transpose()) <= detail::gate(e);
     }
@@ -142,13 +150,15 @@ struct HeldOut {
 
 // held_out_scores: adds the held-out excursions' (train[k] false) chi2 of the predictions with
 // the candidate and with the calibration in use to `h`, both with S of the calibration in use.
+template <int N>
 void held_out_scores(const FixTrack& t, const SelfCalConfig& c, const std::vector<int>& acc,
-                     const Vec3& cand, const std::vector<bool>& train, HeldOut& h) {
-  const std::vector<Eval> base = detail::evaluate_chain(t, acc, detail::to_vec(c.in_use), c, true);
-  const std::vector<Eval> ev = detail::evaluate_chain(t, acc, cand, c, false);
+                     const VecP<N>& cand, const std::vector<bool>& train, HeldOut& h) {
+  const std::vector<Eval<N>> base =
+      detail::evaluate_chain<N>(t, acc, detail::in_use<N>(c), c, true);
+  const std::vector<Eval<N>> ev = detail::evaluate_chain<N>(t, acc, cand, c, false);
   for (std::size_t k = 0; k < ev.size(); ++k) {
     if (train[k] || !ev[k].usable) continue;
-    Eval e = ev[k];
+    Eval<N> e = ev[k];
     e.s = base[k].s;
     h.cand += detail::chi2(e);
     h.use += detail::chi2(base[k]);
@@ -158,9 +168,11 @@ void held_out_scores(const FixTrack& t, const SelfCalConfig& c, const std::vecto
 
 // summarise: excursion counts and the fit's chi2 per dof; train[k]: excursion k is in the
 // estimate's fit, held[k]: it was predicted held out (by the estimate or by a fold's).
+template <int N>
 void summarise(const FixTrack& t, const SelfCalConfig& c, const std::vector<int>& acc,
-               const std::vector<bool>& train, const std::vector<bool>& held, SelfCalResult& r) {
-  const std::vector<Eval> ev = detail::evaluate_chain(t, acc, detail::to_vec(r.estimate), c, true);
+               const VecP<N>& p, const std::vector<bool>& train, const std::vector<bool>& held,
+               SelfCalResult& r) {
+  const std::vector<Eval<N>> ev = detail::evaluate_chain<N>(t, acc, p, c, true);
   double chi = 0.0;
   int dof = 0;
   for (std::size_t k = 0; k < ev.size(); ++k) {
@@ -178,36 +190,46 @@ void summarise(const FixTrack& t, const SelfCalConfig& c, const std::vector<int>
 }
 
 // The distance scale m = (c_L + c_R) / 2 as a direction in p.
-const Vec3 kScale(0.5, 0.5, 0.0);
+template <int N>
+VecP<N> scale_direction() {
+  VecP<N> a = VecP<N>::Zero();
+  a.template head<3>() = Vec3(0.5, 0.5, 0.0);
+  return a;
+}
 
 // given_scale: the covariance conditioned on m (Gaussian conditioning, Sigma - Sigma a a^T
 // Sigma / (a^T Sigma a)): the uncertainty of what is left when the scale is known, which the
 // acceptance bounds test (the scale's own is the prior's at most).
-Mat3 given_scale(const Mat3& cov) {
-  const Vec3 sa = cov * kScale;
-  return cov - sa * sa.transpose() / kScale.dot(sa);
+template <int N>
+MatP<N> given_scale(const MatP<N>& cov) {
+  const VecP<N> a = scale_direction<N>(), sa = cov * a;
+  return cov - sa * sa.transpose() / a.dot(sa);
 }
 
 // scale_learnt: 1 - var(m) / prior var(m): the share of the scale's information that came from
 // the fixes (0: a dock drive, the prior's scale kept; towards 1: open drives).
-double scale_learnt(const SelfCalConfig& c, const Mat3& cov) {
+template <int N>
+double scale_learnt(const SelfCalConfig& c, const MatP<N>& cov) {
   const double prior = 0.5 * c.prior_sigma_factor * c.prior_sigma_factor;
-  return std::clamp(1.0 - kScale.dot(cov * kScale) / prior, 0.0, 1.0);
+  const VecP<N> a = scale_direction<N>();
+  return std::clamp(1.0 - a.dot(cov * a) / prior, 0.0, 1.0);
 }
 
 // The acceptance folds: which excursions were predicted held out, the summed scores and the
 // candidate (on entry: the fit on all excursions).
+template <int N>
 struct Folds {
   std::vector<bool> held;
   HeldOut scores;
-  FitOut candidate;
+  FitOut<N> candidate;
 };
 
 // score_folds: excursion k (time order) is held out by fold k % hold_out_every. kHoldOut scores
 // the last fold's training fit and makes it the candidate; kCrossValidated scores every fold's
 // training fit on its held-out excursions and keeps the fit on all as the candidate.
+template <int N>
 Status score_folds(const FixTrack& t, const SelfCalConfig& c, const std::vector<int>& acc,
-                   Folds& out) {
+                   Folds<N>& out) {
   const std::size_t n_exc = out.held.size(), every = static_cast<std::size_t>(c.hold_out_every);
   const bool cv = c.acceptance == Acceptance::kCrossValidated;
   for (std::size_t fold = cv ? 0 : every - 1; every > 0 && fold < every; ++fold) {
@@ -216,7 +238,7 @@ Status score_folds(const FixTrack& t, const SelfCalConfig& c, const std::vector<
       train[k] = k % every != fold;
       out.held[k] = out.held[k] || !train[k];
     }
-    FitOut ff = detail::fit_once(t, acc, c, train);
+    FitOut<N> ff = detail::fit_once<N>(t, acc, c, train);
     if (!ff.ok) return make_error(Errc::kInvalidArgument, "the fit diverged on the training set");
     held_out_scores(t, c, acc, ff.p, train, out.scores);
     if (!cv) out.candidate = ff;
@@ -240,36 +262,47 @@ Verdict decide(const SelfCalConfig& c, const SelfCalResult& r) {
                                                                         : Verdict::kNotBetter;
 }
 
-}  // namespace
-
-Result<SelfCalResult> fit_fixes(const FixTrack& t, const SelfCalConfig& c) {
-  if (auto s = check_selfcal_config(c); !s) return std::move(s).error();
-  if (auto s = detail::check_track(t); !s) return std::move(s).error();
-  std::vector<int> acc(t.fixes.size()), rejected;
-  std::iota(acc.begin(), acc.end(), 0);
-  auto all = reject_outliers(t, c, acc, rejected);
-  if (!all) return std::move(all).error();
-  if (recheck(t, c, *all, acc, rejected)) {
-    all = detail::fit_once(t, acc, c, {});
-    if (!all->ok) return make_error(Errc::kInvalidArgument, "the fit diverged after re-check");
-  }
-  const std::size_t n_exc = acc.size() - 1;
-  const bool cv = c.acceptance == Acceptance::kCrossValidated;
-  Folds folds{std::vector<bool>(n_exc, false), {}, *all};
-  if (auto s = score_folds(t, c, acc, folds); !s) return std::move(s).error();
-  FitOut& f = folds.candidate;
-  SelfCalResult r;
-  r.initial = detail::to_factors(f.initial);
-  r.estimate = detail::to_factors(f.p);
-  const Mat3 cond = given_scale(f.cov);
-  for (int i = 0; i < 9; ++i) r.covariance[static_cast<std::size_t>(i)] = f.cov(i / 3, i % 3);
+// fill_estimate: the candidate's values, covariance (4 x 4, the x_ICR row and column zero when
+// it is not fitted), standard deviations and x_ICR's observability into r.
+template <int N>
+void fill_estimate(const SelfCalConfig& c, const FitOut<N>& f, SelfCalResult& r) {
+  r.initial = detail::to_factors<N>(f.initial);
+  r.estimate = detail::to_factors<N>(f.p);
+  const MatP<N> cond = given_scale<N>(f.cov);
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j) cov_at(r.covariance, i, j) = f.cov(i, j);
   // max(0, .): the conditioned variance of a direction the scale fixes is zero up to rounding.
   for (int i = 0; i < 3; ++i) {
     r.sigma[static_cast<std::size_t>(i)] = std::sqrt(f.cov(i, i));
     r.sigma_given_scale[static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, cond(i, i)));
   }
-  r.scale_learnt = scale_learnt(c, f.cov);
+  r.scale_learnt = scale_learnt<N>(c, f.cov);
   r.iterations = f.iterations;
+  r.x_icr = detail::x_icr_of<N>(f.p, c);
+  if constexpr (N == 4) {
+    r.sigma_x_icr = std::sqrt(f.cov(3, 3));
+    r.x_icr_observable = r.sigma_x_icr <= c.max_sigma_x_icr;
+  }
+}
+
+// fit: fit_fixes with N parameters (3: c_L, c_R, b; 4: and x_ICR).
+template <int N>
+Result<SelfCalResult> fit(const FixTrack& t, const SelfCalConfig& c) {
+  std::vector<int> acc(t.fixes.size()), rejected;
+  std::iota(acc.begin(), acc.end(), 0);
+  auto all = reject_outliers<N>(t, c, acc, rejected);
+  if (!all) return std::move(all).error();
+  if (recheck<N>(t, c, *all, acc, rejected)) {
+    all = detail::fit_once<N>(t, acc, c, {});
+    if (!all->ok) return make_error(Errc::kInvalidArgument, "the fit diverged after re-check");
+  }
+  const std::size_t n_exc = acc.size() - 1;
+  const bool cv = c.acceptance == Acceptance::kCrossValidated;
+  Folds<N> folds{std::vector<bool>(n_exc, false), {}, *all};
+  if (auto s = score_folds<N>(t, c, acc, folds); !s) return std::move(s).error();
+  const FitOut<N>& f = folds.candidate;
+  SelfCalResult r;
+  fill_estimate<N>(c, f, r);
   r.fixes_used = static_cast<int>(acc.size());
   r.fixes_rejected = static_cast<int>(rejected.size());
   std::sort(rejected.begin(), rejected.end());
@@ -277,7 +310,7 @@ Result<SelfCalResult> fit_fixes(const FixTrack& t, const SelfCalConfig& c) {
   std::vector<bool> in_fit(n_exc, true);
   if (!cv)
     for (std::size_t k = 0; k < n_exc; ++k) in_fit[k] = !folds.held[k];
-  summarise(t, c, acc, in_fit, folds.held, r);
+  summarise<N>(t, c, acc, f.p, in_fit, folds.held, r);
   if (folds.scores.dof > 0) {
     r.score_candidate = folds.scores.cand / folds.scores.dof;
     r.score_in_use = folds.scores.use / folds.scores.dof;
@@ -285,6 +318,14 @@ Result<SelfCalResult> fit_fixes(const FixTrack& t, const SelfCalConfig& c) {
   r.too_uncertain = first_too_uncertain(c, r);
   r.verdict = decide(c, r);
   return r;
+}
+
+}  // namespace
+
+Result<SelfCalResult> fit_fixes(const FixTrack& t, const SelfCalConfig& c) {
+  if (auto s = check_selfcal_config(c); !s) return std::move(s).error();
+  if (auto s = detail::check_track(t); !s) return std::move(s).error();
+  return c.icr == IcrFit::kFit ? fit<4>(t, c) : fit<3>(t, c);
 }
 
 }  // namespace odo::calib

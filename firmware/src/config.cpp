@@ -403,6 +403,7 @@ void read_selfcal(TableReader t, SelfCalSection& s) {
     s.*r.member = static_cast<int>(t.integer(r.key, s.*r.member, r.lo, r.hi));
   for (const auto& r : kSelfCalNumbers)
     s.*r.member = t.number(r.key, s.*r.member, r.lo, r.hi, r.unit);
+  s.x_icr = t.choice("x_icr", s.x_icr);
   if (t.ok() && s.max_fixes < s.min_fixes)
     t.reject("max_fixes", "= " + std::to_string(s.max_fixes) + " must be >= min_fixes (" +
                               std::to_string(s.min_fixes) + ")");

@@ -104,6 +104,10 @@ void SelfCalEstimator::fit() {
   c.max_sigma_factor = s_.cfg.max_sigma_factor;
   c.max_sigma_wheelbase = s_.cfg.max_sigma_wheelbase;
   c.min_improvement = s_.cfg.min_improvement;
+  c.icr = s_.cfg.x_icr;
+  c.x_icr = use.x_icr;  // the model of the kinematics in use, fitted or held
+  c.prior_sigma_x_icr = s_.cfg.prior_sigma_x_icr;
+  c.max_sigma_x_icr = s_.cfg.max_sigma_x_icr;
   auto track = calib::build_track(window_.segments(), window_.fixes());
   auto r = track ? calib::fit_fixes(*track, c) : Result<calib::SelfCalResult>(track.error());
   std::unique_lock lk(m_);
@@ -121,6 +125,10 @@ void SelfCalEstimator::fit() {
        << " rejected): c_l=" << r->estimate.c_l << " c_r=" << r->estimate.c_r
        << " b=" << r->estimate.wheelbase << " m, held-out chi2/dof " << r->score_candidate << " vs "
        << r->score_in_use << " in use: " << calib::verdict_name(r->verdict) << std::endl;
+  if (c.icr == calib::IcrFit::kFit)
+    log_ << s_.log_prefix << "x_icr=" << r->x_icr << " m (sigma " << r->sigma_x_icr << " m): "
+         << (r->x_icr_observable ? "observable" : "not observable (sigma above max_sigma_x_icr)")
+         << std::endl;
   if (r->verdict == calib::Verdict::kAccepted) apply(*r);
 }
 
@@ -129,12 +137,17 @@ void SelfCalEstimator::apply(const calib::SelfCalResult& r) {
   p.c_l = r.estimate.c_l;
   p.c_r = r.estimate.c_r;
   p.wheelbase = r.estimate.wheelbase;
+  // x_ICR only when the fit saw it; otherwise the value in use stays (and is kept in the record
+  // below when it differs from the config's, as the wheel diameter is).
+  if (r.x_icr_observable) p.x_icr = r.x_icr;
   auto k = Kinematics::create(p);
   calib::CalibrationRecord rec;
   rec.c_l = p.c_l;
   rec.c_r = p.c_r;
   rec.wheelbase = p.wheelbase;
   if (p.wheel_diameter != s_.nominal.wheel_diameter) rec.wheel_diameter = p.wheel_diameter;
+  if (r.x_icr_observable || p.x_icr != s_.nominal.x_icr) rec.x_icr = p.x_icr;
+  if (r.x_icr_observable) rec.sigma_x_icr = r.sigma_x_icr;
   rec.time = clock_();
   rec.method = "online";
   rec.fit = calib::FixFitProvenance{static_cast<std::uint32_t>(r.fixes_used),
@@ -170,7 +183,9 @@ void SelfCalEstimator::apply(const calib::SelfCalResult& r) {
     ++counters_.accepted;
   }
   log_ << s_.log_prefix << "applied c_l=" << p.c_l << " c_r=" << p.c_r << " b=" << p.wheelbase
-       << " m" << (store_ != nullptr ? s_.stored_note : " (no store configured)") << std::endl;
+       << " m";
+  if (r.x_icr_observable) log_ << " x_icr=" << p.x_icr << " m";
+  log_ << (store_ != nullptr ? s_.stored_note : " (no store configured)") << std::endl;
   window_.restart_at_newest();
 }
 

@@ -49,7 +49,13 @@ using Mat3 = Eigen::Matrix3d;
 Vec3 vec(const calib::Factors& f) {
   return Vec3(f.c_l, f.c_r, f.wheelbase);
 }
+// mat: the (c_L, c_R, b) block of a parameter covariance, and a pose covariance.
 Mat3 mat(const calib::ParamCov& c) {
+  Mat3 m;
+  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = calib::cov_at(c, i / 3, i % 3);
+  return m;
+}
+Mat3 mat(const Cov3& c) {
   Mat3 m;
   for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = c[static_cast<std::size_t>(i)];
   return m;

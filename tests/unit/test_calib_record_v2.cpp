@@ -5,6 +5,7 @@
 #include <bit>
 #include <string>
 
+#include "calib_record_test_util.hpp"
 #include "odo/calibration/record.hpp"
 #include "odo/calibration/store.hpp"
 #include "odo/hal/crc.hpp"
@@ -13,30 +14,9 @@
 namespace odo::calib {
 namespace {
 
-CalibrationRecord umbmark_record() {
-  CalibrationRecord r;
-  r.c_l = 0.99925;
-  r.c_r = 1.00075;
-  r.wheelbase = 0.33702;
-  r.time = 1795000000;
-  r.method = "umbmark";
-  r.runs = 10;
-  return r;
-}
-
-CalibrationRecord online_record() {
-  CalibrationRecord r = umbmark_record();
-  r.method = "online";
-  r.runs = 0;
-  r.fit = FixFitProvenance{19, 2, 0.76, 3.2e-5, 3.1e-5, 1.04e-4};
-  return r;
-}
-
-std::uint64_t le(const std::vector<std::uint8_t>& b, std::size_t off, int n) {
-  std::uint64_t v = 0;
-  for (int i = 0; i < n; ++i) v |= static_cast<std::uint64_t>(b[off + i]) << (8 * i);
-  return v;
-}
+using test::le;
+using test::online_record;
+using test::umbmark_record;
 
 TEST(CalibRecordV2, WithoutFitStillVersionOne) {
   auto b = encode_record(umbmark_record());
@@ -78,21 +58,11 @@ TEST(CalibRecordV2, ByteLayoutAndRoundTrip) {
 TEST(CalibRecordV2, EveryBitFlipDetectedAndFlagNeedsTheFields) {
   auto b = encode_record(online_record());
   ASSERT_TRUE(b);
-  for (std::size_t byte = 0; byte < b->size(); ++byte)
-    for (int bit = 0; bit < 8; ++bit) {
-      auto c = *b;
-      c[byte] ^= static_cast<std::uint8_t>(1U << bit);
-      ASSERT_FALSE(decode_record(c)) << "byte " << byte << " bit " << bit;
-    }
+  test::expect_every_bit_flip_detected(*b);
   // The fit flag on a 108-byte version-1 record (CRC recomputed): corrupt, named.
   auto v1 = encode_record(umbmark_record());
   ASSERT_TRUE(v1);
-  (*v1)[16] |= 0x40;
-  const std::uint32_t crc = crc32(std::span<const std::uint8_t>(v1->data(), 104));
-  for (int i = 0; i < 4; ++i) (*v1)[104 + i] = static_cast<std::uint8_t>(crc >> (8 * i));
-  auto d = decode_record(*v1);
-  ASSERT_FALSE(d);
-  EXPECT_NE(d.error().message.find("fit fields"), std::string::npos) << d.error().message;
+  test::expect_flag_needs_fields(*v1, 0x40, "fit fields");
 }
 
 TEST(CalibRecordV2, ValidationNamesTheFitField) {
@@ -118,9 +88,7 @@ TEST(CalibRecordV2, StoreKeepsTheOldRecordAndRefusesSmallSlots) {
   ASSERT_TRUE(l->record->fit);
   EXPECT_EQ(l->record->fit->fixes_rejected, 2U);
   EXPECT_TRUE(l->slots[0].valid && l->slots[1].valid);
-  std::vector<std::uint8_t> other(512);
-  ASSERT_TRUE(big.read(l->slot == 0 ? 512 : 0, other));
-  auto old = decode_record(other);
+  auto old = test::other_slot(big, *l);
   ASSERT_TRUE(old);
   EXPECT_EQ(old->method, "umbmark");
   EXPECT_FALSE(old->fit);

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <nlohmann/json.hpp>
 
+#include "calib_record_test_util.hpp"
 #include "odo/analysis/calibration_json.hpp"
 #include "odo/calibration/store.hpp"
 #include "odo/firmware/calibration_reload.hpp"
@@ -64,6 +65,20 @@ TEST(CalibrationIo, ExportImportRoundTrip) {
   ASSERT_TRUE(back) << back.error().message;
   r.sequence = 0;  // the store assigns sequence numbers; import does not carry them
   EXPECT_EQ(*back, r);
+}
+
+TEST(CalibrationIo, ExportImportCarriesTheIcrOffset) {
+  // A skid-steer record (version 3): x_icr and its sigma survive export and import; without
+  // them the export has no such keys (two-wheel exports as before).
+  CalibrationRecord r = calib::test::umbmark_record();
+  r.x_icr = 0.0309;
+  r.sigma_x_icr = 0.0016;
+  auto back = analysis::parse_calibration_json(analysis::export_json(r), "e.json", 0);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(*back, r);
+  r.x_icr.reset();
+  r.sigma_x_icr = 0.0;
+  EXPECT_EQ(analysis::export_json(r).find("x_icr"), std::string::npos);
 }
 
 TEST(CalibrationIo, BadInputNamesTheField) {

@@ -117,6 +117,9 @@ struct FixDriveOptions {
   // random LabMate: wheels as built (c_L = c_R = 1), the track the friction model decides, the
   // robot believing the geometric track x kSkidTrackMultiplier; open excursions only (dock false).
   UmbmarkRobot robot = UmbmarkRobot::kLabmate;
+  // kSkid4: the centre of mass this far ahead of the geometric centre [m] (|.| < 0.131; 0: the
+  // load centred, x_ICR 0): the friction model then turns the body about a point x_ICR ahead.
+  double com_x = 0.0;
 };
 
 // A count log row at 100 Hz: `t,left,right` as `odomctl replay` / `calib fit-fixes` read it.
@@ -139,6 +142,9 @@ struct FixDrive {
   // friction solves that did not converge.
   double spot_turn_rim = 0.0, spot_turn_angle = 0.0;
   std::uint64_t unconverged = 0;
+  // kSkid4: the friction model's x_ICR in a spot turn, -vy / omega of the solved twist for rims
+  // -+0.2 m/s (what the fit's x_ICR is compared with) [m].
+  double truth_x_icr = 0.0;
 };
 
 // simulate_fix_drive: the drive of `o` (repeatable for a seed). With robot kSkid4 the truth's b
@@ -146,7 +152,7 @@ struct FixDrive {
 FixDrive simulate_fix_drive(const FixDriveOptions& o);
 
 // fix_drive_config: the estimator's configuration for a drive: nominal values in use, the
-// drive's wheel noise, prior and bounds of `base`.
+// drive's wheel noise, prior and bounds of `base`; kSkid4 fits x_ICR (IcrFit::kFit, from 0).
 calib::SelfCalConfig fix_drive_config(const FixDrive& d, const FixDriveOptions& o,
                                       calib::SelfCalConfig base = {});
 

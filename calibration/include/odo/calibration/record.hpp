@@ -40,6 +40,8 @@ struct CalibrationRecord {
   std::optional<double> wheelbase;  // effective wheelbase b_new [m] (Eq. 6.28)
   std::optional<double> wheel_diameter;  // corrected nominal wheel diameter Dn* [m] (App. B)
   std::optional<double> e_s;             // scaling error E_s = L_calc / L_actual (Eq. B.1)
+  std::optional<double> x_icr;  // skid steer: ICR offset [m] (Kinematics::x_icr), version 3
+  double sigma_x_icr = 0.0;     // [m] its standard deviation when fitted (0: not fitted)
   // Provenance.
   std::int64_t time = 0;                // when the values were obtained [s since 1970, UTC]
   std::string method;                   // how: "umbmark", "set", "import", ... (<= 15 bytes)
@@ -65,16 +67,24 @@ struct CalibrationRecord {
 // CRC at 144, length 148. A record without `fit` is still written as version 1, so media and
 // readers of version 1 see no change; a version-1 reader reads a version-2 record's version-1
 // fields by the rule above. Flag bit 6 in a record of version < 2 or length < 148 is corrupt.
+//
+// Version 3 (records with `x_icr`, flag bit 7; issue 38): the version-2 layout (its fit fields
+// zero and flag bit 6 clear when the record has no `fit`), then 144 x_icr  152 sigma_x_icr (f64),
+// CRC at 160, length 164. Records without x_icr are written as version 1 or 2 as before; a
+// reader of version 1 or 2 reads a version-3 record's older fields (and runs without x_icr). Flag
+// bit 7 in a record of version < 3 or length < 164 is corrupt.
 inline constexpr std::uint32_t kRecordMagic = 0x4C43444FU;  // bytes 'O' 'D' 'C' 'L'
 inline constexpr std::uint16_t kRecordVersion = 1;
 inline constexpr std::uint16_t kRecordVersionFit = 2;
+inline constexpr std::uint16_t kRecordVersionIcr = 3;
 inline constexpr std::size_t kRecordV1Bytes = 108;
 inline constexpr std::size_t kRecordV2Bytes = 148;
+inline constexpr std::size_t kRecordV3Bytes = 164;
 inline constexpr std::size_t kMethodBytes = 16;
 
-// encode_record: the bytes of `r`: version 1 (kRecordV1Bytes) without `fit`, version 2
-// (kRecordV2Bytes) with it. Fails when the method text is longer than 15 bytes or a value is
-// not finite.
+// encode_record: the bytes of `r`: version 1 (kRecordV1Bytes) without `fit` and `x_icr`,
+// version 2 (kRecordV2Bytes) with `fit` only, version 3 (kRecordV3Bytes) with `x_icr`. Fails when
+// the method text is longer than 15 bytes or a value is not finite.
 Result<std::vector<std::uint8_t>> encode_record(const CalibrationRecord& r);
 
 // decode_record: parses a record at the start of `bytes` (a slot). Errc::kCorrupt with the
@@ -89,14 +99,15 @@ struct RecordLimits {
   static constexpr double kScalingMin = 0.8, kScalingMax = 1.25;       // E_s
   static constexpr double kEmaxMin = 0.0, kEmaxMax = 100.0;            // [m]
   static constexpr std::uint32_t kRunsMax = 1000000;
+  static constexpr double kXIcrMin = -2.0, kXIcrMax = 2.0;  // [m] (KinematicLimits::kXIcr)
 };
 
 // validate_record: every value finite and inside RecordLimits; the error names the field and
 // the allowed range.
 Status validate_record(const CalibrationRecord& r);
 
-// apply_record: the kinematics `nominal` corrected by the record (c_L, c_R, and the wheelbase and
-// wheel diameter when it holds them). Errors: the record's values out of range, or the
+// apply_record: the kinematics `nominal` corrected by the record (c_L, c_R, and the wheelbase,
+// wheel diameter and x_icr when it holds them). Errors: the record's values out of range, or the
 // corrected kinematics invalid (odometryd and the microcontroller firmware both run on nominal
 // values then).
 Result<KinematicParams> apply_record(const KinematicParams& nominal, const CalibrationRecord& r);

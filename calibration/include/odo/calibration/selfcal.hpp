@@ -57,6 +57,10 @@
 //     E_max,syst). The bounds do not apply to the scale: its posterior is never wider than the
 //     prior, so a dock drive writes the ratio and the turn rates with the prior's scale, and an
 //     open drive writes the scale as far as its fixes determined it.
+// x_ICR (issue 38, IcrFit::kFit): a 4th parameter, the skid-steer ICR offset; an excursion from
+// heading theta0 to theta1 then ends x (u(theta0) - u(theta1)) from the plain arcs' end
+// (selfcal_model.cpp), so only net turns other than 0 and 2 pi show it; it is reported
+// observable (to be applied) when its posterior sigma is at most max_sigma_x_icr.
 // Fix headings are used where present. A fix without heading contributes x, y only; the next
 // excursion then starts with the heading predicted by the previous one (its derivative carried
 // along, its variance taken as that of the last heading fix: that heading's correlation with
@@ -71,6 +75,7 @@
 #include <vector>
 
 #include "odo/calibration/count_recorder.hpp"
+#include "odo/calibration/icr_fit.hpp"
 #include "odo/calibration/umbmark.hpp"
 #include "odo/hal/result.hpp"
 #include "odo/hal/time.hpp"
@@ -114,8 +119,16 @@ enum class Acceptance : std::uint8_t {
   kCrossValidated = 1,  // every fold held out in turn; the candidate is the fit on all
 };
 
-// Covariance of (c_L, c_R, b), row-major [-, -, m; ...; m^2].
-using ParamCov = std::array<double, 9>;
+// Covariance of (c_L, c_R, b, x_ICR), row-major 4 x 4 [-, -, m, m; ...; m^2]; the x_ICR row and
+// column are zero when it is not fitted (IcrFit::kFixed).
+using ParamCov = std::array<double, 16>;
+// cov_at: element (i, j) of c (0 c_L, 1 c_R, 2 b, 3 x_ICR).
+constexpr double& cov_at(ParamCov& c, int i, int j) {
+  return c[static_cast<std::size_t>(4 * i + j)];
+}
+constexpr double cov_at(const ParamCov& c, int i, int j) {
+  return c[static_cast<std::size_t>(4 * i + j)];
+}
 
 struct SelfCalConfig {
   double metres_per_count = 0.0;     // c_m, nominal [m/count] (Kinematics::metres_per_count)
@@ -131,6 +144,13 @@ struct SelfCalConfig {
   // The held-out score must be below (1 - min_improvement) times the in-use calibration's: a
   // candidate about as good as the calibration in use is not written (0 .. 0.9).
   double min_improvement = 0.1;
+  // The ICR offset: in use [m] (+ ahead of the centre; the model's in both modes), fitted or not,
+  // its prior standard deviation and the bound on its posterior one below which the fit applies
+  // it (above: not observable from these fixes; c_L, c_R, b are judged as usual).
+  IcrFit icr = IcrFit::kFixed;
+  double x_icr = 0.0;              // [m], within KinematicLimits::kXIcr
+  double prior_sigma_x_icr = 0.1;  // [m]
+  double max_sigma_x_icr = 0.002;  // [m]
 };
 
 // check_selfcal_config: every field finite and in range; the message names the field.
@@ -172,6 +192,12 @@ struct SelfCalResult {
   double score_candidate = 0.0;  // held-out mean chi2 per dof (of the folds' fits)
   double score_in_use = 0.0;
   Verdict verdict = Verdict::kNoHeldOut;
+  // x_ICR: kFit's estimate and standard deviation, or the value in use and 0 (kFixed).
+  // x_icr_observable: fitted and sigma_x_icr <= max_sigma_x_icr, so that an accepted candidate
+  // carries it; false: the value in use stays (the reason: sigma_x_icr against the bound).
+  double x_icr = 0.0;        // [m]
+  double sigma_x_icr = 0.0;  // [m]
+  bool x_icr_observable = false;
 };
 
 // fit_fixes: the whole pipeline above. Errors: invalid config, a fix with a non-positive or
@@ -179,8 +205,8 @@ struct SelfCalResult {
 Result<SelfCalResult> fit_fixes(const FixTrack& track, const SelfCalConfig& cfg);
 
 // predict_excursion: the pose at the end of `legs` from `start` [m, m, rad] with parameters f
-// (exact arcs); for tests and tools.
+// and the ICR offset x_icr [m] (exact arcs, arc_step_icr); for tests and tools.
 Pose2 predict_excursion(const Pose2& start, std::span<const LegCounts> legs, const Factors& f,
-                        double metres_per_count);
+                        double metres_per_count, double x_icr = 0.0);
 
 }  // namespace odo::calib

@@ -12,6 +12,7 @@
 #include <tuple>
 #include <vector>
 
+#include "odo/calibration/icr_fit.hpp"
 #include "odo/hal/angle.hpp"
 #include "odo/hal/choice.hpp"
 #include "odo/hal/field_range.hpp"
@@ -105,7 +106,8 @@ inline constexpr std::tuple kChoiceTables{
     std::span<const Choice<GyroAxis>>(kGyroAxes),
     std::span<const Choice<GyroMode>>(kGyroModes),
     std::span<const Choice<GyroModelKind>>(kGyroModelKinds),
-    std::span<const Choice<SideCombine>>(kSideCombineNames)};
+    std::span<const Choice<SideCombine>>(kSideCombineNames),
+    std::span<const Choice<calib::IcrFit>>(calib::kIcrFitNames)};
 
 // choices: the table of enum E's choices.
 template <class E>
@@ -350,6 +352,11 @@ struct SelfCalSection {
   double min_improvement = 0.1;         // held-out score below (1 - this) x the one in use
   double prior_sigma_factor = 0.01;     // prior around the calibration in use
   double prior_sigma_wheelbase = 0.02;  // [m]
+  // x_icr = "fit": the skid-steer ICR offset is a 4th parameter (issue 38), applied only when
+  // its standard deviation is below max_sigma_x_icr; "fixed": held at the value in use.
+  calib::IcrFit x_icr = calib::IcrFit::kFixed;
+  double prior_sigma_x_icr = 0.1;  // [m]
+  double max_sigma_x_icr = 0.002;  // [m]
 };
 
 // SelfCalRange: one [selfcal] number, its range and unit: the only place they are written
@@ -371,7 +378,9 @@ inline constexpr SelfCalRange<double> kSelfCalNumbers[] = {
     {"max_sigma_wheelbase", &SelfCalSection::max_sigma_wheelbase, 1e-6, 0.1, "m"},
     {"min_improvement", &SelfCalSection::min_improvement, 0.0, 0.9, ""},
     {"prior_sigma_factor", &SelfCalSection::prior_sigma_factor, 1e-4, 0.5, ""},
-    {"prior_sigma_wheelbase", &SelfCalSection::prior_sigma_wheelbase, 1e-4, 1.0, "m"}};
+    {"prior_sigma_wheelbase", &SelfCalSection::prior_sigma_wheelbase, 1e-4, 1.0, "m"},
+    {"prior_sigma_x_icr", &SelfCalSection::prior_sigma_x_icr, 1e-4, 1.0, "m"},
+    {"max_sigma_x_icr", &SelfCalSection::max_sigma_x_icr, 1e-5, 0.1, "m"}};
 
 // [gyro]: a yaw-rate gyro and the gyrodometry fusion (README "Gyro"). backend = "iio": a MEMS
 // gyro through Linux IIO; "can": a rate sent on CAN ([can_gyro]); "sim": a simulated gyro on the
