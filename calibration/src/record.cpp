@@ -249,9 +249,10 @@ Status validate_record(const CalibrationRecord& r) {
   if (r.e_max_after)
     if (auto s = check_range("e_max_syst_after", *r.e_max_after, L::kEmaxMin, L::kEmaxMax, "m"); !s)
       return s;
+  constexpr Limit kX = KinematicLimits::kXIcr;
   if (r.x_icr)
-    if (auto s = check_range("x_icr", *r.x_icr, L::kXIcrMin, L::kXIcrMax, "m"); !s) return s;
-  if (auto s = check_range("sigma_x_icr", r.sigma_x_icr, 0.0, L::kXIcrMax, "m"); !s) return s;
+    if (auto s = check_range("x_icr", *r.x_icr, kX.lo, kX.hi, "m"); !s) return s;
+  if (auto s = check_range("sigma_x_icr", r.sigma_x_icr, 0.0, kX.hi, "m"); !s) return s;
   if (!r.x_icr && r.sigma_x_icr != 0.0)
     return make_error(Errc::kInvalidArgument, "sigma_x_icr is given without x_icr");
   if (auto s = check_count("runs", r.runs); !s) return s;

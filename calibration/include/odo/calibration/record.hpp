@@ -99,7 +99,7 @@ struct RecordLimits {
   static constexpr double kScalingMin = 0.8, kScalingMax = 1.25;       // E_s
   static constexpr double kEmaxMin = 0.0, kEmaxMax = 100.0;            // [m]
   static constexpr std::uint32_t kRunsMax = 1000000;
-  static constexpr double kXIcrMin = -2.0, kXIcrMax = 2.0;  // [m] (KinematicLimits::kXIcr)
+  // x_icr and sigma_x_icr: KinematicLimits::kXIcr, the kinematics' own range.
 };
 
 // validate_record: every value finite and inside RecordLimits; the error names the field and
