@@ -330,7 +330,8 @@ replay_output() { cat "$1"; return "$2"; }
 # the background from the start of the run, at nice 19. On a fresh machine that is the kernel
 # packages' download and the gpio-sim build from Debian's kernel source (51 s of CPU; 186 s of
 # wall time at stop 45 on a loaded machine with an empty cache), which the kernel stage used to
-# wait for on the critical path. vm_prepare_wait: its output; its exit status (the stage's own call when none started).
+# wait for on the critical path. vm_prepare_wait: its output and exit status (without a
+# background run, the stage's own call).
 vm_prepare_pid=''
 vm_prepare_start() {
   mkdir -p build
@@ -365,7 +366,8 @@ stage_kernel() {
       # Each long drive (kernel_long) in a VM of its own beside the rest: they were 306 of the
       # tier's 441 test-seconds (stop 42) and mostly wait on the daemon's timers, so one VM's
       # one CPU left the machine idle; in one second VM together (stops 43-44) the tier took
-      # their sum, 295 s; in two, the longer (173 s).
+      # their sum, 295 s; in two, the longer (stop 45's fresh-chroot run: 187 s, beside the
+      # main VM's 133 s).
       for re in "${kernel_long[@]}"; do
         kernel_has "$tree" "$re" || continue
         long_logs+=("build/$tree/kernel-$re.log")

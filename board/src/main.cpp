@@ -89,6 +89,14 @@ struct EncoderWiring {
   const std::array<SideReadings, 2>* wheels = nullptr;
 };
 
+// side_config: [encoder]'s side keys of cfg with the combiner's slip window counted in this
+// loop's ticks (the combiner reads once a tick).
+SideWheelsConfig side_config(const BoardConfig& cfg) noexcept {
+  SideWheelsConfig w = cfg.wheels;
+  w.read_period = 1.0 / cfg.rate_hz;
+  return w;
+}
+
 #if ODO_BOARD_SIM
 // sim_wheels: several wheels per side on the simulated robot, as odometryd's sim backend with
 // encoder.wheels_per_side > 1 (SimSideWheelsSource, the wheel model's documented defaults).
@@ -98,9 +106,8 @@ EncoderWiring sim_wheels(const BoardConfig& cfg, sim::SimRobot& robot) noexcept 
   p.wheels_per_side = cfg.wheels.wheels_per_side;
   auto model = sim::SideWheelsSim::create(p, robot.geometry());
   if (!model) fail("simulated wheels");
-  SideWheelsConfig w = cfg.wheels;
-  w.read_period = 1.0 / cfg.rate_hz;  // the combiner's slip window in this loop's ticks
-  auto src = sim::SimSideWheelsSource::create(robot, std::move(model).value(), w, cfg.counter_bits);
+  auto src = sim::SimSideWheelsSource::create(robot, std::move(model).value(), side_config(cfg),
+                                              cfg.counter_bits);
   if (!src) fail(src.error().message.c_str());
   enc.emplace(std::move(src).value());
   return {&*enc, sim::scenario_duration(robot.scenario()), &enc->readings()};
@@ -131,10 +138,8 @@ EncoderWiring make_encoders(const BoardConfig& cfg, const Kinematics& k) noexcep
   (void)k;
   static MmioBus mmio;
   if constexpr (kBoardWheelsPerSide == 2) {
-    SideWheelsConfig w = cfg.wheels;
-    w.read_period = 1.0 / cfg.rate_hz;  // the combiner's slip window in this loop's ticks
     static std::optional<Stm32SideTimers> side;
-    auto t = Stm32SideTimers::create(mmio, w);
+    auto t = Stm32SideTimers::create(mmio, side_config(cfg));
     if (!t)
       fail("encoder: wheels_per_side, slip_window, slip_counts or slip_fraction out of range");
     side.emplace(std::move(*t));
